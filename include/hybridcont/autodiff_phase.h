@@ -1,0 +1,196 @@
+// Automatic differentiation of user-written phase functions (included by model.h; not used directly).
+//
+// A user functor F has static templates VectorField, FirstIntegral(s), Event and Reset over the scalar T.
+// AutoDiffPhase<F, P> instantiates them with
+//   - double                       for values,
+//   - Jet  = AutoDiffScalar<dual>  for first derivatives (df, dH, de, D): one forward sweep over n seeds,
+//   - Jet2 = AutoDiffScalar<Jet>   for the Hessians of H (needed by A = df~/dx when xi != 0).
+// Derivative vectors are fixed-capacity (kMaxPhaseDim) stack storage, so no evaluation allocates on the
+// heap. Eigen's AutoDiff module is the well-kept library this builds on (STYLE.md practice 4).
+#ifndef HYBRIDCONT_AUTODIFF_PHASE_H_
+#define HYBRIDCONT_AUTODIFF_PHASE_H_
+
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include <unsupported/Eigen/AutoDiff>
+
+namespace hybridcont::internal {
+
+using DerivativeVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxPhaseDim, 1>;
+using Jet = Eigen::AutoDiffScalar<DerivativeVector>;
+using Jet2 = Eigen::AutoDiffScalar<Eigen::Matrix<Jet, Eigen::Dynamic, 1, 0, kMaxPhaseDim, 1>>;
+
+// x as n independent variables: seed x(i) with the i-th unit derivative.
+inline StateVector<Jet> SeedJets(const Eigen::Ref<const Vector>& x) {
+  const int n = static_cast<int>(x.size());
+  StateVector<Jet> xj(n);
+  for (int i = 0; i < n; ++i) xj(i) = Jet(x(i), n, i);
+  return xj;
+}
+
+inline StateVector<Jet2> SeedJets2(const Eigen::Ref<const Vector>& x) {
+  const int n = static_cast<int>(x.size());
+  StateVector<Jet2> xj(n);
+  for (int i = 0; i < n; ++i) {
+    xj(i).value() = Jet(x(i), n, i);
+    xj(i).derivatives().resize(n);
+    for (int j = 0; j < n; ++j) xj(i).derivatives()(j) = Jet(i == j ? 1.0 : 0.0, DerivativeVector::Zero(n));
+  }
+  return xj;
+}
+
+// Value and Jacobian rows of a vector of Jets. A Jet that never met an input (a constant output) has an
+// empty derivative vector: its row is zero.
+inline void Unpack(const StateVector<Jet>& y, int n, Vector* value, Matrix* jacobian) {
+  const int rows = static_cast<int>(y.size());
+  if (value) value->resize(rows);
+  if (jacobian) jacobian->resize(rows, n);
+  for (int i = 0; i < rows; ++i) {
+    if (value) (*value)(i) = y(i).value();
+    if (jacobian) {
+      if (y(i).derivatives().size() == n) {
+        jacobian->row(i) = y(i).derivatives().transpose();
+      } else {
+        jacobian->row(i).setZero();
+      }
+    }
+  }
+}
+
+// Detects the user's choice between FirstIntegral (k = 1) and FirstIntegrals (k >= 1).
+template <class F, class P>
+concept HasScalarFirstIntegral = requires(const StateVector<double>& x, const P& p) {
+  { F::template FirstIntegral<double>(x, p) };
+};
+
+template <class F, class P, class T>
+StateVector<T> EvaluateFirstIntegrals(const StateVector<T>& x, const P& p) {
+  if constexpr (HasScalarFirstIntegral<F, P>) {
+    StateVector<T> h(1);
+    h(0) = F::template FirstIntegral<T>(x, p);
+    return h;
+  } else {
+    return F::template FirstIntegrals<T>(x, p);
+  }
+}
+
+template <class F, class P>
+class AutoDiffPhase final : public Phase {
+ public:
+  AutoDiffPhase(std::string name, std::vector<std::string> state_names, int next_dim, Vector typical_state,
+                const P* params)
+      : Phase(std::move(name), std::move(state_names), next_dim,
+              static_cast<int>(EvaluateFirstIntegrals<F, P, double>(StateVector<double>(typical_state), *params).size()),
+              typical_state),
+        p_(params) {}
+
+  void VectorField(const Eigen::Ref<const Vector>& x, Vector* f, Matrix* df) const override {
+    if (!df) {
+      *f = F::template VectorField<double>(StateVector<double>(x), *p_);
+      return;
+    }
+    Unpack(F::template VectorField<Jet>(SeedJets(x), *p_), dim(), f, df);
+  }
+
+  void FirstIntegrals(const Eigen::Ref<const Vector>& x, Vector* H, Matrix* dH,
+                      std::vector<Matrix>* d2H) const override {
+    const int n = dim();
+    if (d2H) {
+      const StateVector<Jet2> h = EvaluateFirstIntegrals<F, P, Jet2>(SeedJets2(x), *p_);
+      const int k = static_cast<int>(h.size());
+      if (H) H->resize(k);
+      if (dH) dH->resize(k, n);
+      d2H->resize(k);
+      for (int j = 0; j < k; ++j) {
+        if (H) (*H)(j) = h(j).value().value();
+        Matrix& hess = (*d2H)[j];
+        hess.setZero(n, n);
+        if (dH) dH->row(j).setZero();
+        if (h(j).derivatives().size() != n) continue;
+        for (int a = 0; a < n; ++a) {
+          const Jet& g = h(j).derivatives()(a);
+          if (dH) (*dH)(j, a) = g.value();
+          if (g.derivatives().size() == n) hess.row(a) = g.derivatives().transpose();
+        }
+      }
+      return;
+    }
+    if (!dH) {
+      *H = EvaluateFirstIntegrals<F, P, double>(StateVector<double>(x), *p_);
+      return;
+    }
+    Unpack(EvaluateFirstIntegrals<F, P, Jet>(SeedJets(x), *p_), n, H, dH);
+  }
+
+  double Event(const Eigen::Ref<const Vector>& x, RowVector* de) const override {
+    if (!de) return F::template Event<double>(StateVector<double>(x), *p_);
+    StateVector<Jet> e(1);
+    e(0) = F::template Event<Jet>(SeedJets(x), *p_);
+    Vector value;
+    Matrix jac;
+    Unpack(e, dim(), &value, &jac);
+    *de = jac.row(0);
+    return value(0);
+  }
+
+  void Reset(const Eigen::Ref<const Vector>& x, Vector* x_next, Matrix* D) const override {
+    if (!D) {
+      *x_next = F::template Reset<double>(StateVector<double>(x), *p_);
+      return;
+    }
+    Unpack(F::template Reset<Jet>(SeedJets(x), *p_), dim(), x_next, D);
+  }
+
+ private:
+  const P* p_;
+};
+
+template <class A, class P>
+class AutoDiffAnchor final : public Anchor {
+ public:
+  explicit AutoDiffAnchor(const P* params) : p_(params) {}
+  double Evaluate(const Eigen::Ref<const Vector>& x, RowVector* da) const override {
+    if (!da) return A::template Anchor<double>(StateVector<double>(x), *p_);
+    StateVector<Jet> a(1);
+    a(0) = A::template Anchor<Jet>(SeedJets(x), *p_);
+    Vector value;
+    Matrix jac;
+    Unpack(a, static_cast<int>(x.size()), &value, &jac);
+    *da = jac.row(0);
+    return value(0);
+  }
+
+ private:
+  const P* p_;
+};
+
+template <class P>
+class TypedParameterBlock final : public ParameterBlock {
+ public:
+  void Add(std::string name, double P::*member, std::string description) {
+    infos_.push_back({std::move(name), values_.*member, std::move(description)});
+    members_.push_back(member);
+  }
+  const std::vector<ParameterInfo>& infos() const override { return infos_; }
+  double Get(int index) const override { return values_.*members_[index]; }
+  void Set(int index, double value) override { values_.*members_[index] = value; }
+  const P& values() const { return values_; }
+
+ private:
+  P values_{};
+  std::vector<ParameterInfo> infos_;
+  std::vector<double P::*> members_;
+};
+
+// Checks that every reset maps into the next phase's dimension and that all phases have the same number
+// of first integrals (Lemma `NH`); throws std::invalid_argument otherwise.
+void ValidatePhaseSizes(const std::string& model_name, const std::vector<std::unique_ptr<Phase>>& phases);
+
+}  // namespace hybridcont::internal
+
+#endif  // HYBRIDCONT_AUTODIFF_PHASE_H_

@@ -1,0 +1,249 @@
+// A conservative hybrid dynamical system: a cyclic sequence of m >= 1 phases (paper §2.1).
+//
+// Phase i has a state x_i of its own dimension n_i, a vector field f_i, first integrals H_i (energy; one
+// or more), an event function e_i whose *downward* zero crossing ends the phase (guard: e_i = 0 with
+// de_i·f_i < 0) and a reset map Delta_i: x_i^- -> x_{i+1}^+ into the next phase (cyclic: m+1 = 1).
+// Phase 1 carries the anchor a, whose downward zero crossing defines the Poincaré section.
+//
+// Users write these functions once, as templates over the scalar type; the library differentiates them
+// by forward-mode automatic differentiation (see autodiff_phase.h and ModelBuilder below):
+//
+//   struct BallParameters { double m = 1.0, g = 1.0; };
+//   struct Fall {
+//     template <class T> static StateVector<T> VectorField(const StateVector<T>& x, const BallParameters& p) {
+//       StateVector<T> f(2); f << x(1), T(-p.g); return f;
+//     }
+//     template <class T> static T FirstIntegral(const StateVector<T>& x, const BallParameters& p) {
+//       return 0.5 * p.m * x(1) * x(1) + p.m * p.g * x(0);
+//     }
+//     template <class T> static T Event(const StateVector<T>& x, const BallParameters&) { return x(0); }
+//     template <class T> static StateVector<T> Reset(const StateVector<T>& x, const BallParameters&) {
+//       StateVector<T> y(2); y << x(0), -x(1); return y;
+//     }
+//   };
+//   struct Apex { template <class T> static T Anchor(const StateVector<T>& x, const BallParameters&) { return x(1); } };
+//
+//   ModelBuilder<BallParameters> b("bouncing-ball", "a ball bouncing elastically on the ground");
+//   b.Parameter("m", &BallParameters::m, "mass").Parameter("g", &BallParameters::g, "gravity");
+//   b.AddPhase<Fall>("flight", {"y", "dy"}, /*typical_state=*/{0.5, 0.0});
+//   b.SetAnchor<Apex>();
+//   HybridModel ball = b.Build();
+//
+// A phase functor may define `FirstIntegrals` (returning a StateVector<T> of k values) instead of
+// `FirstIntegral` when the system has k > 1 hybrid first integrals (the paper's remark on N_H > 1).
+// A user who wants analytic derivatives implements the `Phase` interface directly instead.
+#ifndef HYBRIDCONT_MODEL_H_
+#define HYBRIDCONT_MODEL_H_
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hybridcont/types.h"
+
+namespace hybridcont {
+
+// Largest state dimension of a phase written with automatic differentiation. The derivative part of the
+// AD scalars is stack storage of this capacity (no heap allocation in the integrator's inner loop, in the
+// spirit of Ceres' fixed-size Jets). 16 states = 8 degrees of freedom per phase; the nested scalars used
+// for Hessians of H grow with its square and must stay below Eigen's 128 KiB stack-object limit.
+inline constexpr int kMaxPhaseDim = 16;
+
+// The vector type user model functions take and return, for a scalar type T (double or an AD scalar).
+template <class T>
+using StateVector = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, kMaxPhaseDim, 1>;
+
+// One phase of a hybrid system, type-erased. All derivative outputs are optional (nullptr: not wanted).
+// Implementations must be thread-safe for concurrent const calls.
+class Phase {
+ public:
+  Phase(std::string name, std::vector<std::string> state_names, int next_dim, int num_first_integrals,
+        Vector typical_state);
+  virtual ~Phase() = default;
+
+  const std::string& name() const { return name_; }
+  int dim() const { return static_cast<int>(state_names_.size()); }
+  // Dimension of the phase the reset map leads into.
+  int next_dim() const { return next_dim_; }
+  const std::vector<std::string>& state_names() const { return state_names_; }
+  int num_first_integrals() const { return num_first_integrals_; }
+  // A state where the model functions are well defined; used to sample derivative checks.
+  const Vector& typical_state() const { return typical_state_; }
+
+  // f(x) and df/dx.
+  virtual void VectorField(const Eigen::Ref<const Vector>& x, Vector* f, Matrix* df) const = 0;
+  // H_j(x), j = 1..k; dH: k x n with row j = dH_j; d2H: k Hessians n x n.
+  virtual void FirstIntegrals(const Eigen::Ref<const Vector>& x, Vector* H, Matrix* dH,
+                              std::vector<Matrix>* d2H) const = 0;
+  // e(x) and de/dx (row).
+  virtual double Event(const Eigen::Ref<const Vector>& x, RowVector* de) const = 0;
+  // Delta(x) into the next phase and D = dDelta/dx (next_dim x n).
+  virtual void Reset(const Eigen::Ref<const Vector>& x, Vector* x_next, Matrix* D) const = 0;
+
+  // The dissipative unfolding of eq. `hybridDynamicsNum`: f~(x, xi) = f(x) + sum_j xi_j dH_j(x)^T,
+  // with A = df~/dx = df + sum_j xi_j d2H_j and B = df~/dxi = dH^T (n x k). Hessians are evaluated only
+  // when some xi_j != 0 (their term vanishes exactly otherwise).
+  void UnfoldedVectorField(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
+                           Vector* f_tilde, Matrix* A, Matrix* B) const;
+
+ private:
+  std::string name_;
+  std::vector<std::string> state_names_;
+  int next_dim_;
+  int num_first_integrals_;
+  Vector typical_state_;
+};
+
+// The anchor a: X_1 -> R of the Poincaré section (its downward zero crossing).
+class Anchor {
+ public:
+  virtual ~Anchor() = default;
+  virtual double Evaluate(const Eigen::Ref<const Vector>& x, RowVector* da) const = 0;
+};
+
+struct ParameterInfo {
+  std::string name;
+  double default_value;
+  std::string description;
+};
+
+// Named real parameters of a model; the values live in a user struct P (see ModelBuilder).
+class ParameterBlock {
+ public:
+  virtual ~ParameterBlock() = default;
+  virtual const std::vector<ParameterInfo>& infos() const = 0;
+  virtual double Get(int index) const = 0;
+  virtual void Set(int index, double value) = 0;
+};
+
+// A hybrid model: phases, anchor and parameters. Move-only (phases refer to the parameter block it owns).
+class HybridModel {
+ public:
+  HybridModel(std::string name, std::string description, std::unique_ptr<ParameterBlock> parameters,
+              std::vector<std::unique_ptr<Phase>> phases, std::unique_ptr<Anchor> anchor);
+  HybridModel(HybridModel&&) noexcept = default;
+  HybridModel& operator=(HybridModel&&) noexcept = default;
+
+  const std::string& name() const { return name_; }
+  const std::string& description() const { return description_; }
+  // m, the number of phases in one cycle.
+  int num_phases() const { return static_cast<int>(phases_.size()); }
+  // Phase i, 0-based and cyclic: phase(m) is phase(0).
+  const Phase& phase(int i) const { return *phases_[i % phases_.size()]; }
+  int num_first_integrals() const { return phases_.front()->num_first_integrals(); }
+  const Anchor& anchor() const { return *anchor_; }
+
+  const std::vector<ParameterInfo>& parameters() const { return parameters_->infos(); }
+  // Value of the named parameter; throws std::invalid_argument naming the parameter if unknown.
+  double parameter(const std::string& name) const;
+  // Sets a parameter; throws std::invalid_argument if the name is unknown or the value is not finite.
+  void SetParameter(const std::string& name, double value);
+
+ private:
+  int ParameterIndex(const std::string& name) const;
+
+  std::string name_;
+  std::string description_;
+  std::unique_ptr<ParameterBlock> parameters_;
+  std::vector<std::unique_ptr<Phase>> phases_;
+  std::unique_ptr<Anchor> anchor_;
+};
+
+}  // namespace hybridcont
+
+#include "hybridcont/autodiff_phase.h"
+
+namespace hybridcont {
+
+// Assembles a HybridModel from templated functors over a parameter struct P.
+template <class P>
+class ModelBuilder {
+ public:
+  ModelBuilder(std::string name, std::string description)
+      : name_(std::move(name)), description_(std::move(description)),
+        parameters_(std::make_unique<internal::TypedParameterBlock<P>>()) {}
+
+  // Registers a named parameter stored in member `member` of P; its default is the member's initializer.
+  ModelBuilder& Parameter(std::string name, double P::*member, std::string description) {
+    parameters_->Add(std::move(name), member, std::move(description));
+    return *this;
+  }
+
+  // Appends a phase whose functions are the static templates of F (see the header comment).
+  // typical_state: a state where the functions are well defined (sizes the phase; samples checks).
+  template <class F>
+  ModelBuilder& AddPhase(std::string name, std::vector<std::string> state_names, Vector typical_state) {
+    pending_.push_back({std::move(name), std::move(state_names), std::move(typical_state),
+                        [](PendingPhase& pp, int next_dim, const P* params) -> std::unique_ptr<Phase> {
+                          return std::make_unique<internal::AutoDiffPhase<F, P>>(
+                              pp.name, pp.state_names, next_dim, pp.typical_state, params);
+                        }});
+    return *this;
+  }
+  ModelBuilder& AddPhase(std::unique_ptr<Phase> hand_written) {
+    ready_.emplace(static_cast<int>(pending_.size()), std::move(hand_written));
+    pending_.push_back({});
+    return *this;
+  }
+
+  template <class A>
+  ModelBuilder& SetAnchor() {
+    anchor_factory_ = [](const P* params) -> std::unique_ptr<Anchor> {
+      return std::make_unique<internal::AutoDiffAnchor<A, P>>(params);
+    };
+    return *this;
+  }
+
+  // Validates dimensions (reset maps into the next phase, first integrals in every phase) and builds.
+  // Throws std::invalid_argument naming the offending phase.
+  HybridModel Build() {
+    const int m = static_cast<int>(pending_.size());
+    if (m == 0) throw std::invalid_argument("model '" + name_ + "': no phases");
+    if (!anchor_factory_) throw std::invalid_argument("model '" + name_ + "': no anchor set");
+    const P* params = &parameters_->values();
+    std::vector<std::unique_ptr<Phase>> phases(m);
+    std::vector<int> dims(m);
+    for (int i = 0; i < m; ++i) {
+      dims[i] = ready_.count(i) ? ready_.at(i)->dim() : static_cast<int>(pending_[i].state_names.size());
+    }
+    for (int i = 0; i < m; ++i) {
+      if (ready_.count(i)) {
+        phases[i] = std::move(ready_.at(i));
+      } else {
+        if (pending_[i].typical_state.size() != dims[i]) {
+          throw std::invalid_argument("model '" + name_ + "', phase '" + pending_[i].name +
+                                      "': typical_state has " + std::to_string(pending_[i].typical_state.size()) +
+                                      " entries, the phase has " + std::to_string(dims[i]) + " states");
+        }
+        if (dims[i] < 1 || dims[i] > kMaxPhaseDim) {
+          throw std::invalid_argument("model '" + name_ + "', phase '" + pending_[i].name + "': dimension " +
+                                      std::to_string(dims[i]) + " outside [1, kMaxPhaseDim = " +
+                                      std::to_string(kMaxPhaseDim) + "]");
+        }
+        phases[i] = pending_[i].make(pending_[i], dims[(i + 1) % m], params);
+      }
+    }
+    internal::ValidatePhaseSizes(name_, phases);
+    return HybridModel(name_, description_, std::move(parameters_), std::move(phases), anchor_factory_(params));
+  }
+
+ private:
+  struct PendingPhase {
+    std::string name;
+    std::vector<std::string> state_names;
+    Vector typical_state;
+    std::function<std::unique_ptr<Phase>(PendingPhase&, int, const P*)> make;
+  };
+  std::string name_;
+  std::string description_;
+  std::unique_ptr<internal::TypedParameterBlock<P>> parameters_;
+  std::vector<PendingPhase> pending_;
+  std::map<int, std::unique_ptr<Phase>> ready_;
+  std::function<std::unique_ptr<Anchor>(const P*)> anchor_factory_;
+};
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_MODEL_H_

@@ -1,0 +1,39 @@
+// The built-in models of the paper (§4), registered by name, each with its analytic starting point.
+//
+//   for (const std::string& name : BuiltinModelNames()) { ... }
+//   HybridModel slip = MakeBuiltinModel("slip");     // k = 40, w2 = 5, m = l0 = g = 1
+//   slip.SetParameter("k", 20.0);
+//   Vector u0 = BuiltinStartPoint(slip);             // the T0 = 2 pi sqrt(m/k) oscillation at H = 1
+//
+// Normalized units m = l0 = g = 1 throughout; every parameter can be overridden at run time.
+#ifndef HYBRIDCONT_MODELS_H_
+#define HYBRIDCONT_MODELS_H_
+
+#include <string>
+#include <vector>
+
+#include "hybridcont/model.h"
+
+namespace hybridcont {
+
+// "bouncing-ball", "rocking-block", "bouncing-rod", "slip", plus the scalable test model "ball-chain".
+std::vector<std::string> BuiltinModelNames();
+
+// Builds the named model with its default parameters; throws std::invalid_argument listing the known
+// names if there is none of that name.
+HybridModel MakeBuiltinModel(const std::string& name);
+
+// The paper's analytic starting point u0 (time-based layout) for a built-in model at its current
+// parameters: the equilibrium u0 = 0 (ball, block, rod) or the SLIP's harmonic oscillation with zero
+// flight time at H = m g l0. These are singular points of r (bifurcation points), as in the paper.
+Vector BuiltinStartPoint(const HybridModel& model);
+
+// Individual factories (one source file each under src/models/).
+HybridModel MakeBouncingBall();
+HybridModel MakeRockingBlock();
+HybridModel MakeBouncingRod();
+HybridModel MakeSlip();
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_MODELS_H_

@@ -1,0 +1,92 @@
+// The time-based multiple-shooting map r: R^{N+1} -> R^N of paper eq. `timebased` and its Jacobian
+// (eq. `multishootJacobian`), as a ZeroProblem for the continuation engine.
+//
+// Phase durations t_i are unknowns (they may be zero or negative); events and anchor become equations.
+// Residual blocks, in the order of the layout (shooting_layout.h):
+//   r_p  = phi_1(t_{m+1}, x̄_{m+1}; xi) - x̄_1            periodicity
+//   r_a  = a(phi_1(t_{m+1}, x̄_{m+1}; xi))                anchor
+//   r_s,i = Delta_i(phi_i(t_i, x̄_i; xi)) - x̄_{i+1}        shooting, i = m..1
+//   r_e,i = e_i(phi_i(t_i, x̄_i; xi))                      event, i = m..1
+//   r_i  = H_1(x̄_1) - H̄                                   first integral
+//
+// Jacobian (columns grouped as u, rows as r; f~ = f~(phi_i), Phi_i, Psi_i at the end of phase i):
+//
+//          t_{m+1},x̄_{m+1}  t_m,x̄_m   ...   t_1,x̄_1     xi        H̄
+//   m+1  [ R_{m+1}          0          ...   C           Xi_{m+1}   0 ]
+//   m    [ C                R_m        ...   0           Xi_m       0 ]
+//   ...  [        ...             ...                     ...         ]
+//   1    [ 0                ...    C         R_1         Xi_1       0 ]
+//   H    [ 0                ...    0         h_1          0        -1 ]
+//
+//   R_i = [ D_i f~   D_i Phi_i ]     Xi_i = [ D_i Psi_i  ]     C = [ 0  -I ]     h_1 = [ 0  dH_1(x̄_1) ]
+//         [ de_i f~  de_i Phi_i]            [ de_i Psi_i ]         [ 0   0 ]
+// with D_{m+1} = I and de_{m+1} = da. No saltation matrices are needed (paper §3.4).
+//
+// One integration of every phase per evaluation point: r and dr are read from the same flows, and a
+// second call at the same u (e.g. r first, then dr) reuses the cache (STYLE.md practice 8).
+//
+//   TimeBasedShooting shooting(model, IntegratorOptions{});
+//   Vector r; Matrix dr;
+//   EvaluationStatus s = shooting.Evaluate(u, &r, &dr);
+#ifndef HYBRIDCONT_TIMEBASED_SHOOTING_H_
+#define HYBRIDCONT_TIMEBASED_SHOOTING_H_
+
+#include <vector>
+
+#include "hybridcont/flow.h"
+#include "hybridcont/shooting_layout.h"
+#include "hybridcont/zero_problem.h"
+
+namespace hybridcont {
+
+class TimeBasedShooting : public ZeroProblem {
+ public:
+  // Keeps a reference to model (it must outlive this object).
+  TimeBasedShooting(const HybridModel& model, IntegratorOptions options);
+
+  int num_equations() const override { return layout_.num_equations(); }
+  std::vector<std::string> unknown_names() const override { return layout_.unknown_names(); }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override;
+
+  const ShootingLayout& layout() const { return layout_; }
+  const HybridModel& model() const { return *model_; }
+  const IntegratorOptions& integrator_options() const { return options_; }
+
+  // Fixed levels H̄_j of first integrals j = 2..k (size k-1); zero by default.
+  void SetFixedLevels(const Vector& levels);
+
+  // Flow of segment i (0-based) at the last evaluated u (x, Phi, Psi when dr was requested).
+  const PhaseFlowResult& segment_flow(int i) const { return flows_[i]; }
+  // Work done by all evaluations so far.
+  const FlowCounters& counters() const { return counters_; }
+  long num_evaluations() const { return num_evaluations_; }
+  void ResetCounters() {
+    counters_ = FlowCounters();
+    num_evaluations_ = 0;
+  }
+
+ private:
+  EvaluationStatus Integrate(const Vector& u, bool sensitivities);
+
+  const HybridModel* model_;
+  IntegratorOptions options_;
+  ShootingLayout layout_;
+  Vector fixed_levels_;
+  std::vector<PhaseFlow> integrators_;
+  std::vector<PhaseFlowResult> flows_;
+  // cache of the last integrated point
+  Vector cached_u_;
+  bool cached_sensitivities_ = false;
+  bool cache_valid_ = false;
+  EvaluationStatus cached_status_;
+  FlowCounters counters_;
+  long num_evaluations_ = 0;
+  // scratch
+  Vector out_, H_;
+  Matrix D_, dH_;
+  RowVector de_;
+};
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_TIMEBASED_SHOOTING_H_

@@ -1,0 +1,67 @@
+// A zero problem: a smooth map r: R^{N+1} -> R^N with its Jacobian dr (N x (N+1)).
+//
+// Its zero set S = r^{-1}(0) is, near regular points, a curve; the continuation engine traces it. The
+// engine knows nothing about hybrid systems: the time-based shooting map (timebased_shooting.h), the
+// state-based map, and the algebraic test curves (a circle, a pitchfork) are all ZeroProblems.
+//
+//   class Circle : public hybridcont::ZeroProblem {
+//    public:
+//     int num_equations() const override { return 1; }
+//     std::vector<std::string> unknown_names() const override { return {"x", "y"}; }
+//     EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+//       if (r) *r = Vector::Constant(1, u.squaredNorm() - 1.0);
+//       if (dr) *dr = 2.0 * u.transpose();
+//       return {};
+//     }
+//   };
+//
+// Evaluate is non-const: implementations keep their scratch space (integrator state, sensitivities) in
+// members so that repeated evaluations allocate nothing. A numerical failure during an evaluation (the
+// integrator's step fell below its minimum, a model function returned NaN) is reported through the
+// returned status, never by an exception: the caller decides (e.g. the corrector halves its step).
+#ifndef HYBRIDCONT_ZERO_PROBLEM_H_
+#define HYBRIDCONT_ZERO_PROBLEM_H_
+
+#include <string>
+#include <vector>
+
+#include "hybridcont/types.h"
+
+namespace hybridcont {
+
+// Outcome of one evaluation of r / dr.
+struct EvaluationStatus {
+  bool ok = true;
+  std::string message;  // empty when ok; otherwise what failed, where (phase, time) and why
+  static EvaluationStatus Failure(std::string why) { return {false, std::move(why)}; }
+};
+
+class ZeroProblem {
+ public:
+  virtual ~ZeroProblem() = default;
+
+  // N, the number of equations. The number of unknowns is N + 1.
+  virtual int num_equations() const = 0;
+  int num_unknowns() const { return num_equations() + 1; }
+
+  // Names of the N+1 unknowns, in the order of u (used to label outputs and to address components,
+  // e.g. "H" for the level set of the first integral or "xi" for the unfolding parameter).
+  virtual std::vector<std::string> unknown_names() const = 0;
+
+  // Evaluates r(u) into *r (if r != nullptr) and dr(u) into *dr (if dr != nullptr), resizing them.
+  // Both outputs are computed from the same internal state when both are requested.
+  virtual EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) = 0;
+
+  // Index of the named unknown, or -1.
+  int UnknownIndex(const std::string& name) const {
+    const std::vector<std::string> names = unknown_names();
+    for (int i = 0; i < static_cast<int>(names.size()); ++i) {
+      if (names[i] == name) return i;
+    }
+    return -1;
+  }
+};
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_ZERO_PROBLEM_H_

@@ -1,0 +1,246 @@
+#include "hybridcont/derivative_check.h"
+
+#include <cmath>
+#include <functional>
+#include <iomanip>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include "hybridcont/timebased_shooting.h"
+
+namespace hybridcont {
+
+std::string DerivativeCheckOptions::Validate() const {
+  std::ostringstream os;
+  if (num_points < 1) os << "DerivativeCheckOptions::num_points = " << num_points << " must be >= 1";
+  else if (!(model_step > 0.0)) os << "DerivativeCheckOptions::model_step = " << model_step << " must be > 0";
+  else if (!(flow_step > 0.0)) os << "DerivativeCheckOptions::flow_step = " << flow_step << " must be > 0";
+  else if (!(max_duration >= 0.0)) os << "DerivativeCheckOptions::max_duration = " << max_duration << " must be >= 0";
+  else return integrator.Validate();
+  return os.str();
+}
+
+bool DerivativeCheckReport::passed() const {
+  for (const auto& e : entries) {
+    if (!e.passed()) return false;
+  }
+  return true;
+}
+
+std::string DerivativeCheckReport::Table() const {
+  std::ostringstream os;
+  os << "derivative check of model '" << model << "' (relative error vs central finite differences)\n";
+  os << std::left << std::setw(44) << "derivative" << std::right << std::setw(12) << "worst error" << std::setw(12)
+     << "threshold" << "  verdict\n";
+  for (const auto& e : entries) {
+    os << std::left << std::setw(44) << e.what << std::right << std::scientific << std::setprecision(2)
+       << std::setw(12) << e.worst_error << std::setw(12) << e.tolerance << "  " << (e.passed() ? "ok" : "FAIL");
+    if (!e.note.empty()) os << " (" << e.note << ")";
+    os << "\n";
+  }
+  os << (passed() ? "all derivatives agree with finite differences\n" : "SOME DERIVATIVES DISAGREE\n");
+  return os.str();
+}
+
+namespace {
+
+double RelativeError(const Matrix& exact, const Matrix& fd) {
+  const double scale = std::max(exact.cwiseAbs().maxCoeff(), 1e-8);
+  return (exact - fd).cwiseAbs().maxCoeff() / scale;
+}
+
+// Central differences of a vector function g at x along each coordinate (steps h (1 + |x_j|)).
+Matrix FiniteDifferenceJacobian(const std::function<bool(const Vector&, Vector*)>& g, const Vector& x, double h,
+                                bool* ok) {
+  Vector plus, minus;
+  Matrix J;
+  for (int j = 0; j < x.size(); ++j) {
+    const double step = h * (1.0 + std::abs(x(j)));
+    Vector xp = x, xm = x;
+    xp(j) += step;
+    xm(j) -= step;
+    if (!g(xp, &plus) || !g(xm, &minus)) {
+      *ok = false;
+      return J;
+    }
+    if (j == 0) J.resize(plus.size(), x.size());
+    J.col(j) = (plus - minus) / (2.0 * step);
+  }
+  *ok = true;
+  return J;
+}
+
+class Checker {
+ public:
+  Checker(const HybridModel& model, const DerivativeCheckOptions& o) : model_(model), o_(o), rng_(o.seed) {}
+
+  DerivativeCheckReport Run() {
+    report_.model = model_.name();
+    for (int p = 0; p < model_.num_phases(); ++p) CheckPhase(model_.phase(p));
+    CheckAnchor();
+    CheckShootingMap();
+    return report_;
+  }
+
+ private:
+  double Uniform(double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng_); }
+
+  Vector SampleState(const Phase& phase) {
+    Vector x = phase.typical_state();
+    for (int i = 0; i < x.size(); ++i) x(i) += 0.1 * (1.0 + std::abs(x(i))) * Uniform(-1.0, 1.0);
+    return x;
+  }
+
+  DerivativeCheckEntry& Entry(const std::string& what, double tolerance) {
+    for (auto& e : report_.entries) {
+      if (e.what == what) return e;
+    }
+    report_.entries.push_back({what, 0.0, tolerance, ""});
+    return report_.entries.back();
+  }
+
+  void Record(const std::string& what, double tolerance, const Matrix& exact, const Matrix& fd, bool ok,
+              const std::string& failure = "finite-difference evaluation failed") {
+    DerivativeCheckEntry& e = Entry(what, tolerance);
+    if (!ok) {
+      e.note = failure;
+      return;
+    }
+    e.worst_error = std::max(e.worst_error, RelativeError(exact, fd));
+  }
+
+  void CheckPhase(const Phase& phase) {
+    const std::string tag = "phase '" + phase.name() + "': ";
+    const int k = phase.num_first_integrals();
+    PhaseFlow flow(phase, o_.integrator);
+    for (int point = 0; point < o_.num_points; ++point) {
+      const Vector x = SampleState(phase);
+      bool ok = false;
+      // vector field
+      Vector f;
+      Matrix df;
+      phase.VectorField(x, &f, &df);
+      Matrix fd = FiniteDifferenceJacobian([&](const Vector& y, Vector* out) {
+        phase.VectorField(y, out, nullptr);
+        return out->allFinite();
+      }, x, o_.model_step, &ok);
+      Record(tag + "df/dx", o_.model_tolerance, df, fd, ok);
+      // event
+      RowVector de;
+      phase.Event(x, &de);
+      fd = FiniteDifferenceJacobian([&](const Vector& y, Vector* out) {
+        *out = Vector::Constant(1, phase.Event(y, nullptr));
+        return out->allFinite();
+      }, x, o_.model_step, &ok);
+      Record(tag + "de/dx", o_.model_tolerance, de, fd, ok);
+      // reset
+      Vector xn;
+      Matrix D;
+      phase.Reset(x, &xn, &D);
+      fd = FiniteDifferenceJacobian([&](const Vector& y, Vector* out) {
+        phase.Reset(y, out, nullptr);
+        return out->allFinite();
+      }, x, o_.model_step, &ok);
+      Record(tag + "dDelta/dx", o_.model_tolerance, D, fd, ok);
+      // first integrals: gradient and Hessians
+      Vector H;
+      Matrix dH;
+      std::vector<Matrix> d2H;
+      phase.FirstIntegrals(x, &H, &dH, &d2H);
+      fd = FiniteDifferenceJacobian([&](const Vector& y, Vector* out) {
+        phase.FirstIntegrals(y, out, nullptr, nullptr);
+        return out->allFinite();
+      }, x, o_.model_step, &ok);
+      Record(tag + "dH/dx", o_.model_tolerance, dH, fd, ok);
+      for (int j = 0; j < k; ++j) {
+        fd = FiniteDifferenceJacobian([&](const Vector& y, Vector* out) {
+          Vector h;
+          Matrix g;
+          phase.FirstIntegrals(y, &h, &g, nullptr);
+          *out = g.row(j).transpose();
+          return out->allFinite();
+        }, x, o_.model_step, &ok);
+        Record(tag + "d2H/dx2" + (k > 1 ? "[" + std::to_string(j + 1) + "]" : ""), o_.model_tolerance, d2H[j], fd,
+               ok);
+      }
+      // flow sensitivities with xi != 0 and a duration of either sign
+      const double t = Uniform(-o_.max_duration, o_.max_duration);
+      Vector xi(k);
+      for (int j = 0; j < k; ++j) xi(j) = Uniform(-o_.max_xi, o_.max_xi);
+      PhaseFlowResult res;
+      flow.Integrate(x, xi, t, true, &res);
+      if (!res.ok()) {
+        Record(tag + "Phi = dphi/dx0", o_.flow_tolerance, Matrix(), Matrix(), false, res.message);
+        continue;
+      }
+      auto integrate = [&](const Vector& x0, const Vector& xi0, Vector* out) {
+        PhaseFlowResult r;
+        flow.Integrate(x0, xi0, t, false, &r);
+        *out = r.x;
+        return r.ok();
+      };
+      fd = FiniteDifferenceJacobian([&](const Vector& y, Vector* out) { return integrate(y, xi, out); }, x,
+                                    o_.flow_step, &ok);
+      Record(tag + "Phi = dphi/dx0", o_.flow_tolerance, res.Phi, fd, ok);
+      fd = FiniteDifferenceJacobian([&](const Vector& z, Vector* out) { return integrate(x, z, out); }, xi,
+                                    o_.flow_step, &ok);
+      Record(tag + "Psi = dphi/dxi", o_.flow_tolerance, res.Psi, fd, ok);
+    }
+  }
+
+  void CheckAnchor() {
+    const Phase& phase = model_.phase(0);
+    for (int point = 0; point < o_.num_points; ++point) {
+      const Vector x = SampleState(phase);
+      RowVector da;
+      model_.anchor().Evaluate(x, &da);
+      bool ok = false;
+      const Matrix fd = FiniteDifferenceJacobian([&](const Vector& y, Vector* out) {
+        *out = Vector::Constant(1, model_.anchor().Evaluate(y, nullptr));
+        return out->allFinite();
+      }, x, o_.model_step, &ok);
+      Record("anchor: da/dx", o_.model_tolerance, da, fd, ok);
+    }
+  }
+
+  void CheckShootingMap() {
+    TimeBasedShooting shooting(model_, o_.integrator);
+    const ShootingLayout& layout = shooting.layout();
+    for (int point = 0; point < o_.num_points; ++point) {
+      Vector u(layout.num_unknowns());
+      for (int i = 0; i < layout.num_segments(); ++i) {
+        u(layout.time_index(i)) = Uniform(-o_.max_duration, o_.max_duration);
+        u.segment(layout.state_offset(i), layout.dim(i)) = SampleState(model_.phase(i));
+      }
+      for (int j = 0; j < layout.num_first_integrals(); ++j) u(layout.xi_index(j)) = Uniform(-o_.max_xi, o_.max_xi);
+      u(layout.H_index()) = Uniform(0.0, 2.0);
+      Vector r;
+      Matrix dr;
+      const EvaluationStatus s = shooting.Evaluate(u, &r, &dr);
+      if (!s.ok) {
+        Record("shooting map: dr/du", o_.flow_tolerance, Matrix(), Matrix(), false, s.message);
+        continue;
+      }
+      bool ok = false;
+      const Matrix fd = FiniteDifferenceJacobian([&](const Vector& v, Vector* out) {
+        return shooting.Evaluate(v, out, nullptr).ok;
+      }, u, o_.flow_step, &ok);
+      Record("shooting map: dr/du", o_.flow_tolerance, dr, fd, ok);
+    }
+  }
+
+  const HybridModel& model_;
+  const DerivativeCheckOptions& o_;
+  std::mt19937_64 rng_;
+  DerivativeCheckReport report_;
+};
+
+}  // namespace
+
+DerivativeCheckReport CheckDerivatives(const HybridModel& model, const DerivativeCheckOptions& options) {
+  if (const std::string why = options.Validate(); !why.empty()) throw std::invalid_argument(why);
+  return Checker(model, options).Run();
+}
+
+}  // namespace hybridcont

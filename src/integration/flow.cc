@@ -1,0 +1,209 @@
+#include "hybridcont/flow.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <boost/numeric/odeint.hpp>
+#include <boost/numeric/odeint/external/eigen/eigen.hpp>
+
+namespace hybridcont {
+
+namespace odeint = boost::numeric::odeint;
+
+std::string ToString(IntegratorMethod method) {
+  switch (method) {
+    case IntegratorMethod::kDormandPrince54: return "dopri5";
+    case IntegratorMethod::kFehlberg78: return "rkf78";
+  }
+  return "unknown";
+}
+
+bool FromString(const std::string& name, IntegratorMethod* method) {
+  if (name == "dopri5") {
+    *method = IntegratorMethod::kDormandPrince54;
+  } else if (name == "rkf78") {
+    *method = IntegratorMethod::kFehlberg78;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+std::string ToString(FlowStatus status) {
+  switch (status) {
+    case FlowStatus::kSuccess: return "success";
+    case FlowStatus::kNonFinite: return "non-finite value";
+    case FlowStatus::kStepTooSmall: return "step size too small";
+    case FlowStatus::kMaxSteps: return "maximum number of steps";
+  }
+  return "unknown";
+}
+
+std::string IntegratorOptions::Validate() const {
+  std::ostringstream os;
+  auto positive = [&](const char* field, double v) {
+    if (!(v > 0.0) || !std::isfinite(v)) os << "IntegratorOptions::" << field << " = " << v << " must be finite and > 0";
+  };
+  positive("rtol", rtol);
+  if (os.tellp() == 0) positive("atol", atol);
+  if (os.tellp() == 0) positive("initial_step", initial_step);
+  if (os.tellp() == 0) positive("min_step", min_step);
+  if (os.tellp() == 0 && max_steps < 1) os << "IntegratorOptions::max_steps = " << max_steps << " must be >= 1";
+  return os.str();
+}
+
+namespace {
+
+using State = Vector;
+using Dopri5 = odeint::runge_kutta_dopri5<State, double, State, double, odeint::vector_space_algebra>;
+using Rkf78 = odeint::runge_kutta_fehlberg78<State, double, State, double, odeint::vector_space_algebra>;
+using ControlledDopri5 = odeint::controlled_runge_kutta<Dopri5>;
+using ControlledRkf78 = odeint::controlled_runge_kutta<Rkf78>;
+
+// The augmented right-hand side [f~; A Phi; A Psi + B], with z = [x; vec(Phi); vec(Psi)].
+struct AugmentedSystem {
+  const Phase* phase;
+  const Vector* xi;
+  int n;
+  int k;
+  bool sensitivities;
+  long* rhs_evaluations;
+  bool* nonfinite;
+  double* nonfinite_time;
+  // scratch, sized once per integration
+  Vector* f;
+  Matrix* A;
+  Matrix* B;
+
+  void operator()(const State& z, State& dz, double t) const {
+    ++*rhs_evaluations;
+    dz.resize(z.size());
+    phase->UnfoldedVectorField(z.head(n), *xi, f, sensitivities ? A : nullptr, sensitivities ? B : nullptr);
+    if (!f->allFinite() || (sensitivities && (!A->allFinite() || !B->allFinite()))) {
+      if (!*nonfinite) *nonfinite_time = t;
+      *nonfinite = true;
+      dz.setZero();  // keep the stepper's arithmetic finite; the driver loop reports the failure
+      return;
+    }
+    dz.head(n) = *f;
+    if (!sensitivities) return;
+    Eigen::Map<const Matrix> Phi(z.data() + n, n, n);
+    Eigen::Map<Matrix> dPhi(dz.data() + n, n, n);
+    dPhi.noalias() = *A * Phi;
+    Eigen::Map<const Matrix> Psi(z.data() + n + n * n, n, k);
+    Eigen::Map<Matrix> dPsi(dz.data() + n + n * n, n, k);
+    dPsi.noalias() = *A * Psi;
+    dPsi += *B;
+  }
+};
+
+}  // namespace
+
+struct PhaseFlow::Steppers {
+  ControlledDopri5 dopri5;
+  ControlledRkf78 rkf78;
+  State z;
+  Vector f;
+  Matrix A, B;
+  Vector xi;
+  Steppers(double atol, double rtol)
+      : dopri5(odeint::default_error_checker<double, odeint::vector_space_algebra, odeint::default_operations>(atol, rtol)),
+        rkf78(odeint::default_error_checker<double, odeint::vector_space_algebra, odeint::default_operations>(atol, rtol)) {}
+};
+
+PhaseFlow::PhaseFlow(const Phase& phase, IntegratorOptions options)
+    : phase_(&phase), options_(options), steppers_(std::make_unique<Steppers>(options.atol, options.rtol)) {}
+PhaseFlow::~PhaseFlow() = default;
+PhaseFlow::PhaseFlow(PhaseFlow&&) noexcept = default;
+PhaseFlow& PhaseFlow::operator=(PhaseFlow&&) noexcept = default;
+
+FlowStatus PhaseFlow::Integrate(const Eigen::Ref<const Vector>& x0, const Eigen::Ref<const Vector>& xi, double t,
+                                bool with_sensitivities, PhaseFlowResult* result) {
+  return Integrate(x0, xi, t, with_sensitivities, result, Observer());
+}
+
+FlowStatus PhaseFlow::Integrate(const Eigen::Ref<const Vector>& x0, const Eigen::Ref<const Vector>& xi, double t,
+                                bool with_sensitivities, PhaseFlowResult* result, const Observer& observer) {
+  const int n = phase_->dim();
+  const int k = phase_->num_first_integrals();
+  Steppers& s = *steppers_;
+  result->counters = FlowCounters();
+  result->message.clear();
+  result->status = FlowStatus::kSuccess;
+
+  const int size = with_sensitivities ? n + n * n + n * k : n;
+  State& z = s.z;
+  z.resize(size);
+  z.head(n) = x0;
+  if (with_sensitivities) {
+    Eigen::Map<Matrix>(z.data() + n, n, n).setIdentity();
+    Eigen::Map<Matrix>(z.data() + n + n * n, n, k).setZero();
+  }
+  s.xi = xi;
+
+  auto finish = [&](FlowStatus status, std::string message) {
+    result->status = status;
+    result->message = std::move(message);
+    result->x = z.head(n);
+    if (with_sensitivities) {
+      result->Phi = Eigen::Map<const Matrix>(z.data() + n, n, n);
+      result->Psi = Eigen::Map<const Matrix>(z.data() + n + n * n, n, k);
+    }
+    return status;
+  };
+  if (!z.head(n).allFinite() || !s.xi.allFinite()) {
+    return finish(FlowStatus::kNonFinite, "phase '" + phase_->name() + "': non-finite initial state or xi");
+  }
+  if (!std::isfinite(t)) {
+    return finish(FlowStatus::kNonFinite, "phase '" + phase_->name() + "': non-finite duration");
+  }
+  if (observer) observer(0.0, z.head(n));
+  if (t == 0.0) return finish(FlowStatus::kSuccess, "");
+
+  bool nonfinite = false;
+  double nonfinite_time = 0.0;
+  AugmentedSystem system{phase_, &s.xi, n, k, with_sensitivities, &result->counters.rhs_evaluations,
+                         &nonfinite, &nonfinite_time, &s.f, &s.A, &s.B};
+  const double direction = t > 0.0 ? 1.0 : -1.0;
+  double time = 0.0;
+  double dt = direction * std::min(std::abs(t), options_.initial_step);
+  s.dopri5.reset();
+  long attempts = 0;
+  while (direction * (t - time) > 0.0) {
+    // Land exactly on t; the 1e-14 slack avoids a sliver step of round-off size.
+    if (direction * (time + dt - t) > -1e-14 * std::max(1.0, std::abs(t))) dt = t - time;
+    if (++attempts > options_.max_steps) {
+      std::ostringstream os;
+      os << "phase '" << phase_->name() << "': " << options_.max_steps << " steps exhausted at t = " << time
+         << " of " << t;
+      return finish(FlowStatus::kMaxSteps, os.str());
+    }
+    odeint::controlled_step_result step_result;
+    if (options_.method == IntegratorMethod::kDormandPrince54) {
+      step_result = s.dopri5.try_step(system, z, time, dt);
+    } else {
+      step_result = s.rkf78.try_step(system, z, time, dt);
+    }
+    if (nonfinite || !z.allFinite()) {
+      std::ostringstream os;
+      os << "phase '" << phase_->name() << "': model returned a non-finite value at t = "
+         << (nonfinite ? nonfinite_time : time) << " (duration " << t << ")";
+      return finish(FlowStatus::kNonFinite, os.str());
+    }
+    if (step_result == odeint::success) {
+      ++result->counters.steps;
+      if (observer) observer(time, z.head(n));
+    } else {
+      ++result->counters.rejected_steps;
+    }
+    if (std::abs(dt) < options_.min_step && direction * (t - time) > 0.0) {
+      std::ostringstream os;
+      os << "phase '" << phase_->name() << "': step size " << std::abs(dt) << " below min_step "
+         << options_.min_step << " at t = " << time;
+      return finish(FlowStatus::kStepTooSmall, os.str());
+    }
+  }
+  return finish(FlowStatus::kSuccess, "");
+}
+
+}  // namespace hybridcont

@@ -1,0 +1,95 @@
+#include "hybridcont/model.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace hybridcont {
+
+Phase::Phase(std::string name, std::vector<std::string> state_names, int next_dim, int num_first_integrals,
+             Vector typical_state)
+    : name_(std::move(name)),
+      state_names_(std::move(state_names)),
+      next_dim_(next_dim),
+      num_first_integrals_(num_first_integrals),
+      typical_state_(std::move(typical_state)) {}
+
+void Phase::UnfoldedVectorField(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
+                                Vector* f_tilde, Matrix* A, Matrix* B) const {
+  const bool dissipative = (xi.array() != 0.0).any();
+  const bool need_hessians = A != nullptr && dissipative;
+  const bool need_gradients = B != nullptr || dissipative;
+  VectorField(x, f_tilde, A);
+  if (!need_gradients) return;
+  Vector H;
+  Matrix dH;
+  std::vector<Matrix> d2H;
+  FirstIntegrals(x, &H, &dH, need_hessians ? &d2H : nullptr);
+  if (dissipative) {
+    f_tilde->noalias() += dH.transpose() * xi;
+    if (A) {
+      for (int j = 0; j < xi.size(); ++j) *A += xi(j) * d2H[j];
+    }
+  }
+  if (B) *B = dH.transpose();
+}
+
+HybridModel::HybridModel(std::string name, std::string description, std::unique_ptr<ParameterBlock> parameters,
+                         std::vector<std::unique_ptr<Phase>> phases, std::unique_ptr<Anchor> anchor)
+    : name_(std::move(name)),
+      description_(std::move(description)),
+      parameters_(std::move(parameters)),
+      phases_(std::move(phases)),
+      anchor_(std::move(anchor)) {}
+
+int HybridModel::ParameterIndex(const std::string& name) const {
+  const auto& infos = parameters_->infos();
+  for (int i = 0; i < static_cast<int>(infos.size()); ++i) {
+    if (infos[i].name == name) return i;
+  }
+  std::string known;
+  for (const auto& info : infos) known += (known.empty() ? "" : ", ") + info.name;
+  throw std::invalid_argument("model '" + name_ + "' has no parameter '" + name + "' (parameters: " + known + ")");
+}
+
+double HybridModel::parameter(const std::string& name) const { return parameters_->Get(ParameterIndex(name)); }
+
+void HybridModel::SetParameter(const std::string& name, double value) {
+  const int index = ParameterIndex(name);
+  if (!std::isfinite(value)) {
+    throw std::invalid_argument("parameter '" + name + "' of model '" + name_ + "' must be finite, got " +
+                                std::to_string(value));
+  }
+  parameters_->Set(index, value);
+}
+
+namespace internal {
+
+void ValidatePhaseSizes(const std::string& model_name, const std::vector<std::unique_ptr<Phase>>& phases) {
+  const int m = static_cast<int>(phases.size());
+  for (int i = 0; i < m; ++i) {
+    const Phase& p = *phases[i];
+    const Phase& next = *phases[(i + 1) % m];
+    const std::string where = "model '" + model_name + "', phase '" + p.name() + "'";
+    Vector f, x_next, H;
+    p.VectorField(p.typical_state(), &f, nullptr);
+    if (f.size() != p.dim()) {
+      throw std::invalid_argument(where + ": vector field has " + std::to_string(f.size()) + " entries, the phase " +
+                                  std::to_string(p.dim()) + " states");
+    }
+    p.Reset(p.typical_state(), &x_next, nullptr);
+    if (x_next.size() != next.dim()) {
+      throw std::invalid_argument(where + ": reset map returns " + std::to_string(x_next.size()) +
+                                  " states, next phase '" + next.name() + "' has " + std::to_string(next.dim()));
+    }
+    if (p.num_first_integrals() != phases.front()->num_first_integrals()) {
+      throw std::invalid_argument(where + ": " + std::to_string(p.num_first_integrals()) +
+                                  " first integrals, phase 1 has " +
+                                  std::to_string(phases.front()->num_first_integrals()) +
+                                  " (a hybrid first integral exists in every phase)");
+    }
+    if (p.num_first_integrals() < 1) throw std::invalid_argument(where + ": needs at least one first integral");
+  }
+}
+
+}  // namespace internal
+}  // namespace hybridcont

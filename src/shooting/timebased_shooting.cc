@@ -1,0 +1,125 @@
+#include "hybridcont/timebased_shooting.h"
+
+#include <stdexcept>
+
+namespace hybridcont {
+
+TimeBasedShooting::TimeBasedShooting(const HybridModel& model, IntegratorOptions options)
+    : model_(&model), options_(options), layout_(model),
+      fixed_levels_(Vector::Zero(model.num_first_integrals() - 1)) {
+  if (const std::string why = options.Validate(); !why.empty()) throw std::invalid_argument(why);
+  const int m = model.num_phases();
+  for (int i = 0; i <= m; ++i) integrators_.emplace_back(model.phase(i), options);
+  flows_.resize(m + 1);
+}
+
+void TimeBasedShooting::SetFixedLevels(const Vector& levels) {
+  if (levels.size() != fixed_levels_.size()) {
+    throw std::invalid_argument("SetFixedLevels: expected " + std::to_string(fixed_levels_.size()) +
+                                " levels (first integrals 2..k), got " + std::to_string(levels.size()));
+  }
+  fixed_levels_ = levels;
+  cache_valid_ = false;
+}
+
+EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivities) {
+  const int k = layout_.num_first_integrals();
+  const auto xi = u.segment(layout_.xi_index(), k);
+  EvaluationStatus status;
+  for (int i = 0; i < layout_.num_segments(); ++i) {
+    const double t = u(layout_.time_index(i));
+    const auto x0 = u.segment(layout_.state_offset(i), layout_.dim(i));
+    integrators_[i].Integrate(x0, xi, t, sensitivities, &flows_[i]);
+    counters_ += flows_[i].counters;
+    if (!flows_[i].ok()) {
+      status = EvaluationStatus::Failure("segment " + std::to_string(i + 1) + ": " + flows_[i].message);
+      break;
+    }
+  }
+  cached_u_ = u;
+  cached_sensitivities_ = sensitivities;
+  cache_valid_ = true;
+  cached_status_ = status;
+  return status;
+}
+
+EvaluationStatus TimeBasedShooting::Evaluate(const Vector& u, Vector* r, Matrix* dr) {
+  if (u.size() != layout_.num_unknowns()) {
+    throw std::invalid_argument("TimeBasedShooting::Evaluate: u has " + std::to_string(u.size()) +
+                                " entries, expected " + std::to_string(layout_.num_unknowns()));
+  }
+  const bool need_sensitivities = dr != nullptr;
+  if (!cache_valid_ || (need_sensitivities && !cached_sensitivities_) || cached_u_ != u) {
+    ++num_evaluations_;
+    Integrate(u, need_sensitivities);
+  }
+  if (!cached_status_.ok) return cached_status_;
+
+  const int m = model_->num_phases();
+  const int k = layout_.num_first_integrals();
+  const int N = layout_.num_equations();
+  const auto xi = u.segment(layout_.xi_index(), k);
+  if (r) r->resize(N);
+  if (dr) dr->setZero(N, N + 1);
+
+  Vector f_tilde;
+  for (int i = 0; i <= m; ++i) {
+    const Phase& phase = model_->phase(i);
+    const PhaseFlowResult& flow = flows_[i];
+    const int next = (i + 1) % (m + 1);
+    const int n_out = layout_.dim(next);
+    const int row = layout_.block_row(i);
+    double event;
+    if (i < m) {
+      // shooting + event: Delta_i(phi_i) - x̄_{i+1}, e_i(phi_i)
+      phase.Reset(flow.x, &out_, dr ? &D_ : nullptr);
+      event = phase.Event(flow.x, dr ? &de_ : nullptr);
+    } else {
+      // periodicity + anchor: phi_1(t_{m+1}, x̄_{m+1}) - x̄_1, a(phi_1)
+      out_ = flow.x;
+      if (dr) D_.setIdentity(n_out, n_out);
+      event = model_->anchor().Evaluate(flow.x, dr ? &de_ : nullptr);
+    }
+    if (!out_.allFinite() || !std::isfinite(event)) {
+      return EvaluationStatus::Failure("segment " + std::to_string(i + 1) + " (phase '" + phase.name() +
+                                       "'): " + (i < m ? "reset map or event function" : "anchor") +
+                                       " returned a non-finite value");
+    }
+    const auto x_next = u.segment(layout_.state_offset(next), n_out);
+    if (r) {
+      r->segment(row, n_out) = out_ - x_next;
+      (*r)(row + n_out) = event;
+    }
+    if (dr) {
+      phase.UnfoldedVectorField(flow.x, xi, &f_tilde, nullptr, nullptr);
+      const int n = layout_.dim(i);
+      const int ct = layout_.time_index(i);
+      dr->block(row, ct, n_out, 1).noalias() = D_ * f_tilde;
+      dr->block(row, ct + 1, n_out, n).noalias() = D_ * flow.Phi;
+      dr->block(row, layout_.xi_index(), n_out, k).noalias() = D_ * flow.Psi;
+      (*dr)(row + n_out, ct) = de_.dot(f_tilde);
+      dr->block(row + n_out, ct + 1, 1, n).noalias() = de_ * flow.Phi;
+      dr->block(row + n_out, layout_.xi_index(), 1, k).noalias() = de_ * flow.Psi;
+      // C: -I on x̄_{i+1}
+      dr->block(row, layout_.state_offset(next), n_out, n_out).diagonal().array() -= 1.0;
+    }
+  }
+  // First integrals at x̄_1: H_1 - H̄ (unknown level), H_j - H̄_j fixed for j >= 2.
+  const int n1 = layout_.dim(0);
+  const auto x1 = u.segment(layout_.state_offset(0), n1);
+  model_->phase(0).FirstIntegrals(x1, &H_, dr ? &dH_ : nullptr, nullptr);
+  const int row = layout_.first_integral_row();
+  if (r) {
+    (*r)(row) = H_(0) - u(layout_.H_index());
+    for (int j = 1; j < k; ++j) (*r)(row + j) = H_(j) - fixed_levels_(j - 1);
+    if (!r->allFinite()) return EvaluationStatus::Failure("first integral returned a non-finite value");
+  }
+  if (dr) {
+    dr->block(row, layout_.state_offset(0), k, n1) = dH_;
+    (*dr)(row, layout_.H_index()) = -1.0;
+    if (!dr->allFinite()) return EvaluationStatus::Failure("Jacobian has non-finite entries");
+  }
+  return {};
+}
+
+}  // namespace hybridcont
