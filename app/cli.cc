@@ -1,5 +1,60 @@
 #include "cli.h"
 
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+#include "commands.h"
+#include "hybridcont/models.h"
+
 namespace hybridcont::app {
-int RunCli(int, const char* const*, std::ostream&, std::ostream&) { return 0; }
+
+int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{"hybridcont: families of periodic orbits of conservative hybrid systems"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "hybridcont 0.1.0");
+
+  auto* list = app.add_subcommand("list", "list the built-in models with phases, dimensions and parameters");
+
+  CheckArguments check_args;
+  auto* check = app.add_subcommand("check", "compare every derivative of a model with finite differences");
+  check->add_option("model", check_args.model, "built-in model name")->required();
+  check->add_option("--set", check_args.assignments, "override a parameter, NAME=VALUE (repeatable)");
+  check->add_option("--points", check_args.points, "random points per phase")->check(CLI::PositiveNumber);
+  check->add_option("--seed", check_args.seed, "seed of the random points");
+
+  RunArguments run_args;
+  auto* run = app.add_subcommand("run", "compute the bifurcation diagram of a built-in model");
+  AddRunOptions(run, &run_args);
+
+  std::string plot_dir;
+  auto* plot = app.add_subcommand("plot", "draw the figures of saved results");
+  plot->add_option("dir", plot_dir, "results folder written by `hybridcont run`")->required();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // CLI11 formats help/version/usage errors itself
+    std::ostringstream o, e2;
+    const int code = app.exit(e, o, e2);
+    out << o.str();
+    err << e2.str();
+    return code;
+  }
+  try {
+    if (*list) return ListCommand(out);
+    if (*check) return CheckCommand(check_args, out, err);
+    if (*run) return RunCommand(run_args, out, err);
+    if (*plot) return PlotCommand(plot_dir, out, err);
+  } catch (const std::invalid_argument& e) {
+    err << "error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    err << "error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
+
 }  // namespace hybridcont::app

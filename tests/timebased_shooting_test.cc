@@ -7,21 +7,10 @@
 
 #include "hybridcont/models.h"
 #include "hybridcont/timebased_shooting.h"
+#include "known_orbits.h"
 
 namespace hybridcont {
 namespace {
-
-// The analytic bouncing-ball orbit at level H (m = g = 1): apex height H, fall and rise times sqrt(2H).
-Vector BallOrbit(const ShootingLayout& layout, double H) {
-  Vector u = Vector::Zero(layout.num_unknowns());
-  const double t = std::sqrt(2.0 * H);
-  u(layout.time_index(0)) = t;                 // t1: apex -> impact
-  u(layout.state_offset(0)) = H;               // x1 = [H, 0]
-  u(layout.time_index(1)) = t;                 // t2: impact -> apex
-  u(layout.state_offset(1) + 1) = std::sqrt(2.0 * H);  // x2 = [0, +v]
-  u(layout.H_index()) = H;
-  return u;
-}
 
 TEST(TimeBasedShooting, LayoutFollowsThePaper) {
   const HybridModel slip = MakeSlip();
@@ -51,30 +40,6 @@ TEST(TimeBasedShooting, AnalyticBallOrbitIsAZeroWithPeriodSqrt8H) {
     shooting.Evaluate(perturbed, &r, nullptr);
     EXPECT_GT(r.lpNorm<Eigen::Infinity>(), 5e-4);
   }
-}
-
-// SLIP hopping in place (alpha = 0): harmonic stance about l_eq = l0 - mg/k from the nadir l_min,
-// ballistic flight. H = m g l_min + k (l_min - l0)^2 / 2 fixes l_min.
-Vector SlipHoppingInPlace(const HybridModel& slip, const ShootingLayout& layout, double H) {
-  const double m = slip.parameter("m"), g = slip.parameter("g"), k = slip.parameter("k"), l0 = slip.parameter("l0");
-  // k/2 (l - l0)^2 + m g l - H = 0, smaller root
-  const double a = 0.5 * k, b = m * g - k * l0, c = 0.5 * k * l0 * l0 - H;
-  const double l_min = (-b - std::sqrt(b * b - 4 * a * c)) / (2 * a);
-  const double w = std::sqrt(k / m);
-  const double amplitude = (l0 - m * g / k) - l_min;
-  const double t_stance = std::acos(-(m * g / k) / amplitude) / w;
-  const double dl_takeoff = amplitude * w * std::sin(w * t_stance);
-  Vector u = Vector::Zero(layout.num_unknowns());
-  u(layout.time_index(0)) = t_stance;
-  u(layout.state_offset(0) + 1) = l_min;
-  u(layout.time_index(1)) = 2.0 * dl_takeoff / g;
-  u(layout.state_offset(1) + 0) = l0;          // y
-  u(layout.state_offset(1) + 3) = dl_takeoff;  // dy
-  u(layout.time_index(2)) = t_stance;
-  u(layout.state_offset(2) + 1) = l0;
-  u(layout.state_offset(2) + 3) = -dl_takeoff;
-  u(layout.H_index()) = H;
-  return u;
 }
 
 TEST(TimeBasedShooting, SlipHoppingInPlaceIsAZero) {

@@ -1,0 +1,43 @@
+// `hybridcont list` and `hybridcont check`.
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "hybridcont/derivative_check.h"
+#include "hybridcont/models.h"
+#include "hybridcont/shooting_layout.h"
+#include "model_options.h"
+
+namespace hybridcont::app {
+
+int ListCommand(std::ostream& out) {
+  for (const std::string& name : BuiltinModelNames()) {
+    const HybridModel model = MakeBuiltinModel(name);
+    const ShootingLayout layout(model);
+    out << fmt::format("{}: {}\n", name, model.description());
+    out << fmt::format("  phases (m = {}, N = {} equations in the time-based map):\n", model.num_phases(),
+                       layout.num_equations());
+    for (int i = 0; i < model.num_phases(); ++i) {
+      const Phase& p = model.phase(i);
+      std::string states;
+      for (const auto& s : p.state_names()) states += (states.empty() ? "" : ", ") + s;
+      out << fmt::format("    {}. {:<14} n = {}  ({})\n", i + 1, p.name(), p.dim(), states);
+    }
+    out << "  parameters:\n";
+    for (const auto& info : model.parameters()) {
+      out << fmt::format("    {:<6} = {:<8g} {}\n", info.name, info.default_value, info.description);
+    }
+  }
+  return 0;
+}
+
+int CheckCommand(const CheckArguments& args, std::ostream& out, std::ostream&) {
+  const HybridModel model = MakeModelWithOverrides(args.model, args.assignments);
+  DerivativeCheckOptions options;
+  options.num_points = args.points;
+  options.seed = args.seed;
+  const DerivativeCheckReport report = CheckDerivatives(model, options);
+  out << report.Table();
+  return report.passed() ? 0 : 1;
+}
+
+}  // namespace hybridcont::app

@@ -1,0 +1,44 @@
+// The CLI subcommands; each returns the process exit code.
+#ifndef HYBRIDCONT_APP_COMMANDS_H_
+#define HYBRIDCONT_APP_COMMANDS_H_
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace hybridcont::app {
+
+int ListCommand(std::ostream& out);
+
+struct CheckArguments {
+  std::string model;
+  std::vector<std::string> assignments;
+  int points = 5;
+  unsigned seed = 20251122;
+};
+int CheckCommand(const CheckArguments& args, std::ostream& out, std::ostream& err);
+
+struct RunArguments {
+  std::string model;
+  std::vector<std::string> assignments;
+  std::vector<std::string> until;
+  std::string out_dir;
+  double rtol = 0.0;  // 0: library default
+  double atol = 0.0;
+  int max_branches = 0;  // 0: model default
+  std::string formulation = "time";
+  bool quiet = false;
+  bool no_plots = false;
+};
+void AddRunOptions(CLI::App* run, RunArguments* args);
+int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err);
+
+int PlotCommand(const std::string& dir, std::ostream& out, std::ostream& err);
+
+}  // namespace hybridcont::app
+
+#endif  // HYBRIDCONT_APP_COMMANDS_H_

@@ -1,0 +1,61 @@
+// Physical or not: the paper's solid vs dashed lines (Table `stateVStime` and the remark after it).
+//
+// A zero u of the time-based map is a periodic orbit of the mechanical system only if, in this order of
+// checks (the first failing one is the reason):
+//   xi = 0 (Thm 3.1; "at-rest" when all durations vanish too, e.g. the ball's xi-branch),
+//   every t_i > 0 ("reversed-time" if some t_i < 0, "zero-duration" if some t_i = 0),
+//   every event is crossed downward at the end of its phase (de·f < 0; "wrong-direction", "grazing"),
+//   the anchor is crossed downward at the end of the return segment ("anchor-grazing"),
+//   no earlier downward crossing of the phase's event inside the phase ("missed-event") and no earlier
+//   anchor crossing in the return segment ("missed-anchor"), searched on the dense output (orbit_trace.h).
+//
+//   Classification c = ClassifyOrbit(model, u, trace, ClassificationOptions{});
+//   if (c.physical) ...; else std::cout << ToString(c.reason) << ": " << c.detail;
+#ifndef HYBRIDCONT_CLASSIFICATION_H_
+#define HYBRIDCONT_CLASSIFICATION_H_
+
+#include <string>
+
+#include "hybridcont/orbit_trace.h"
+
+namespace hybridcont {
+
+enum class OrbitClass {
+  kPhysical,
+  kAtRest,           // xi != 0 and all durations zero: an equilibrium of the dissipative unfolding
+  kDissipative,      // xi != 0
+  kReversedTime,     // some t_i < 0
+  kZeroDuration,     // some t_i = 0 (violates As3)
+  kWrongDirection,   // an event reached upward (de·f > 0)
+  kGrazing,          // an event reached tangentially (de·f = 0, As2 violated)
+  kAnchorGrazing,    // the anchor is not crossed transversally downward
+  kMissedEvent,      // the event was crossed earlier in the phase: t_i is not the first crossing
+  kMissedAnchor,     // the anchor was crossed earlier in the return segment
+  kIntegrationFailed,
+};
+// Short hyphenated words used in the CSV files ("physical", "reversed-time", ...).
+std::string ToString(OrbitClass c);
+
+struct ClassificationOptions {
+  // |xi| above this is dissipative. Newton leaves |xi| ~ 1e-12 on orbits; branches at rest have |xi| ~ 1.
+  double xi_tolerance = 1e-7;
+  // |t_i| at or below this (relative to max(1, |T|)) counts as a zero duration.
+  double duration_tolerance = 1e-7;
+  // Normalized crossing speed (de·f) / (|de| |f|) above -this counts as grazing.
+  double grazing_tolerance = 1e-6;
+  // Interpolant evaluations per integrator step when searching earlier crossings.
+  int samples_per_step = 8;
+};
+
+struct Classification {
+  bool physical = false;
+  OrbitClass reason = OrbitClass::kIntegrationFailed;
+  std::string detail;  // which segment, time, value
+};
+
+Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const OrbitTrace& trace,
+                             const ClassificationOptions& options);
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_CLASSIFICATION_H_

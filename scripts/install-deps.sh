@@ -1,0 +1,16 @@
+#!/bin/sh
+# Installs what hybridcont needs to build, test and draw figures, from Debian's registry, if missing.
+# Idempotent: does nothing (and needs no network) when everything is present.
+set -eu
+PACKAGES="g++ cmake make libeigen3-dev libboost-dev libcli11-dev nlohmann-json3-dev libfmt-dev libgtest-dev libbenchmark-dev python3 python3-matplotlib"
+missing=""
+for p in $PACKAGES; do
+  dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  echo "installing:$missing"
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing >/dev/null
+fi

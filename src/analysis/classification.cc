@@ -1,0 +1,113 @@
+#include "hybridcont/classification.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace hybridcont {
+
+std::string ToString(OrbitClass c) {
+  switch (c) {
+    case OrbitClass::kPhysical: return "physical";
+    case OrbitClass::kAtRest: return "at-rest";
+    case OrbitClass::kDissipative: return "dissipative";
+    case OrbitClass::kReversedTime: return "reversed-time";
+    case OrbitClass::kZeroDuration: return "zero-duration";
+    case OrbitClass::kWrongDirection: return "wrong-direction";
+    case OrbitClass::kGrazing: return "grazing";
+    case OrbitClass::kAnchorGrazing: return "anchor-grazing";
+    case OrbitClass::kMissedEvent: return "missed-event";
+    case OrbitClass::kMissedAnchor: return "missed-anchor";
+    case OrbitClass::kIntegrationFailed: return "integration-failed";
+  }
+  return "unknown";
+}
+
+namespace {
+
+Classification NonPhysical(OrbitClass reason, const std::string& detail) { return {false, reason, detail}; }
+
+// The scalar guard of segment i (event e_i for i < m, anchor a for the return segment).
+double Guard(const HybridModel& model, int i, const Vector& x, RowVector* grad) {
+  if (i < model.num_phases()) return model.phase(i).Event(x, grad);
+  return model.anchor().Evaluate(x, grad);
+}
+
+// First downward crossing (g > 0, then g <= 0) of the guard strictly before the end of the segment, on
+// the Hermite interpolant of every step. Returns the local time or NaN if none.
+double EarlierDownwardCrossing(const HybridModel& model, const OrbitTrace& trace, int i, int samples_per_step) {
+  const auto& nodes = trace.segment(i);
+  const double end = trace.duration(i);
+  // Crossings within this fraction of the segment's end are the end crossing itself.
+  const double end_slack = 1e-9 * std::max(1.0, std::abs(end));
+  double previous = Guard(model, i, nodes.front().x, nullptr);
+  for (std::size_t j = 0; j + 1 < nodes.size(); ++j) {
+    for (int s = 1; s <= samples_per_step; ++s) {
+      const double t = nodes[j].t + (nodes[j + 1].t - nodes[j].t) * s / samples_per_step;
+      if (std::abs(end - t) <= end_slack) return std::nan("");
+      const Vector x = s == samples_per_step ? nodes[j + 1].x : trace.Interpolate(i, static_cast<int>(j), t);
+      const double g = Guard(model, i, x, nullptr);
+      if (previous > 0.0 && g <= 0.0) return t;
+      previous = g;
+    }
+  }
+  return std::nan("");
+}
+
+}  // namespace
+
+Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const OrbitTrace& trace,
+                             const ClassificationOptions& options) {
+  const ShootingLayout layout(model);
+  const int m = model.num_phases();
+  std::ostringstream os;
+  const double xi = u.segment(layout.xi_index(), layout.num_first_integrals()).cwiseAbs().maxCoeff();
+  const double T = layout.Period(u);
+  const double zero_time = options.duration_tolerance * std::max(1.0, std::abs(T));
+  bool all_zero = true, any_negative = false, any_zero = false;
+  int negative_segment = -1, zero_segment = -1;
+  for (int i = 0; i <= m; ++i) {
+    const double t = u(layout.time_index(i));
+    all_zero = all_zero && std::abs(t) <= zero_time;
+    if (t < -zero_time && negative_segment < 0) any_negative = true, negative_segment = i;
+    if (std::abs(t) <= zero_time && zero_segment < 0) any_zero = true, zero_segment = i;
+  }
+  if (xi > options.xi_tolerance) {
+    os << "|xi| = " << xi;
+    return NonPhysical(all_zero ? OrbitClass::kAtRest : OrbitClass::kDissipative, os.str());
+  }
+  if (any_negative) {
+    os << "t" << negative_segment + 1 << " = " << u(layout.time_index(negative_segment)) << " < 0";
+    return NonPhysical(OrbitClass::kReversedTime, os.str());
+  }
+  if (any_zero) {
+    os << "t" << zero_segment + 1 << " = " << u(layout.time_index(zero_segment));
+    return NonPhysical(OrbitClass::kZeroDuration, os.str());
+  }
+  if (!trace.ok()) return NonPhysical(OrbitClass::kIntegrationFailed, trace.message());
+  // Transversal downward crossing at the end of every segment.
+  for (int i = 0; i <= m; ++i) {
+    const TraceNode& end = trace.segment(i).back();
+    RowVector grad;
+    Guard(model, i, end.x, &grad);
+    const double speed = grad.dot(end.f) / std::max(grad.norm() * end.f.norm(), 1e-300);
+    if (speed > -options.grazing_tolerance) {
+      os << (i < m ? "event of segment " : "anchor at the end of segment ") << i + 1
+         << ": normalized crossing speed " << speed;
+      if (i == m) return NonPhysical(OrbitClass::kAnchorGrazing, os.str());
+      return NonPhysical(speed > options.grazing_tolerance ? OrbitClass::kWrongDirection : OrbitClass::kGrazing,
+                         os.str());
+    }
+  }
+  // First crossing: no earlier downward crossing inside the segment.
+  for (int i = 0; i <= m; ++i) {
+    const double t = EarlierDownwardCrossing(model, trace, i, options.samples_per_step);
+    if (!std::isnan(t)) {
+      os << (i < m ? "event" : "anchor") << " of segment " << i + 1 << " crossed at t = " << t << " < "
+         << trace.duration(i);
+      return NonPhysical(i < m ? OrbitClass::kMissedEvent : OrbitClass::kMissedAnchor, os.str());
+    }
+  }
+  return {true, OrbitClass::kPhysical, ""};
+}
+
+}  // namespace hybridcont
