@@ -24,7 +24,7 @@ summary.json
                       "status" (located|bracketed), "precision", "u"}]
     orbits          [{"file", "branch", "index", "H", "T", "label"}]   (optional)
 branch-<id>.csv
-    header row, then one row per point.  Used columns: H, T, xi, t1..t<m+1>, x<i>_<state>, physical (1/0),
+    header row, then one row per point.  Used columns: H, T, xi (or xi1), t1..t<m+1>, x<i>_<state>, physical (1/0),
     classification (word), index (to find special points without "u"), stable (1/0/empty, optional).
     Segment i = 1..m+1 uses phase (i-1) mod m.  Empty or non-numeric cells are read as NaN.
 orbit-<k>.csv
@@ -87,6 +87,17 @@ def to_float(text):
         return math.nan
 
 
+def to_flag(text):
+    """1/0 flag ("1", "1.0", "true", "yes" -> 1; "0", "false", "no" -> 0; anything else NaN)."""
+    word = str(text).strip().lower()
+    if word in ("true", "yes", "y", "t"):
+        return 1.0
+    if word in ("false", "no", "n", "f"):
+        return 0.0
+    v = to_float(text)
+    return (1.0 if v == 1 else 0.0) if finite(v) else math.nan
+
+
 def finite(*values):
     return all(isinstance(v, (int, float)) and math.isfinite(v) for v in values)
 
@@ -117,7 +128,8 @@ class Table:
         """Column as floats (NaN for empty cells), or None when the column does not exist."""
         if name not in self._cache:
             col = self.text(name)
-            self._cache[name] = None if col is None else [to_float(c) for c in col]
+            convert = to_flag if name in ("physical", "stable") else to_float
+            self._cache[name] = None if col is None else [convert(c) for c in col]
         return self._cache[name]
 
 
@@ -126,8 +138,10 @@ def warn(message):
 
 
 def load_summary(results_dir):
-    if not os.path.isdir(results_dir):
+    if not os.path.exists(results_dir):
         raise PlotError("results folder '%s' does not exist" % results_dir)
+    if not os.path.isdir(results_dir):
+        raise PlotError("'%s' is not a folder" % results_dir)
     path = os.path.join(results_dir, "summary.json")
     if not os.path.isfile(path):
         raise PlotError("no summary.json in '%s' (run 'hybridcont run MODEL --out DIR' first)" % results_dir)
@@ -350,6 +364,8 @@ class Results:
             if t1 is None or t2 is None or t3 is None:
                 return None
             return [b - (a + c) for a, b, c in zip(t1, t2, t3)]
+        if name == "xi" and not t.has("xi") and t.has("xi1"):  # several first integrals: xi1..xik
+            return t.num("xi1")
         return t.num(name)
 
     def sp_value(self, sp, name):
@@ -360,8 +376,9 @@ class Results:
         if name == "asym":
             vals = [self.sp_value(sp, c) for c in ("t1", "t2", "t3")]
             return vals[1] - (vals[0] + vals[2]) if finite(*vals) else math.nan
-        if isinstance(u, list) and len(u) == len(self.unknowns) and name in self.unknowns:
-            v = to_float(u[self.unknowns.index(name)])
+        key = "xi1" if name == "xi" and "xi" not in self.unknowns else name
+        if isinstance(u, list) and len(u) == len(self.unknowns) and key in self.unknowns:
+            v = to_float(u[self.unknowns.index(key)])
             if finite(v):
                 return v
         if name == "T" and isinstance(u, list) and len(u) == len(self.unknowns):
@@ -479,10 +496,17 @@ def save(fig, res, name, svg, written):
 def figure_h_t(res, svg, written):
     fig, ax = plt.subplots(figsize=(7.0, 4.8))
     drawn, sp_styles = projection(ax, res, "T", "H")
+    extra = []
+    if res.model == "rocking-block":  # energy bound of the homoclinic orbit (paper Fig. HoverT b)
+        h_max = res.parameter("m", 1.0) * res.parameter("g", 1.0) * res.parameter("l0", 1.0) * (
+            1.0 - math.cos(res.parameter("beta", 0.3)))
+        ax.axhline(h_max, color="0.45", lw=0.9, ls=":", zorder=1)
+        extra.append(Line2D([], [], color="0.45", lw=0.9, ls=":",
+                            label=r"$\bar{H}_\mathrm{max}=m_\mathrm{o} g l_\mathrm{o}(1-\cos\beta)$"))
     if not drawn:
         ax.text(0.5, 0.5, "no branch points", transform=ax.transAxes, ha="center", va="center", color="0.4")
     ax.set_title(r"$\bar{H}$ over $T$: " + model_title(res), fontsize=10)
-    place_legend(fig, ax, legend_handles(res, drawn, sp_styles, res.has_stable()))
+    place_legend(fig, ax, legend_handles(res, drawn, sp_styles, res.has_stable(), extra))
     save(fig, res, "H_T", svg, written)
 
 
