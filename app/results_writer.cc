@@ -1,0 +1,140 @@
+#include "results_writer.h"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+namespace hybridcont::app {
+
+namespace fs = std::filesystem;
+
+void ResultsWriter::PrepareDirectory(const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::invalid_argument("--out '" + dir.string() + "': cannot create the folder (" + ec.message() + ")");
+  if (!fs::is_directory(dir)) throw std::invalid_argument("--out '" + dir.string() + "': not a folder");
+  const fs::path probe = dir / ".hybridcont-write-test";
+  {
+    std::ofstream f(probe);
+    if (!f || !(f << "x") || !f.flush()) {
+      throw std::invalid_argument("--out '" + dir.string() + "': folder is not writable");
+    }
+  }
+  fs::remove(probe, ec);
+}
+
+ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::json options)
+    : dir_(std::move(dir)), model_(model), layout_(model) {
+  summary_["model"] = model.name();
+  summary_["description"] = model.description();
+  nlohmann::json params = nlohmann::json::object();
+  for (const auto& info : model.parameters()) params[info.name] = model.parameter(info.name);
+  summary_["parameters"] = params;
+  nlohmann::json phases = nlohmann::json::array();
+  for (int i = 0; i < model.num_phases(); ++i) {
+    phases.push_back({{"name", model.phase(i).name()}, {"states", model.phase(i).state_names()}});
+  }
+  summary_["phases"] = phases;
+  summary_["unknowns"] = layout_.unknown_names();
+  summary_["options"] = std::move(options);
+  summary_["branches"] = nlohmann::json::array();
+  summary_["special_points"] = nlohmann::json::array();
+  summary_["orbits"] = nlohmann::json::array();
+  // Remove results of an earlier run in the same folder so that the folder describes this run only.
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    const std::string name = entry.path().filename().string();
+    const bool ours = (name.rfind("branch-", 0) == 0 || name.rfind("orbit-", 0) == 0) && entry.path().extension() == ".csv";
+    if (ours) fs::remove(entry.path());
+  }
+  WriteSummary();
+}
+
+void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
+  auto it = branch_files_.find(branch_id);
+  if (it == branch_files_.end()) {
+    it = branch_files_.emplace(branch_id, std::ofstream(dir_ / BranchFileName(branch_id))).first;
+    std::ofstream& f = it->second;
+    f << "index,H,T";
+    const auto& names = layout_.unknown_names();
+    for (int j = 0; j < layout_.num_first_integrals(); ++j) f << "," << names[layout_.xi_index(j)];
+    for (int i = 0; i < layout_.num_segments(); ++i) f << ",t" << i + 1;
+    for (int i = 0; i < layout_.num_segments(); ++i) {
+      for (int c = 0; c < layout_.dim(i); ++c) f << "," << names[layout_.state_offset(i) + c];
+    }
+    f << ",physical,classification,residual,newton_iterations,step";
+    for (const auto& [name, value] : p.extra) f << "," << name;
+    f << "\n";
+  }
+  std::ofstream& f = it->second;
+  const Vector& u = p.u;
+  f << fmt::format("{},{:.17g},{:.17g}", p.index, u(layout_.H_index()), layout_.Period(u));
+  for (int j = 0; j < layout_.num_first_integrals(); ++j) f << fmt::format(",{:.17g}", u(layout_.xi_index(j)));
+  for (int i = 0; i < layout_.num_segments(); ++i) f << fmt::format(",{:.17g}", u(layout_.time_index(i)));
+  for (int i = 0; i < layout_.num_segments(); ++i) {
+    for (int c = 0; c < layout_.dim(i); ++c) f << fmt::format(",{:.17g}", u(layout_.state_offset(i) + c));
+  }
+  f << fmt::format(",{},{},{:.3e},{},{:.6g}", p.classification.physical ? 1 : 0, ToString(p.classification.reason),
+                   p.residual, p.newton_iterations, p.step);
+  for (const auto& [name, value] : p.extra) f << fmt::format(",{:.10g}", value);
+  f << "\n";
+  f.flush();
+  ++points_per_branch_[branch_id];
+}
+
+void ResultsWriter::EndBranch(const Branch& b) {
+  auto file = branch_files_.find(b.id);
+  if (file != branch_files_.end()) file->second.close();
+  summary_["branches"].push_back({{"id", b.id},
+                                  {"file", BranchFileName(b.id)},
+                                  {"parent", b.parent_special_point},
+                                  {"direction", b.direction},
+                                  {"depth", b.depth},
+                                  {"points", points_per_branch_[b.id]},
+                                  {"termination", ToString(b.termination)},
+                                  {"message", b.message},
+                                  {"newton_iterations", b.newton_iterations},
+                                  {"rejected_steps", b.rejected_steps}});
+  WriteSummary();
+}
+
+void ResultsWriter::SetSpecialPoints(nlohmann::json special_points) {
+  summary_["special_points"] = std::move(special_points);
+}
+
+std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int index, double H, double T,
+                                    const std::string& label) {
+  const std::string name = "orbit-" + std::to_string(summary_["orbits"].size()) + ".csv";
+  std::ofstream f(dir_ / name);
+  f << "t,segment";
+  for (int p = 0; p < model_.num_phases(); ++p) {
+    for (const auto& s : model_.phase(p).state_names()) f << "," << model_.phase(p).name() << "." << s;
+  }
+  f << "\n";
+  for (const OrbitSample& s : trace.Sample(400)) {
+    f << fmt::format("{:.12g},{}", s.t, s.segment + 1);
+    const int phase = s.segment % model_.num_phases();
+    for (int p = 0; p < model_.num_phases(); ++p) {
+      for (int c = 0; c < model_.phase(p).dim(); ++c) {
+        if (p == phase) f << fmt::format(",{:.12g}", s.x(c));
+        else f << ",";
+      }
+    }
+    f << "\n";
+  }
+  summary_["orbits"].push_back(
+      {{"file", name}, {"branch", branch_id}, {"index", index}, {"H", H}, {"T", T}, {"label", label}});
+  return name;
+}
+
+void ResultsWriter::SetReport(const std::string& report) { summary_["report"] = report; }
+
+void ResultsWriter::WriteSummary() {
+  const fs::path tmp = dir_ / "summary.json.tmp";
+  {
+    std::ofstream f(tmp);
+    f << summary_.dump(1) << "\n";
+  }
+  fs::rename(tmp, dir_ / "summary.json");
+}
+
+}  // namespace hybridcont::app

@@ -1,0 +1,69 @@
+// Writes a run's results as they are computed (issue 4, item 2):
+//   DIR/summary.json       model, parameters, effective options, branches, special points, orbits
+//   DIR/branch-<id>.csv    one row per point: H, T, xi, t1..t<m+1>, x<i>_<state>..., physical, ...
+//   DIR/orbit-<k>.csv      sampled trajectories of selected physical orbits (key frames)
+// Every CSV row is flushed when written and summary.json is rewritten atomically (temp + rename) after
+// each branch, so an interrupted run leaves consistent files with everything computed so far.
+#ifndef HYBRIDCONT_APP_RESULTS_WRITER_H_
+#define HYBRIDCONT_APP_RESULTS_WRITER_H_
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "hybridcont/classification.h"
+#include "hybridcont/continuation.h"
+#include "hybridcont/orbit_trace.h"
+#include "hybridcont/shooting_layout.h"
+
+namespace hybridcont::app {
+
+// What is known about one branch point beyond u.
+struct PointRecord {
+  int index = 0;
+  Vector u;
+  Classification classification;
+  double residual = 0.0;
+  int newton_iterations = 0;
+  double step = 0.0;
+  // Extra named columns appended after the fixed ones (e.g. Floquet data); same names for every row.
+  std::vector<std::pair<std::string, double>> extra;
+};
+
+class ResultsWriter {
+ public:
+  // Creates dir if needed and checks that a file can be written in it. Throws std::invalid_argument
+  // ("--out 'DIR': ...") otherwise. Call before any computation so that bad input writes nothing.
+  static void PrepareDirectory(const std::filesystem::path& dir);
+
+  ResultsWriter(std::filesystem::path dir, const HybridModel& model, nlohmann::json options);
+
+  void AddPoint(int branch_id, const PointRecord& point);
+  // Records the finished branch's metadata and rewrites summary.json.
+  void EndBranch(const Branch& branch);
+  void SetSpecialPoints(nlohmann::json special_points);
+  // Writes orbit-<k>.csv and records it in the summary; returns the file name.
+  std::string AddOrbit(const OrbitTrace& trace, int branch_id, int index, double H, double T,
+                       const std::string& label);
+  void SetReport(const std::string& report);
+  void WriteSummary();
+
+  const std::filesystem::path& dir() const { return dir_; }
+  static std::string BranchFileName(int id) { return "branch-" + std::to_string(id) + ".csv"; }
+
+ private:
+  std::filesystem::path dir_;
+  const HybridModel& model_;
+  ShootingLayout layout_;
+  nlohmann::json summary_;
+  std::map<int, std::ofstream> branch_files_;
+  std::map<int, int> points_per_branch_;
+};
+
+}  // namespace hybridcont::app
+
+#endif  // HYBRIDCONT_APP_RESULTS_WRITER_H_

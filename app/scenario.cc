@@ -1,0 +1,51 @@
+#include "scenario.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "hybridcont/models.h"
+#include "hybridcont/shooting_layout.h"
+
+namespace hybridcont::app {
+
+namespace {
+std::vector<std::string> Durations(const HybridModel& model) {
+  std::vector<std::string> t;
+  for (int i = 0; i <= model.num_phases(); ++i) t.push_back("t" + std::to_string(i + 1));
+  return t;
+}
+}  // namespace
+
+Scenario DefaultScenario(const HybridModel& model) {
+  Scenario s;
+  s.start = BuiltinStartPoint(model);
+  // |xi| <= 1 ends the at-rest xi-branches through the equilibria (they exist for every xi).
+  s.bounds.push_back({"xi", -1.0, 1.0});
+  const std::string& name = model.name();
+  if (name == "bouncing-ball") {
+    s.bounds.push_back({"H", -1.0, 1.0});
+    s.keyframes = {"H", 0.5};
+  } else if (name == "rocking-block") {
+    const double H_max = model.parameter("m") * model.parameter("g") * model.parameter("l0") *
+                         (1.0 - std::cos(model.parameter("beta")));
+    s.bounds.push_back({"H", -1.0, H_max});
+    // T grows without bound towards the homoclinic orbit at H_max: stop cleanly at |T| = 40.
+    s.sum_bounds.push_back({Durations(model), -40.0, 40.0});
+    s.keyframes = {"H", 0.5 * H_max};
+  } else if (name == "bouncing-rod") {
+    s.bounds.push_back({"H", -1.0, 0.6});
+    s.sum_bounds.push_back({Durations(model), -10.0, 10.0});
+    s.start_conditions.push_back({{{"t2", 1.0}, {"t1", -1.0}, {"t3", -1.0}}, "t2 = t1 + t3"});
+    s.keyframes = {"T", 0.8};
+    s.max_step = 0.05;
+  } else if (name == "slip") {
+    s.bounds.push_back({"H", 0.0, 2.0});
+    s.sum_bounds.push_back({Durations(model), -20.0, 20.0});
+    s.keyframes = {"H", 1.8};
+  } else {
+    throw std::invalid_argument("model '" + name + "' has no default run scenario");
+  }
+  return s;
+}
+
+}  // namespace hybridcont::app
