@@ -1,22 +1,256 @@
-// `hybridcont run` and `hybridcont plot` (filled in by the exploration work).
+// `hybridcont run MODEL ...`: the complete bifurcation diagram of a built-in model, as data and figures.
+//
+// Order of work, so that bad input writes nothing: parse and validate every option, build the model,
+// validate the exploration options against the problem, prepare the output folder; only then compute.
+// Points are classified (physical or why not) and streamed to branch-<id>.csv as they are accepted.
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
 
 #include "commands.h"
+#include "hybridcont/classification.h"
+#include "hybridcont/exploration.h"
+#include "hybridcont/models.h"
+#include "hybridcont/timebased_shooting.h"
+#include "model_options.h"
+#include "results_writer.h"
+#include "scenario.h"
 
 namespace hybridcont::app {
 
+namespace fs = std::filesystem;
+
 void AddRunOptions(CLI::App* run, RunArguments* args) {
-  run->add_option("model", args->model, "built-in model name")->required();
+  run->add_option("model", args->model, "built-in model name (see `hybridcont list`)")->required();
+  run->add_option("--set", args->assignments, "override a model parameter, NAME=VALUE (repeatable)");
+  run->add_option("--until", args->until,
+                  "end every branch exactly where a component of u reaches a value, NAME=VALUE, e.g. H=2 "
+                  "(repeatable)");
+  run->add_option("--out", args->out_dir, "results folder (default results/MODEL)");
+  run->add_option("--rtol", args->rtol, "integrator relative tolerance (default 1e-10)");
+  run->add_option("--atol", args->atol, "integrator absolute tolerance (default 1e-10)");
+  run->add_option("--max-branches", args->max_branches, "maximum number of half-branches traced");
+  run->add_option("--formulation", args->formulation, "shooting formulation: time (default)");
+  run->add_flag("--quiet", args->quiet, "no progress lines");
+  run->add_flag("--no-plots", args->no_plots, "do not draw figures");
 }
 
-int RunCommand(const RunArguments&, std::ostream&, std::ostream& err) {
-  err << "error: run is not available yet\n";
-  return 1;
+namespace {
+
+struct RunSetup {
+  IntegratorOptions integrator;
+  ExplorationOptions exploration;
+  Scenario scenario;
+};
+
+nlohmann::json OptionsJson(const RunArguments& args, const RunSetup& setup) {
+  nlohmann::json j;
+  j["formulation"] = args.formulation;
+  j["integrator"] = {{"method", ToString(setup.integrator.method)},
+                     {"rtol", setup.integrator.rtol},
+                     {"atol", setup.integrator.atol}};
+  const ContinuationOptions& c = setup.exploration.continuation;
+  j["continuation"] = {{"initial_step", c.initial_step},
+                       {"min_step", c.min_step},
+                       {"max_step", c.max_step},
+                       {"max_points", c.max_points},
+                       {"location_tolerance", c.location_tolerance}};
+  nlohmann::json bounds = nlohmann::json::array();
+  for (const auto& b : c.bounds) bounds.push_back({{"component", b.component}, {"lower", b.lower}, {"upper", b.upper}});
+  for (const auto& b : c.sum_bounds) {
+    bounds.push_back({{"sum_of", b.components}, {"lower", b.lower}, {"upper", b.upper}});
+  }
+  j["bounds"] = bounds;
+  nlohmann::json targets = nlohmann::json::array();
+  for (const auto& t : c.targets) targets.push_back({{"component", t.component}, {"value", t.value}});
+  j["targets"] = targets;
+  j["max_branches"] = setup.exploration.max_branches;
+  j["max_depth"] = setup.exploration.max_depth;
+  nlohmann::json conditions = nlohmann::json::array();
+  for (const auto& sc : setup.scenario.start_conditions) conditions.push_back(sc.description);
+  j["start_conditions"] = conditions;
+  return j;
 }
 
-int PlotCommand(const std::string&, std::ostream&, std::ostream& err) {
-  err << "error: plot is not available yet\n";
-  return 1;
+std::string SpecialPointTypeCode(SpecialPointType type) {
+  switch (type) {
+    case SpecialPointType::kSimpleBifurcation: return "SB";
+    case SpecialPointType::kTurningPoint: return "TP";
+    case SpecialPointType::kSingularStart: return "start";
+  }
+  return "?";
+}
+
+nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayout& layout) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const SpecialPoint& sp : d.special_points) {
+    const double H = sp.u.size() ? sp.u(layout.H_index()) : std::nan("");
+    const double precision_H = sp.interval_width.size() ? sp.interval_width(layout.H_index()) : std::nan("");
+    nlohmann::json j = {{"id", sp.id},
+                        {"type", SpecialPointTypeCode(sp.type)},
+                        {"branch", sp.branch_id},
+                        {"index", sp.index},
+                        {"H", H},
+                        {"T", sp.u.size() ? layout.Period(sp.u) : std::nan("")},
+                        {"status", ToString(sp.status)},
+                        {"precision", sp.precision()},
+                        {"precision_H", precision_H},
+                        {"residual", sp.residual_norm},
+                        {"component", sp.component},
+                        {"duplicate_of", sp.duplicate_of},
+                        {"message", sp.message}};
+    j["u"] = std::vector<double>(sp.u.data(), sp.u.data() + sp.u.size());
+    list.push_back(j);
+  }
+  return list;
+}
+
+// Runs the figure script on dir; returns its exit code (non-zero if python/matplotlib is missing).
+int DrawFigures(const fs::path& dir, std::ostream& err) {
+  std::string script = HYBRIDCONT_SOURCE_PLOT_SCRIPT;
+  if (!fs::exists(script)) script = HYBRIDCONT_INSTALLED_PLOT_SCRIPT;
+  if (!fs::exists(script)) {
+    err << "warning: figure script not found; results are saved, figures skipped\n";
+    return 1;
+  }
+  // Debian's python3 carries matplotlib (python3-matplotlib); prefer it over other pythons on PATH.
+  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  const std::string command = python + " '" + script + "' '" + dir.string() + "' > '" +
+                              (dir / "plot.log").string() + "' 2>&1";
+  const int rc = std::system(command.c_str());
+  if (rc != 0) err << "warning: drawing the figures failed (see " << (dir / "plot.log").string() << ")\n";
+  return rc;
+}
+
+}  // namespace
+
+int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
+  // ---- 1. validate all input before anything is written
+  HybridModel model = MakeModelWithOverrides(args.model, args.assignments);
+  if (args.formulation != "time") {
+    throw std::invalid_argument("--formulation '" + args.formulation + "': expected 'time'");
+  }
+  RunSetup setup;
+  if (args.rtol != 0.0) setup.integrator.rtol = args.rtol;
+  if (args.atol != 0.0) setup.integrator.atol = args.atol;
+  if (const std::string why = setup.integrator.Validate(); !why.empty()) {
+    throw std::invalid_argument((args.rtol != 0.0 && !(args.rtol > 0) ? "--rtol: " : "--rtol/--atol: ") + why);
+  }
+  setup.scenario = DefaultScenario(model);
+  const Scenario& sc = setup.scenario;
+  ContinuationOptions& c = setup.exploration.continuation;
+  c.bounds = sc.bounds;
+  c.sum_bounds = sc.sum_bounds;
+  c.max_points = sc.max_points;
+  c.initial_step = sc.initial_step;
+  c.max_step = sc.max_step;
+  for (const std::string& u : args.until) {
+    const auto [name, value] = ParseAssignment("--until", u);
+    c.targets.push_back({name, value});
+  }
+  setup.exploration.max_depth = sc.max_depth;
+  setup.exploration.max_branches = sc.max_branches;
+  if (args.max_branches != 0) {
+    if (args.max_branches < 1) {
+      throw std::invalid_argument("--max-branches " + std::to_string(args.max_branches) + ": must be >= 1");
+    }
+    setup.exploration.max_branches = args.max_branches;
+  }
+  for (const StartCondition& cond : sc.start_conditions) setup.exploration.start_conditions.push_back({cond.terms});
+
+  TimeBasedShooting shooting(model, setup.integrator);
+  const ShootingLayout& layout = shooting.layout();
+  if (const std::string why = c.ValidateFor(layout.unknown_names()); !why.empty()) {
+    throw std::invalid_argument("--until: " + why);
+  }
+  if (const std::string why = setup.exploration.Validate(); !why.empty()) throw std::invalid_argument(why);
+  const fs::path dir = args.out_dir.empty() ? fs::path("results") / model.name() : fs::path(args.out_dir);
+  ResultsWriter::PrepareDirectory(dir);
+
+  // ---- 2. compute, streaming every accepted point
+  ResultsWriter writer(dir, model, OptionsJson(args, setup));
+  TimeBasedShooting residual_map(model, setup.integrator);  // separate cache: the engine's stays intact
+  std::map<int, int> physical_points;
+  int current_branch = -1;
+  const auto start_time = std::chrono::steady_clock::now();
+  c.progress_components.clear();  // ProgressInfo::values = all of u
+  c.progress = [&](const ProgressInfo& info) {
+    const Vector u = Eigen::Map<const Vector>(info.values.data(), static_cast<Eigen::Index>(info.values.size()));
+    PointRecord record;
+    record.index = info.point_index;
+    record.u = u;
+    const OrbitTrace trace(model, u, setup.integrator);
+    record.classification = ClassifyOrbit(model, u, trace, ClassificationOptions{});
+    Vector r;
+    const EvaluationStatus status = residual_map.Evaluate(u, &r, nullptr);
+    record.residual = status.ok ? r.norm() : std::nan("");
+    record.newton_iterations = info.newton_iterations;
+    record.step = info.step;
+    writer.AddPoint(info.branch_id, record);
+    if (record.classification.physical) ++physical_points[info.branch_id];
+    if (!args.quiet) {
+      if (info.branch_id != current_branch) {
+        out << fmt::format("branch {}\n", info.branch_id);
+        current_branch = info.branch_id;
+      }
+      out << fmt::format("  b{:<3} #{:<4} H = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {}\n", info.branch_id,
+                         info.point_index, u(layout.H_index()), layout.Period(u), info.step, info.newton_iterations,
+                         ToString(record.classification.reason));
+    }
+  };
+  const BifurcationDiagram diagram = Explore(&shooting, sc.start, setup.exploration);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+
+  // ---- 3. summary, key-frame orbits, report, figures
+  for (const Branch& b : diagram.branches) writer.EndBranch(b);
+  writer.SetSpecialPoints(SpecialPointsJson(diagram, layout));
+  int orbits = 0;
+  for (const Branch& b : diagram.branches) {
+    if (orbits >= sc.max_keyframe_orbits || physical_points[b.id] == 0) continue;
+    // the physical point of this branch closest to the key-frame target
+    int best = -1;
+    double best_distance = 1e300;
+    for (int i = 0; i < static_cast<int>(b.points.size()); ++i) {
+      const Vector& u = b.points[i].u;
+      const double value = sc.keyframes.component == "T" ? layout.Period(u) : u(layout.H_index());
+      const double distance = std::abs(value - sc.keyframes.value);
+      if (distance < best_distance) {
+        const OrbitTrace trace(model, u, setup.integrator);
+        if (!ClassifyOrbit(model, u, trace, ClassificationOptions{}).physical) continue;
+        best = i;
+        best_distance = distance;
+      }
+    }
+    if (best < 0) continue;
+    const Vector& u = b.points[best].u;
+    const OrbitTrace trace(model, u, setup.integrator);
+    writer.AddOrbit(trace, b.id, best, u(layout.H_index()), layout.Period(u), "branch " + std::to_string(b.id));
+    ++orbits;
+  }
+  const std::string report =
+      diagram.FullReport() + fmt::format("\nwall time {:.3f} s, {} right-hand-side evaluations in {} map evaluations\n",
+                                         seconds, shooting.counters().rhs_evaluations, shooting.num_evaluations());
+  writer.SetReport(report);
+  writer.WriteSummary();
+  out << report;
+  out << fmt::format("results written to {}/ (summary.json, branch-*.csv, orbit-*.csv)\n", dir.string());
+  if (!args.no_plots && DrawFigures(dir, err) == 0) out << fmt::format("figures written to {}/\n", dir.string());
+  return diagram.status == ExplorationStatus::kStartFailed ? 1 : 0;
+}
+
+int PlotCommand(const std::string& dir, std::ostream& out, std::ostream& err) {
+  if (!fs::exists(fs::path(dir) / "summary.json")) {
+    throw std::invalid_argument("plot '" + dir + "': no summary.json (run `hybridcont run MODEL --out " + dir + "` first)");
+  }
+  const int rc = DrawFigures(dir, err);
+  if (rc == 0) out << "figures written to " << dir << "/\n";
+  return rc == 0 ? 0 : 1;
 }
 
 }  // namespace hybridcont::app
