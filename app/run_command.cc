@@ -17,6 +17,7 @@
 #include "hybridcont/classification.h"
 #include "hybridcont/exploration.h"
 #include "hybridcont/models.h"
+#include "hybridcont/scaled_problem.h"
 #include "hybridcont/timebased_shooting.h"
 #include "model_options.h"
 #include "results_writer.h"
@@ -169,19 +170,45 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   if (const std::string why = c.ValidateFor(layout.unknown_names()); !why.empty()) {
     throw std::invalid_argument("--until: " + why);
   }
+  nlohmann::json options_json = OptionsJson(args, setup);  // in the model's units, before scaling
+  for (const auto& [name, scale] : sc.unknown_scales) options_json["unknown_scales"][name] = scale;
+  Vector scales = Vector::Ones(layout.num_unknowns());
+  for (const auto& [name, scale] : sc.unknown_scales) scales(shooting.UnknownIndex(name)) = scale;
+  ScaledProblem scaled(&shooting, scales);
+  // Bounds, targets and start conditions are stated in u; the engine works in u ./ scales.
+  const auto scale_of = [&](const std::string& name) {
+    const int k = shooting.UnknownIndex(name);
+    return k < 0 ? 1.0 : scales(k);
+  };
+  for (ComponentBound& b : c.bounds) b.lower /= scale_of(b.component), b.upper /= scale_of(b.component);
+  for (ComponentTarget& t : c.targets) t.value /= scale_of(t.component);
+  for (SumBound& b : c.sum_bounds) {
+    const double s0 = scale_of(b.components.front());
+    for (const std::string& name : b.components) {
+      if (scale_of(name) != s0) throw std::invalid_argument("sum bound over components of different scales");
+    }
+    b.lower /= s0, b.upper /= s0;
+  }
+  for (LinearCondition& cond : setup.exploration.start_conditions) {
+    for (auto& [name, coefficient] : cond.coefficients) coefficient *= scale_of(name);
+  }
+  if (const std::string why = c.ValidateFor(layout.unknown_names()); !why.empty()) {
+    throw std::invalid_argument("--until: " + why);
+  }
   if (const std::string why = setup.exploration.Validate(); !why.empty()) throw std::invalid_argument(why);
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / model.name() : fs::path(args.out_dir);
   ResultsWriter::PrepareDirectory(dir);
 
   // ---- 2. compute, streaming every accepted point
-  ResultsWriter writer(dir, model, OptionsJson(args, setup));
+  ResultsWriter writer(dir, model, options_json);
   TimeBasedShooting residual_map(model, setup.integrator);  // separate cache: the engine's stays intact
   std::map<int, int> physical_points;
   int current_branch = -1;
   const auto start_time = std::chrono::steady_clock::now();
   c.progress_components.clear();  // ProgressInfo::values = all of u
   c.progress = [&](const ProgressInfo& info) {
-    const Vector u = Eigen::Map<const Vector>(info.values.data(), static_cast<Eigen::Index>(info.values.size()));
+    const Vector u = scaled.FromScaled(
+        Eigen::Map<const Vector>(info.values.data(), static_cast<Eigen::Index>(info.values.size())));
     PointRecord record;
     record.index = info.point_index;
     record.u = u;
@@ -204,7 +231,15 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
                          ToString(record.classification.reason));
     }
   };
-  const BifurcationDiagram diagram = Explore(&shooting, sc.start, setup.exploration);
+  BifurcationDiagram diagram = Explore(&scaled, scaled.ToScaled(sc.start), setup.exploration);
+  // back to the model's coordinates
+  for (Branch& b : diagram.branches) {
+    for (ContinuationPoint& p : b.points) p.u = scaled.FromScaled(p.u);
+  }
+  for (SpecialPoint& sp : diagram.special_points) {
+    if (sp.u.size()) sp.u = scaled.FromScaled(sp.u);
+    if (sp.interval_width.size()) sp.interval_width = scaled.FromScaled(sp.interval_width);
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
 
   // ---- 3. summary, key-frame orbits, report, figures

@@ -32,12 +32,19 @@ Scenario DefaultScenario(const HybridModel& model) {
     // T grows without bound towards the homoclinic orbit at H_max: stop cleanly at |T| = 40.
     s.sum_bounds.push_back({Durations(model), -40.0, 40.0});
     s.keyframes = {"H", 0.5 * H_max};
+    // Towards the homoclinic limit the durations grow while H barely changes: let the steps grow.
+    s.max_step = 2.0;
+    s.max_points = 1500;
   } else if (name == "bouncing-rod") {
     s.bounds.push_back({"H", -1.0, 0.6});
     s.sum_bounds.push_back({Durations(model), -10.0, 10.0});
     s.start_conditions.push_back({{{"t2", 1.0}, {"t1", -1.0}, {"t3", -1.0}}, "t2 = t1 + t3"});
     s.keyframes = {"T", 0.8};
-    s.max_step = 0.05;
+    // dalpha = sqrt(2H)/r ~ 100 would dominate every norm of u; r * dalpha is O(1) (an energy-like
+    // velocity), and durations are O(0.1).
+    for (int i = 1; i <= model.num_phases() + 1; ++i) {
+      s.unknown_scales.push_back({"x" + std::to_string(i) + "_dalpha", model.parameter("l0") / model.parameter("r")});
+    }
   } else if (name == "slip") {
     s.bounds.push_back({"H", 0.0, 2.0});
     s.sum_bounds.push_back({Durations(model), -20.0, 20.0});

@@ -39,6 +39,9 @@ struct Scenario {
   int max_points = 600;
   double initial_step = 0.02;
   double max_step = 0.1;
+  // Typical magnitudes of unknowns (by name) far from 1; the continuation works in u ./ scale
+  // (scaled_problem.h). Unlisted unknowns have scale 1.
+  std::vector<std::pair<std::string, double>> unknown_scales;
   KeyframeTarget keyframes{"H", 0.5};
   int max_keyframe_orbits = 4;
 };

@@ -1,0 +1,40 @@
+// Unknown scaling for continuation: trace r(u) = 0 in the coordinates ũ = u ./ s.
+//
+// Arclength steps, tangent angles, corrector distances and "same point / same branch" tolerances all use
+// the Euclidean norm of u. When components have very different typical magnitudes (the bouncing rod:
+// dalpha ~ sqrt(2H)/r ~ 100 while durations are ~ 0.01), that norm sees only the large ones: the curve
+// crawls in H and symmetry-breaking directions become invisible. Dividing each component by its typical
+// magnitude s_k makes all of them O(1) — the "weights" of AUTO and COCO.
+//
+//   ScaledProblem scaled(&shooting, scales);                 // scales(k) > 0
+//   BifurcationDiagram d = Explore(&scaled, scaled.ToScaled(u0), options);
+//   Vector u = scaled.FromScaled(d.branches[0].points[5].u);
+#ifndef HYBRIDCONT_SCALED_PROBLEM_H_
+#define HYBRIDCONT_SCALED_PROBLEM_H_
+
+#include "hybridcont/zero_problem.h"
+
+namespace hybridcont {
+
+class ScaledProblem : public ZeroProblem {
+ public:
+  // problem must outlive this object; scales must be positive and finite (std::invalid_argument).
+  ScaledProblem(ZeroProblem* problem, Vector scales);
+
+  int num_equations() const override { return problem_->num_equations(); }
+  std::vector<std::string> unknown_names() const override { return problem_->unknown_names(); }
+  EvaluationStatus Evaluate(const Vector& v, Vector* r, Matrix* dr) override;
+
+  Vector ToScaled(const Vector& u) const { return u.cwiseQuotient(scales_); }
+  Vector FromScaled(const Vector& v) const { return v.cwiseProduct(scales_); }
+  const Vector& scales() const { return scales_; }
+
+ private:
+  ZeroProblem* problem_;
+  Vector scales_;
+  Vector u_;
+};
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_SCALED_PROBLEM_H_

@@ -1,0 +1,29 @@
+#include "hybridcont/scaled_problem.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace hybridcont {
+
+ScaledProblem::ScaledProblem(ZeroProblem* problem, Vector scales) : problem_(problem), scales_(std::move(scales)) {
+  if (scales_.size() != problem_->num_unknowns()) {
+    throw std::invalid_argument("ScaledProblem: " + std::to_string(scales_.size()) + " scales for " +
+                                std::to_string(problem_->num_unknowns()) + " unknowns");
+  }
+  const auto names = problem_->unknown_names();
+  for (int k = 0; k < scales_.size(); ++k) {
+    if (!(scales_(k) > 0.0) || !std::isfinite(scales_(k))) {
+      throw std::invalid_argument("ScaledProblem: scale of '" + names[k] + "' = " + std::to_string(scales_(k)) +
+                                  " must be finite and > 0");
+    }
+  }
+}
+
+EvaluationStatus ScaledProblem::Evaluate(const Vector& v, Vector* r, Matrix* dr) {
+  u_ = FromScaled(v);
+  const EvaluationStatus status = problem_->Evaluate(u_, r, dr);
+  if (status.ok && dr) *dr = *dr * scales_.asDiagonal();  // dr/dv = dr/du diag(s)
+  return status;
+}
+
+}  // namespace hybridcont
