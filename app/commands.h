@@ -2,6 +2,7 @@
 #ifndef HYBRIDCONT_APP_COMMANDS_H_
 #define HYBRIDCONT_APP_COMMANDS_H_
 
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -27,9 +28,9 @@ struct RunArguments {
   std::vector<std::string> assignments;
   std::vector<std::string> until;
   std::string out_dir;
-  double rtol = 0.0;  // 0: library default
-  double atol = 0.0;
-  int max_branches = 0;  // 0: model default
+  std::optional<double> rtol;          // unset: library default
+  std::optional<double> atol;
+  std::optional<int> max_branches;     // unset: the model's scenario default
   std::string formulation = "time";
   bool quiet = false;
   bool no_plots = false;

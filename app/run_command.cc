@@ -138,10 +138,10 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     throw std::invalid_argument("--formulation '" + args.formulation + "': expected 'time'");
   }
   RunSetup setup;
-  if (args.rtol != 0.0) setup.integrator.rtol = args.rtol;
-  if (args.atol != 0.0) setup.integrator.atol = args.atol;
+  if (args.rtol) setup.integrator.rtol = *args.rtol;
+  if (args.atol) setup.integrator.atol = *args.atol;
   if (const std::string why = setup.integrator.Validate(); !why.empty()) {
-    throw std::invalid_argument((args.rtol != 0.0 && !(args.rtol > 0) ? "--rtol: " : "--rtol/--atol: ") + why);
+    throw std::invalid_argument("--rtol/--atol: " + why);
   }
   setup.scenario = DefaultScenario(model);
   const Scenario& sc = setup.scenario;
@@ -157,11 +157,11 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   }
   setup.exploration.max_depth = sc.max_depth;
   setup.exploration.max_branches = sc.max_branches;
-  if (args.max_branches != 0) {
-    if (args.max_branches < 1) {
-      throw std::invalid_argument("--max-branches " + std::to_string(args.max_branches) + ": must be >= 1");
+  if (args.max_branches) {
+    if (*args.max_branches < 1) {
+      throw std::invalid_argument("--max-branches " + std::to_string(*args.max_branches) + ": must be >= 1");
     }
-    setup.exploration.max_branches = args.max_branches;
+    setup.exploration.max_branches = *args.max_branches;
   }
   for (const StartCondition& cond : sc.start_conditions) setup.exploration.start_conditions.push_back({cond.terms});
 

@@ -1,0 +1,120 @@
+// The command-line tool as a user meets it: exit codes, messages, files (issues 2 and 4).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+
+namespace hybridcont::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliResult {
+  int code;
+  std::string out;
+  std::string err;
+};
+
+CliResult RunTool(std::vector<std::string> args) {
+  args.insert(args.begin(), "hybridcont");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  const int code = RunCli(static_cast<int>(argv.size()), argv.data(), out, err);
+  return {code, out.str(), err.str()};
+}
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("hybridcont_cli_test_" + name);
+  fs::remove_all(dir);
+  return dir;
+}
+
+TEST(Cli, ListShowsModelsPhasesAndParameters) {
+  const CliResult r = RunTool({"list"});
+  EXPECT_EQ(r.code, 0);
+  for (const char* s : {"bouncing-ball", "rocking-block", "bouncing-rod", "slip", "stance", "n = 5", "w2", "beta"}) {
+    EXPECT_NE(r.out.find(s), std::string::npos) << s;
+  }
+}
+
+TEST(Cli, CheckPassesForEveryModel) {
+  for (const char* model : {"bouncing-ball", "rocking-block", "bouncing-rod", "slip"}) {
+    const CliResult r = RunTool({"check", model, "--points", "2"});
+    EXPECT_EQ(r.code, 0) << model << "\n" << r.out << r.err;
+    EXPECT_NE(r.out.find("shooting map: dr/du"), std::string::npos);
+  }
+  EXPECT_EQ(RunTool({"check", "slip", "--set", "k=20", "--set", "w2=3", "--points", "2"}).code, 0);
+}
+
+TEST(Cli, BadInputGetsAClearMessageAndNonZeroExit) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"check", "pogo-stick"}, "unknown model 'pogo-stick'"},
+      {{"check", "slip", "--set", "stiffness=3"}, "has no parameter 'stiffness'"},
+      {{"check", "slip", "--set", "k"}, "expected NAME=VALUE"},
+      {{"check", "slip", "--set", "k=abc"}, "'abc' is not a number"},
+      {{"check", "slip", "--set", "k=nan"}, "is not finite"},
+      {{"check", "slip", "--set", "k=inf"}, "is not finite"},
+      {{"run", "slip", "--until", "Q=2", "--out", TempDir("bad_until").string()}, "Q"},
+      {{"run", "slip", "--rtol", "-1", "--out", TempDir("bad_rtol").string()}, "rtol"},
+      {{"run", "slip", "--max-branches", "0", "--out", TempDir("bad_branches").string()}, "--max-branches"},
+      {{"run", "slip", "--out", "/proc/hybridcont-cannot-write-here"}, "--out"},
+      {{"frobnicate"}, ""},
+  };
+  for (const Case& c : cases) {
+    const CliResult r = RunTool(c.args);
+    EXPECT_NE(r.code, 0) << c.args[0] << " " << c.args.back();
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << "expected '" << c.message << "' in: " << r.err;
+  }
+  // nothing written half-way for rejected runs
+  EXPECT_FALSE(fs::exists(TempDir("bad_until")));
+  EXPECT_FALSE(fs::exists(TempDir("bad_rtol")));
+}
+
+TEST(Cli, RunBouncingBallWritesClassifiedBranchesThatMatchTheClosedForm) {
+  const fs::path dir = TempDir("ball");
+  const CliResult r = RunTool({"run", "bouncing-ball", "--out", dir.string(), "--quiet", "--no-plots"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream summary_file(dir / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["model"], "bouncing-ball");
+  ASSERT_EQ(summary["branches"].size(), 4u);  // orbit family both ways, at-rest xi-branch both ways
+  int physical = 0, reversed = 0, at_rest = 0;
+  double worst = 0.0;
+  for (const auto& b : summary["branches"]) {
+    std::ifstream csv(dir / b["file"].get<std::string>());
+    std::string line;
+    std::getline(csv, line);
+    // header: index,H,T,xi,t1,t2,x1_y,x1_dy,x2_y,x2_dy,physical,classification,...
+    EXPECT_EQ(line.rfind("index,H,T,xi,t1,t2,x1_y,x1_dy,x2_y,x2_dy,physical,classification,residual", 0), 0u) << line;
+    while (std::getline(csv, line)) {
+      std::vector<std::string> cells;
+      std::stringstream ss(line);
+      for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+      const double H = std::stod(cells[1]), T = std::stod(cells[2]);
+      if (cells[10] == "1") {
+        ++physical;
+        worst = std::max(worst, std::abs(T - std::sqrt(8.0 * H)));
+      }
+      reversed += cells[11] == "reversed-time";
+      at_rest += cells[11] == "at-rest";
+    }
+  }
+  EXPECT_GT(physical, 10);
+  EXPECT_GT(reversed, 10);
+  EXPECT_GT(at_rest, 10);
+  EXPECT_LT(worst, 1e-9);  // T = sqrt(8 H) on every physical point
+}
+
+}  // namespace
+}  // namespace hybridcont::app
