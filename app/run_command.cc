@@ -17,8 +17,8 @@
 #include "hybridcont/classification.h"
 #include "hybridcont/exploration.h"
 #include "hybridcont/models.h"
-#include "hybridcont/scaled_problem.h"
 #include "hybridcont/timebased_shooting.h"
+#include "model_exploration.h"
 #include "model_options.h"
 #include "results_writer.h"
 #include "scenario.h"
@@ -145,57 +145,27 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   }
   setup.scenario = DefaultScenario(model);
   const Scenario& sc = setup.scenario;
+  setup.exploration = ScenarioExplorationOptions(sc);
   ContinuationOptions& c = setup.exploration.continuation;
-  c.bounds = sc.bounds;
-  c.sum_bounds = sc.sum_bounds;
-  c.max_points = sc.max_points;
-  c.initial_step = sc.initial_step;
-  c.max_step = sc.max_step;
   for (const std::string& u : args.until) {
     const auto [name, value] = ParseAssignment("--until", u);
     c.targets.push_back({name, value});
   }
-  setup.exploration.max_depth = sc.max_depth;
-  setup.exploration.max_branches = sc.max_branches;
   if (args.max_branches) {
     if (*args.max_branches < 1) {
       throw std::invalid_argument("--max-branches " + std::to_string(*args.max_branches) + ": must be >= 1");
     }
     setup.exploration.max_branches = *args.max_branches;
   }
-  for (const StartCondition& cond : sc.start_conditions) setup.exploration.start_conditions.push_back({cond.terms});
-
-  TimeBasedShooting shooting(model, setup.integrator);
-  const ShootingLayout& layout = shooting.layout();
-  if (const std::string why = c.ValidateFor(layout.unknown_names()); !why.empty()) {
-    throw std::invalid_argument("--until: " + why);
-  }
-  nlohmann::json options_json = OptionsJson(args, setup);  // in the model's units, before scaling
+  nlohmann::json options_json = OptionsJson(args, setup);
   for (const auto& [name, scale] : sc.unknown_scales) options_json["unknown_scales"][name] = scale;
-  Vector scales = Vector::Ones(layout.num_unknowns());
-  for (const auto& [name, scale] : sc.unknown_scales) scales(shooting.UnknownIndex(name)) = scale;
-  ScaledProblem scaled(&shooting, scales);
-  // Bounds, targets and start conditions are stated in u; the engine works in u ./ scales.
-  const auto scale_of = [&](const std::string& name) {
-    const int k = shooting.UnknownIndex(name);
-    return k < 0 ? 1.0 : scales(k);
-  };
-  for (ComponentBound& b : c.bounds) b.lower /= scale_of(b.component), b.upper /= scale_of(b.component);
-  for (ComponentTarget& t : c.targets) t.value /= scale_of(t.component);
-  for (SumBound& b : c.sum_bounds) {
-    const double s0 = scale_of(b.components.front());
-    for (const std::string& name : b.components) {
-      if (scale_of(name) != s0) throw std::invalid_argument("sum bound over components of different scales");
-    }
-    b.lower /= s0, b.upper /= s0;
+  std::unique_ptr<ModelExploration> exploration;
+  try {
+    exploration = std::make_unique<ModelExploration>(model, sc, setup.integrator, setup.exploration);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string(args.until.empty() ? "" : "--until: ") + e.what());
   }
-  for (LinearCondition& cond : setup.exploration.start_conditions) {
-    for (auto& [name, coefficient] : cond.coefficients) coefficient *= scale_of(name);
-  }
-  if (const std::string why = c.ValidateFor(layout.unknown_names()); !why.empty()) {
-    throw std::invalid_argument("--until: " + why);
-  }
-  if (const std::string why = setup.exploration.Validate(); !why.empty()) throw std::invalid_argument(why);
+  const ShootingLayout& layout = exploration->shooting().layout();
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / model.name() : fs::path(args.out_dir);
   ResultsWriter::PrepareDirectory(dir);
 
@@ -205,10 +175,7 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   std::map<int, int> physical_points;
   int current_branch = -1;
   const auto start_time = std::chrono::steady_clock::now();
-  c.progress_components.clear();  // ProgressInfo::values = all of u
-  c.progress = [&](const ProgressInfo& info) {
-    const Vector u = scaled.FromScaled(
-        Eigen::Map<const Vector>(info.values.data(), static_cast<Eigen::Index>(info.values.size())));
+  const auto on_point = [&](const ProgressInfo& info, const Vector& u) {
     PointRecord record;
     record.index = info.point_index;
     record.u = u;
@@ -231,15 +198,7 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
                          ToString(record.classification.reason));
     }
   };
-  BifurcationDiagram diagram = Explore(&scaled, scaled.ToScaled(sc.start), setup.exploration);
-  // back to the model's coordinates
-  for (Branch& b : diagram.branches) {
-    for (ContinuationPoint& p : b.points) p.u = scaled.FromScaled(p.u);
-  }
-  for (SpecialPoint& sp : diagram.special_points) {
-    if (sp.u.size()) sp.u = scaled.FromScaled(sp.u);
-    if (sp.interval_width.size()) sp.interval_width = scaled.FromScaled(sp.interval_width);
-  }
+  const BifurcationDiagram diagram = exploration->Run(on_point);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
 
   // ---- 3. summary, key-frame orbits, report, figures
@@ -270,7 +229,8 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   }
   const std::string report =
       diagram.FullReport() + fmt::format("\nwall time {:.3f} s, {} right-hand-side evaluations in {} map evaluations\n",
-                                         seconds, shooting.counters().rhs_evaluations, shooting.num_evaluations());
+                                         seconds, exploration->shooting().counters().rhs_evaluations,
+                                         exploration->shooting().num_evaluations());
   writer.SetReport(report);
   writer.WriteSummary();
   out << report;
