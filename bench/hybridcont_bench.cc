@@ -1,0 +1,124 @@
+// Benchmarks (issue 6): per built-in model, one evaluation of r and dr, one corrector solve, and the full
+// exploration of the model's default scenario. Counters: points, Newton iterations per point, rejected
+// steps, right-hand-side (RHS) evaluations and their ratio to the floor — one integration of every phase
+// with sensitivities per accepted point (the RHS count of one r+dr evaluation at a representative point
+// times the number of accepted points).
+//
+//   build/bench/hybridcont_bench --benchmark_filter=FullRun
+#include <benchmark/benchmark.h>
+
+#include <map>
+
+#include "hybridcont/corrector.h"
+#include "hybridcont/models.h"
+#include "model_exploration.h"
+
+namespace hybridcont::app {
+namespace {
+
+const char* const kModels[] = {"bouncing-ball", "rocking-block", "bouncing-rod", "slip"};
+
+// A representative physical point per model: the middle physical point of the first branch with one.
+struct Representative {
+  Vector u;
+  Vector tangent;
+};
+
+const Representative& RepresentativePoint(const std::string& name) {
+  static std::map<std::string, Representative> cache;
+  auto it = cache.find(name);
+  if (it != cache.end()) return it->second;
+  const HybridModel model = MakeBuiltinModel(name);
+  const Scenario scenario = DefaultScenario(model);
+  ModelExploration exploration(model, scenario, IntegratorOptions{}, ScenarioExplorationOptions(scenario));
+  const BifurcationDiagram d = exploration.Run();
+  Representative rep;
+  for (const Branch& b : d.branches) {
+    if (b.points.size() > 4) {
+      // prefer a branch with positive durations (physical side)
+      const ContinuationPoint& p = b.points[b.points.size() / 2];
+      if (exploration.shooting().layout().Period(p.u) > 0 || rep.u.size() == 0) rep = {p.u, p.tangent};
+      if (exploration.shooting().layout().Period(p.u) > 0) break;
+    }
+  }
+  return cache.emplace(name, rep).first->second;
+}
+
+void BM_ShootingEvaluate(benchmark::State& state) {
+  const std::string name = kModels[state.range(0)];
+  const HybridModel model = MakeBuiltinModel(name);
+  const Representative& rep = RepresentativePoint(name);
+  TimeBasedShooting shooting(model, IntegratorOptions{});
+  Vector u = rep.u, r;
+  Matrix dr;
+  for (auto _ : state) {
+    u(0) += 1e-15;  // defeat the cache: a new point each time
+    shooting.Evaluate(u, &r, &dr);
+    benchmark::DoNotOptimize(dr.data());
+  }
+  state.SetLabel(name);
+  state.counters["rhs_per_eval"] =
+      static_cast<double>(shooting.counters().rhs_evaluations) / static_cast<double>(shooting.num_evaluations());
+  state.counters["N"] = shooting.num_equations();
+}
+BENCHMARK(BM_ShootingEvaluate)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
+
+void BM_CorrectorSolve(benchmark::State& state) {
+  const std::string name = kModels[state.range(0)];
+  const HybridModel model = MakeBuiltinModel(name);
+  const Representative& rep = RepresentativePoint(name);
+  TimeBasedShooting shooting(model, IntegratorOptions{});
+  Corrector corrector(&shooting);
+  // a predictor 1e-2 along the tangent: a typical continuation step
+  const Vector u_pred = rep.u + 1e-2 * rep.tangent;
+  Vector u;
+  long iterations = 0, solves = 0;
+  for (auto _ : state) {
+    const CorrectorResult result = corrector.CorrectPseudoArclength(u_pred, rep.tangent, &u);
+    iterations += result.iterations;
+    ++solves;
+    if (!result.converged()) state.SkipWithError(result.message.c_str());
+  }
+  state.SetLabel(name);
+  state.counters["newton_iterations"] = static_cast<double>(iterations) / static_cast<double>(solves);
+}
+BENCHMARK(BM_CorrectorSolve)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
+
+void BM_FullRun(benchmark::State& state) {
+  const std::string name = kModels[state.range(0)];
+  const HybridModel model = MakeBuiltinModel(name);
+  const Scenario scenario = DefaultScenario(model);
+  long points = 0, newton = 0, rejected = 0, rhs = 0, branches = 0;
+  double floor_rhs = 0;
+  {
+    // RHS evaluations of one r+dr evaluation at the representative point: the per-point floor
+    TimeBasedShooting probe(model, IntegratorOptions{});
+    Vector r;
+    Matrix dr;
+    probe.Evaluate(RepresentativePoint(name).u, &r, &dr);
+    floor_rhs = static_cast<double>(probe.counters().rhs_evaluations);
+  }
+  for (auto _ : state) {
+    ModelExploration exploration(model, scenario, IntegratorOptions{}, ScenarioExplorationOptions(scenario));
+    const BifurcationDiagram d = exploration.Run();
+    points = newton = rejected = 0;
+    for (const Branch& b : d.branches) {
+      points += static_cast<long>(b.points.size());
+      newton += b.newton_iterations;
+      rejected += b.rejected_steps;
+    }
+    branches = static_cast<long>(d.branches.size());
+    rhs = exploration.shooting().counters().rhs_evaluations;
+  }
+  state.SetLabel(name);
+  state.counters["branches"] = static_cast<double>(branches);
+  state.counters["points"] = static_cast<double>(points);
+  state.counters["newton_per_point"] = static_cast<double>(newton) / static_cast<double>(points);
+  state.counters["rejected"] = static_cast<double>(rejected);
+  state.counters["rhs"] = static_cast<double>(rhs);
+  state.counters["rhs_over_floor"] = static_cast<double>(rhs) / (floor_rhs * static_cast<double>(points));
+}
+BENCHMARK(BM_FullRun)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace
+}  // namespace hybridcont::app
