@@ -3,7 +3,7 @@
 // These are the defaults of `hybridcont run MODEL`; every value can be overridden from the command line
 // (--until, --max-branches, ...). They encode the paper's §4 set-up:
 //   bouncing-ball  u0 = 0 (equilibrium), H <= 1
-//   rocking-block  u0 = 0, up to the homoclinic limit H_max = m g l0 (1 - cos beta), stopping as T grows
+//   rocking-block  u0 = 0, up to the homoclinic limit H_max = m g l0 (1 - cos beta), stopping at T = 20
 //   bouncing-rod   u0 = 0 (non-simple: kernel of dimension 3), symmetric direction t2 = t1 + t3, H <= 0.6
 //   slip           the T0 = 2 pi sqrt(m/k) oscillation at H = m g l0, H <= 2
 #ifndef HYBRIDCONT_APP_SCENARIO_H_
