@@ -1,0 +1,239 @@
+// Predictor–corrector continuation of one branch of S = r^{-1}(0) (paper §3.1).
+//
+// A branch is traced from a point u⁰ by repeating (eqs. IVP, predictor, corrector):
+//
+//   tangent     τⁱ  with dr(uⁱ)τⁱ = 0, ||τⁱ|| = 1, oriented continuously: τⁱ⁺¹·τⁱ > 0   (eq. tangentvector)
+//   predictor   u_pred = uⁱ + h·pⁱ,    pⁱ = τⁱ (tangent) or (uⁱ − uⁱ⁻¹)/||·|| (secant)     (eq. predictor)
+//   corrector   uⁱ⁺¹ = Newton on [r(u); pⁱᵀ(u − u_pred)] = 0 (or Moore–Penrose)         (eq. corrector)
+//   step size   Allgower–Georg ch. 6: with κ the Newton contraction ||Δ₁||/||Δ₀||, δ = ||uⁱ⁺¹ − u_pred||
+//               and α = ∠(τⁱ, τⁱ⁺¹), the deceleration factor
+//                   f = max( sqrt(κ/κ̃), sqrt(δ/δ̃), α/α̃ )        (κ̃, δ̃, α̃ the nominal values)
+//               rejects the step when f > 2 (retry with h/2) and otherwise sets h ← h / max(f, 1/2),
+//               clamped to [min_step, max_step]. A failed corrector also halves h; below min_step the
+//               branch ends with kStepTooSmall and keeps its points.
+//
+// The tangent is the solution of the bordered system [dr(uⁱ⁺¹); τⁱᵀ] v = e_{N+1}, normalized: its last
+// equation τⁱᵀv = 1 is the continuous orientation, so the curve passes straight through simple
+// bifurcation points (where the paper's det > 0 convention would flip τ; the sign flip of
+// det([dr; τᵀ]) is kept as the SB test function instead). At the start the kernel comes from a QR of drᵀ
+// and is oriented so that det([dr; τᵀ]) > 0, then multiplied by `direction` d ∈ {−1, +1} (eq. IVP).
+//
+// Stops, each located exactly where it is a level set: a target u_k = value and a bound on u_k or on a
+// sum Σ u_k (e.g. the period t1 + t2 + t3 <= T_max) end the branch on the point with that value, found
+// by the linear-constraint corrector [r(u); cᵀu − value] = 0 from the secant interpolant. A user predicate,
+// max_points and a closed loop (the branch returns to its start point) end it at a branch point.
+//
+// Tiny example (the unit circle; see zero_problem.h):
+//
+//   ContinuationOptions options;
+//   options.turning_point_components = {"y"};
+//   Branch branch = TraceBranch(&circle, Vector2d(1, 0), options);
+//   // branch.termination == TerminationReason::kClosedLoop, two turning points at (0, ±1)
+//
+//   ContinuationStepper stepper(&circle, options);        // the same, one point at a time
+//   for (stepper.Start(u0); stepper.Step() == StepStatus::kContinuing;) { ... stepper.branch() ... }
+//
+// Decisions where the issue is silent:
+//  - Step length h is measured along the predictor direction (≈ arclength); branch arclength is the sum of
+//    chord lengths.
+//  - A corrected point at which the bordered tangent system is singular (a point exactly on an SB point)
+//    is rejected like a failed corrector: the step is halved, so branch points are always regular.
+//  - A bound crossed already at the start point (value exactly on the bound, moving outward) ends the
+//    branch with only its start point; a start point outside a bound ends it at once (kBoundReached).
+//  - The first interval of a branch started at a singular point (branch switching, singular starts) is
+//    not searched for special points: its start point is the bifurcation point itself.
+//  - Closed loop: the start point lies within the chord-sag tolerance of the last chord and the tangents
+//    agree; the start point is then appended as the last point, so the curve closes exactly.
+#ifndef HYBRIDCONT_CONTINUATION_H_
+#define HYBRIDCONT_CONTINUATION_H_
+
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hybridcont/corrector.h"
+#include "hybridcont/special_point.h"
+#include "hybridcont/types.h"
+#include "hybridcont/zero_problem.h"
+
+namespace hybridcont {
+
+enum class TerminationReason {
+  kNotFinished,     // the stepper can still take steps
+  kMaxPoints,       // max_points reached
+  kTargetReached,   // a ComponentTarget was reached (the last point has exactly that value)
+  kBoundReached,    // a ComponentBound or SumBound was reached (the last point lies on it)
+  kUserStop,        // stop_predicate returned true for the last point
+  kStepTooSmall,    // the corrector failed even with min_step; the branch keeps its points
+  kClosedLoop,      // the branch returned to its start point (last point == first point)
+  kKnownBranch,     // exploration: the branch runs along a branch already traced
+  kStartFailed,     // the start point could not be corrected or is singular (see message)
+};
+std::string ToString(TerminationReason reason);
+
+enum class PredictorType {
+  kTangent,  // Euler predictor along τ (eq. predictor)
+  kSecant,   // along the chord of the last two points: free, and often better on curved branches
+};
+std::string ToString(PredictorType type);
+bool StringToPredictorType(const std::string& text, PredictorType* type);
+
+enum class StepStatus {
+  kContinuing,  // more steps can follow (a point was added)
+  kFinished,    // the branch is finished: see Branch::termination
+};
+
+// lower <= u[component] <= upper; the branch ends on the bound it reaches.
+struct ComponentBound {
+  std::string component;
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+};
+// The branch ends on the first point with u[component] == value (reached from either side).
+struct ComponentTarget {
+  std::string component;
+  double value = 0;
+};
+// lower <= Σ u[c] over components <= upper, e.g. the period {"t1", "t2", "t3"} <= T_max.
+struct SumBound {
+  std::vector<std::string> components;
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+};
+
+struct ContinuationPoint {
+  Vector u;
+  Vector tangent;               // unit, oriented continuously along the branch
+  double arclength = 0;         // sum of chord lengths from the branch start
+  double step = 0;              // predictor step h that produced this point (0 for the start)
+  int newton_iterations = 0;    // corrector iterations for this point
+  double contraction = 0;       // Newton contraction κ of its corrector
+  // Hadamard-normalized det([dr; τᵀ]) ∈ [−1, 1] (special_point.h); its sign flips across SB points.
+  // 0 at a singular start point.
+  double sb_test = 0;
+};
+
+// What the progress callback sees after every accepted point (the library itself never prints).
+struct ProgressInfo {
+  int branch_id = 0;
+  int point_index = 0;
+  std::vector<double> values;   // the components named in progress_components (all if empty)
+  double step = 0;              // step h used for this point
+  double next_step = 0;         // step the controller proposes next
+  int newton_iterations = 0;
+  int rejected_steps = 0;       // on this branch so far
+};
+
+struct ContinuationOptions {
+  // First predictor step. Small enough for Newton to converge from the tangent predictor on typical
+  // problems scaled to O(1); the controller grows it quickly when the curve is easy.
+  double initial_step = 0.05;
+  // Below this the branch is given up (kStepTooSmall): the corrector keeps failing at a scale where the
+  // curve is no longer resolved in double precision relative to u = O(1).
+  double min_step = 1e-8;
+  // Upper bound for h: keeps special points from being stepped over (two SB sign changes in one step
+  // cancel) and bounds the chord error of the plotted branch.
+  double max_step = 0.25;
+  // d of eq. IVP: which of the two orientations of the start tangent to follow (det > 0 convention).
+  int direction = +1;
+  // Branch points including the start point.
+  int max_points = 1000;
+  PredictorType predictor = PredictorType::kTangent;
+  CorrectorType corrector_type = CorrectorType::kPseudoArclength;
+  CorrectorOptions corrector;
+  // Nominal Newton contraction κ̃ (Allgower–Georg use 0.3–0.5): faster contraction lets h grow.
+  double nominal_contraction = 0.3;
+  // Nominal distance δ̃ between predictor and corrected point, in the units of u.
+  double nominal_distance = 0.1;
+  // Nominal angle α̃ (radians) between consecutive tangents: ~8.6°, fine enough to resolve folds.
+  double nominal_angle = 0.15;
+  // Corrector iterates farther than this multiple of h from the predictor count as divergence: a
+  // Newton iteration that travels farther than the step is probably jumping to another branch.
+  double max_corrector_distance = 1.0;
+  // Correct the start point with the Moore–Penrose corrector (a start guess need not be on the curve).
+  bool correct_start_point = true;
+  // Detect (and locate) simple bifurcation points by the sign of det([dr; τᵀ]).
+  bool detect_bifurcations = true;
+  // Components whose turning points (sign changes of τ_k) are detected and located. Empty means "H"
+  // when the problem names an unknown "H", and none otherwise.
+  std::vector<std::string> turning_point_components;
+  // Width of the final root-finder bracket (in arclength) at which a special point counts as located.
+  // 1e-11 makes located components exact to ~1e-11 (turning-point values to ~1e-20) when the
+  // residual allows.
+  double location_tolerance = 1e-11;
+  // Root-finder budget per special point; Illinois needs ~10, bisection fallback ~40 for 1e-11.
+  int max_location_iterations = 60;
+  std::vector<ComponentBound> bounds;
+  std::vector<ComponentTarget> targets;
+  std::vector<SumBound> sum_bounds;
+  // Called with each accepted point; returning true ends the branch there (kUserStop). E.g. a maximum
+  // period computed from u by the caller.
+  std::function<bool(const Vector& u)> stop_predicate;
+  // Recognize a branch that returns to its start point (kClosedLoop).
+  bool detect_closed_loop = true;
+  // Components reported in ProgressInfo::values (names); empty reports all of u.
+  std::vector<std::string> progress_components;
+  std::function<void(const ProgressInfo&)> progress;
+
+  // Empty if valid; otherwise names the field, its value and the violated constraint.
+  std::string Validate() const;
+  // Validate() plus: every component named in the options is one of `unknown_names`.
+  std::string ValidateFor(const std::vector<std::string>& unknown_names) const;
+};
+
+struct Branch {
+  int id = 0;
+  int direction = +1;                 // d of eq. IVP used at the start
+  int parent_special_point = -1;      // SB point / singular start this branch leaves, −1 for none
+  int depth = 0;                      // exploration: number of branch switches from the start
+  std::vector<ContinuationPoint> points;
+  std::vector<SpecialPoint> special_points;  // in arclength order
+  TerminationReason termination = TerminationReason::kNotFinished;
+  std::string message;
+  int newton_iterations = 0;          // total over accepted and rejected steps
+  int rejected_steps = 0;
+  int located_iterations = 0;         // root-finder iterations spent locating special points
+
+  std::string BriefReport() const;
+  std::string FullReport(const std::vector<std::string>& unknown_names = {}) const;
+};
+
+// Traces one branch point by point. Construct, call one Start*, then Step() until kFinished.
+class ContinuationStepper {
+ public:
+  // problem must outlive the stepper. Throws std::invalid_argument if options are invalid for problem.
+  ContinuationStepper(ZeroProblem* problem, const ContinuationOptions& options, int branch_id = 0);
+  ~ContinuationStepper();
+  ContinuationStepper(ContinuationStepper&&) noexcept;
+  ContinuationStepper& operator=(ContinuationStepper&&) noexcept;
+
+  // Regular start: corrects u0 (if correct_start_point), tangent with det([dr; τᵀ]) > 0 times direction.
+  StepStatus Start(const Vector& u0);
+  // Regular start, tangent oriented so that τ·direction_hint > 0.
+  StepStatus Start(const Vector& u0, const Vector& direction_hint);
+  // Start at a singular point (an SB point or a singular start) along a given branch direction, e.g. from
+  // branch_switching.h. No correction and no tangent computation at u0.
+  StepStatus StartAtSingularPoint(const Vector& u0, const Vector& tangent);
+  // Adds one point (or finishes the branch).
+  StepStatus Step();
+  // Ends the branch from outside (exploration: kKnownBranch). Keeps the points.
+  void Terminate(TerminationReason reason, const std::string& message);
+
+  bool finished() const;
+  double step_size() const;           // h proposed for the next step
+  const Branch& branch() const;
+  Branch TakeBranch();                // moves the branch out; the stepper is finished afterwards
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Convenience driver: Start(u0) then Step() until finished.
+Branch TraceBranch(ZeroProblem* problem, const Vector& u0, const ContinuationOptions& options);
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_CONTINUATION_H_

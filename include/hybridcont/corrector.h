@@ -1,0 +1,142 @@
+// Newton correctors: bring a predicted point back onto the solution curve S = r^{-1}(0).
+//
+// Paper §3.1, eq. (corrector): u^{i+1} ≈ argmin_{u ∈ S} ||u − u_pred||. Every corrector here is Newton's
+// method on r(u) = 0 bordered by one extra scalar equation, so that the (N+1) x (N+1) matrix
+//
+//        [ dr(u) ]   N rows      (the Jacobian of the zero problem, N x (N+1))
+//    B = [-------]
+//        [  bᵀ   ]   1 row       (the border: what pins u down along the curve)
+//
+// is square and, at a regular point, invertible. The three borders:
+//
+//   pseudo-arclength   F(u) = [ r(u) ; τᵀ(u − u_pred) ],  b = τ      u stays on the hyperplane ⟂ τ through
+//                                                                      u_pred (Keller).
+//   Moore–Penrose      Δ_k  = −[dr(u_k); τ_kᵀ]⁻¹ [r(u_k); 0],          the minimum-norm Newton step
+//                      τ_{k+1} = [dr(u_k); τ_kᵀ]⁻¹ e_{N+1} / ||·||      (Allgower–Georg §3.3): τ_k follows
+//                                                                      the kernel of dr, so u converges to
+//                                                                      the point of S nearest to u_pred —
+//                                                                      eq. (corrector) of the paper.
+//   linear constraint  F(u) = [ r(u) ; cᵀu − value ],  b = c         e.g. c = e_H, value = 2: the point of
+//                                                                      S with H = 2 exactly (stops, targets).
+//
+// Tiny example (the unit circle x² + y² = 1, predictor off the curve):
+//
+//   Circle circle;                                  // a ZeroProblem, see zero_problem.h
+//   hybridcont::Corrector corrector(&circle);
+//   Vector u;
+//   CorrectorResult result = corrector.CorrectPseudoArclength(Vector2d(1.1, 0.2), Vector2d(0, 1), &u);
+//   // result.status == CorrectorStatus::kConverged, u ≈ (0.979796, 0.2)
+//
+// Convergence: ||F(u_k)||₂ <= residual_tolerance AND the last Newton step satisfies
+// ||Δ|| <= step_tolerance·(1 + ||u||). Decision where the issue is silent: when the residual is already
+// below its tolerance but the steps stop contracting (the rounding floor, e.g. near a bifurcation point
+// where B is ill-conditioned), the point is accepted as converged — the residual test decides there.
+// At least one Newton step is always taken, so a converged u is never the raw predictor.
+//
+// Numerical outcomes are statuses (CorrectorResult), never exceptions or prints. A wrong vector size is
+// a programming error and throws std::invalid_argument.
+#ifndef HYBRIDCONT_CORRECTOR_H_
+#define HYBRIDCONT_CORRECTOR_H_
+
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "hybridcont/types.h"
+#include "hybridcont/zero_problem.h"
+
+namespace hybridcont {
+
+enum class CorrectorStatus {
+  kConverged,         // residual and step tests met
+  kMaxIterations,     // still iterating after max_iterations Newton steps
+  kDiverged,          // steps grew, the iterate left max_distance, or a value became NaN/Inf
+  kSingular,          // the bordered matrix [dr; bᵀ] is numerically singular
+  kEvaluationFailed,  // ZeroProblem::Evaluate reported a failure (message copied)
+};
+std::string ToString(CorrectorStatus status);
+
+enum class CorrectorType {
+  kPseudoArclength,  // hyperplane ⟂ predictor direction; cheapest, the default
+  kMoorePenrose,     // minimum-norm steps with a kernel update per iteration (Allgower–Georg)
+};
+std::string ToString(CorrectorType type);
+// Parses "pseudo-arclength" / "moore-penrose"; returns false for anything else.
+bool StringToCorrectorType(const std::string& text, CorrectorType* type);
+
+struct CorrectorOptions {
+  // Newton converges quadratically from a good predictor; needing more than a dozen steps means the
+  // step was too long, and halving it is cheaper than iterating on.
+  int max_iterations = 12;
+  // ||F(u)||₂ at acceptance. 1e-10 leaves room for integrator round-off in shooting maps, and is far below
+  // the 1e-10 precision asked of located special points only in combination with step_tolerance.
+  double residual_tolerance = 1e-10;
+  // Last Newton step ||Δ||₂ / (1 + ||u||₂). With quadratic convergence the error after a step of 1e-10 is
+  // ~1e-20, so accepted points are accurate to the rounding level.
+  double step_tolerance = 1e-10;
+  // A step ratio ||Δ_{k+1}|| / ||Δ_k|| above this is divergence: Newton inside its basin contracts.
+  double max_contraction = 1.0;
+  // ||u − u_pred||₂ above this is divergence: keeps the corrector from jumping to another branch.
+  // The stepper sets it per step (a multiple of the step length); infinite for a bare corrector.
+  double max_distance = std::numeric_limits<double>::infinity();
+
+  // Empty if valid; otherwise names the field, its value and the violated constraint.
+  std::string Validate() const;
+};
+
+struct CorrectorResult {
+  CorrectorStatus status = CorrectorStatus::kMaxIterations;
+  std::string message;        // empty when converged; otherwise why not (evaluation message included)
+  int iterations = 0;         // Newton steps taken (each costs one factorization)
+  int evaluations = 0;        // calls of ZeroProblem::Evaluate (iterations + 1 when converged)
+  double residual_norm = 0;   // ||F(u)||₂ at the returned u
+  double step_norm = 0;       // ||Δ||₂ of the last Newton step
+  // Allgower–Georg contraction estimate κ = ||Δ₁|| / ||Δ₀|| (0 when Newton stopped after one step): the
+  // step controller's main signal.
+  double contraction = 0;
+  double distance = 0;        // ||u − u_pred||₂ at the returned u
+
+  bool converged() const { return status == CorrectorStatus::kConverged; }
+  std::string BriefReport() const;
+};
+
+class Corrector {
+ public:
+  // problem must outlive the corrector. Throws std::invalid_argument if options are invalid.
+  explicit Corrector(ZeroProblem* problem, const CorrectorOptions& options = CorrectorOptions());
+  ~Corrector();
+  Corrector(Corrector&&) noexcept;
+  Corrector& operator=(Corrector&&) noexcept;
+
+  // Pseudo-arclength: solves [r(u); τᵀ(u − u_pred)] = 0 starting from u_pred. τ need not be normalized.
+  CorrectorResult CorrectPseudoArclength(const Vector& u_pred, const Vector& tau, Vector* u);
+  // Moore–Penrose: minimum-norm Newton steps, τ (an approximate tangent) updated to the kernel of dr.
+  CorrectorResult CorrectMoorePenrose(const Vector& u_pred, const Vector& tau, Vector* u);
+  // Linear constraint: solves [r(u); cᵀu − value] = 0 starting from u_pred.
+  CorrectorResult CorrectWithConstraint(const Vector& u_pred, const Vector& c, double value, Vector* u);
+  // Component `index` of u fixed to `target` (c = e_index): stop exactly at e.g. H = 2.
+  CorrectorResult CorrectFixedComponent(const Vector& u_pred, int index, double target, Vector* u);
+  // Dispatches on type (pseudo-arclength or Moore–Penrose) with τ as hyperplane normal / tangent guess.
+  CorrectorResult Correct(CorrectorType type, const Vector& u_pred, const Vector& tau, Vector* u);
+
+  // r and dr at the u returned by the last call (valid when it converged): the stepper reuses dr for the
+  // tangent, so a converged point costs no extra evaluation.
+  const Vector& residual() const;
+  const Matrix& jacobian() const;
+
+  const CorrectorOptions& options() const { return options_; }
+  void set_max_distance(double max_distance) { options_.max_distance = max_distance; }
+
+ private:
+  struct Workspace;
+  enum class Border { kArclength, kMoorePenrose, kConstraint };
+  CorrectorResult Run(Border border, const Vector& u_pred, const Vector& b, double value, Vector* u);
+
+  ZeroProblem* problem_;
+  CorrectorOptions options_;
+  std::unique_ptr<Workspace> workspace_;
+};
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_CORRECTOR_H_

@@ -1,0 +1,108 @@
+// Automatic exploration: from one start point, trace every branch reachable by switching at simple
+// bifurcation points, and return the bifurcation diagram as a graph.
+//
+//   nodes: special points (SB points, turning points, a singular start), each stored once
+//   edges: half-branches, each leaving a start point or an SB point in one direction (Branch::direction,
+//          Branch::parent_special_point) and ending for a TerminationReason
+//
+// Algorithm (breadth first over SB points):
+//   1. Start. Regular u0 (kernel of dr of dimension 1): trace d = +1 and d = −1 (eq. IVP); the second is
+//      skipped when the first closes a loop. Singular u0 (kernel dimension >= 2, e.g. an equilibrium with
+//      zero phase durations): the branch lines from the algebraic bifurcation equations
+//      (branch_switching.h, with ExplorationOptions::start_conditions for kernels of dimension > 2), each
+//      traced as two half-branches ±v from u0.
+//   2. Every SB point located on a traced branch is compared with the known ones (distance in u below
+//      same_point_tolerance·(1 + ||u||)): a new one is queued, a known one only records the branch.
+//   3. For a queued SB point within max_depth: the transverse ABE root v (SwitchDirectionAt) gives the two
+//      half-branches ±v, each traced unless a branch already leaves the point in that direction.
+//   4. Never twice: a "ray" (point, direction) is recorded for every branch leaving, passing through or
+//      returning to a special point; a new half-branch whose ray matches one (|cos| >=
+//      same_direction_cosine) is not traced. Independently, the first known_branch_check_points points of
+//      every new branch are compared with all traced branches (distance to a chord within the chord sag,
+//      parallel tangent); a match ends the new branch at once with kKnownBranch.
+//
+// Tiny example (pitchfork x³ − λx from a regular point of the trivial branch):
+//
+//   ExplorationOptions options;
+//   options.continuation.bounds = {{"lambda", -1, 1}};
+//   BifurcationDiagram diagram = Explore(&pitchfork, Vector2d(0, -0.5), options);
+//   // 4 half-branches: x = 0 (λ up, λ down) and λ = x² (x > 0, x < 0); one SB point at (0, 0), located.
+//
+// The library never prints: ContinuationOptions::progress receives every accepted point (with the
+// branch id), and BriefReport()/FullReport() summarize the result.
+#ifndef HYBRIDCONT_EXPLORATION_H_
+#define HYBRIDCONT_EXPLORATION_H_
+
+#include <string>
+#include <vector>
+
+#include "hybridcont/branch_switching.h"
+#include "hybridcont/continuation.h"
+#include "hybridcont/special_point.h"
+#include "hybridcont/types.h"
+#include "hybridcont/zero_problem.h"
+
+namespace hybridcont {
+
+struct ExplorationOptions {
+  // Per half-branch: bounds, targets, max_points (the limit per branch), step sizes, progress callback.
+  ContinuationOptions continuation;
+  // Kernel, cokernel and ABE at SB points and at a singular start.
+  BranchSwitchOptions switching;
+  // Linear conditions on the direction at a singular start whose kernel has dimension > 2 (the rod).
+  std::vector<LinearCondition> start_conditions;
+  // Branch switches from the start: branches from the start have depth 0, from their SB points depth 1...
+  int max_depth = 4;
+  // Total number of half-branches; exploration ends with kMaxBranches when reached.
+  int max_branches = 64;
+  // SB points closer than this · (1 + ||u||) (max-norm) are one point. Located points agree to ~1e-10;
+  // distinct bifurcation points of O(1) problems are far more than 1e-6 apart.
+  double same_point_tolerance = 1e-6;
+  // Two directions at one point with |cos| at least this are the same ray (about 8°: branch directions
+  // from finite-difference ABEs are accurate to ~1e-6, distinct branches cross at visible angles).
+  double same_direction_cosine = 0.99;
+  // Points (after the start) of every new branch compared with the traced branches.
+  int known_branch_check_points = 3;
+  // Absolute part of the "lies on a traced branch" distance, · (1 + ||u||), added to the chord sag.
+  double known_branch_tolerance = 1e-6;
+
+  std::string Validate() const;
+};
+
+enum class ExplorationStatus {
+  kCompleted,    // every reachable branch within the bounds and depth was traced
+  kMaxBranches,  // stopped at max_branches
+  kStartFailed,  // no branch could be started (see message)
+};
+std::string ToString(ExplorationStatus status);
+
+struct SwitchRecord {
+  int special_point = -1;     // the SB point (or singular start) switched at
+  BranchSwitch result;        // direction found (or fallback) and the ABE coefficients
+  int traced = 0;             // half-branches traced from it
+  int skipped = 0;            // half-branches recognized as already traced
+};
+
+struct BifurcationDiagram {
+  std::vector<std::string> unknown_names;
+  std::vector<Branch> branches;               // id == index
+  std::vector<SpecialPoint> special_points;   // unique points, id == index
+  std::vector<SwitchRecord> switches;
+  BranchDirections start;                     // analysis of the start point
+  ExplorationStatus status = ExplorationStatus::kCompleted;
+  std::string message;
+
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+// Explores from u0: regular (corrected, both directions) or singular (branch directions from the ABE).
+// Throws std::invalid_argument for invalid options.
+BifurcationDiagram Explore(ZeroProblem* problem, const Vector& u0, const ExplorationOptions& options);
+// Explores from a regular u0 whose tangent orientation is given (the first half-branch follows it).
+BifurcationDiagram Explore(ZeroProblem* problem, const Vector& u0, const Vector& tangent,
+                           const ExplorationOptions& options);
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_EXPLORATION_H_

@@ -1,0 +1,301 @@
+// Lyapunov–Schmidt reduction at singular points (branch_switching.h).
+#include "hybridcont/branch_switching.h"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace hybridcont {
+namespace {
+
+// Forms (A_j)_pq = ψ_jᵀ d²r[φ_p, φ_q] by central differences of dr along each φ_q, symmetrized.
+bool QuadraticForms(ZeroProblem* problem, const Vector& u, const Matrix& kernel, const Matrix& cokernel,
+                    double eps, std::vector<Matrix>* forms, std::string* message) {
+  const Eigen::Index k = kernel.cols(), m = cokernel.cols();
+  forms->assign(m, Matrix::Zero(k, k));
+  Matrix dr_plus, dr_minus;
+  for (Eigen::Index q = 0; q < k; ++q) {
+    const EvaluationStatus plus = problem->Evaluate(u + eps * kernel.col(q), nullptr, &dr_plus);
+    const EvaluationStatus minus = problem->Evaluate(u - eps * kernel.col(q), nullptr, &dr_minus);
+    if (!plus.ok || !minus.ok) {
+      *message = "finite-difference evaluation failed: " + plus.message + minus.message;
+      return false;
+    }
+    const Matrix second = cokernel.transpose() * ((dr_plus - dr_minus) / (2 * eps)) * kernel;  // m x k: [j, p]
+    for (Eigen::Index j = 0; j < m; ++j) (*forms)[j].col(q) = second.row(j).transpose();
+  }
+  for (Matrix& form : *forms) form = 0.5 * (form + form.transpose()).eval();
+  return true;
+}
+
+enum class Roots { kTwo, kDouble, kNone };
+
+// Real roots (unit vectors in R²) of α A α = a α₁² + 2b α₁α₂ + c α₂² = 0. A discriminant within
+// ±degeneracy_tolerance·(a² + b² + c²) of zero is a double root (one direction), below that no real root.
+Roots QuadraticRoots(const Matrix& A, double degeneracy_tolerance, std::vector<Eigen::Vector2d>* roots) {
+  const double a = A(0, 0), b = A(0, 1), c = A(1, 1);
+  const double scale = a * a + b * b + c * c;
+  const double disc = b * b - a * c;
+  roots->clear();
+  if (!(scale > 0) || disc < -degeneracy_tolerance * scale) return Roots::kNone;
+  // Homogeneous roots (α₁, α₂) of a α₁² + 2b α₁α₂ + c α₂²: t = α₁/α₂ ∈ {q/a, c/q} gives the directions
+  // (q, a) and (c, q) without any division, valid also for a = 0 or c = 0 (e.g. Q = −2α₁α₂).
+  if (disc <= degeneracy_tolerance * scale) {
+    const Eigen::Vector2d first(-b, a), second(c, -b);
+    roots->push_back((first.norm() >= second.norm() ? first : second).normalized());
+    return Roots::kDouble;
+  }
+  const double q = -(b + std::copysign(std::sqrt(disc), b));  // |q| >= sqrt(disc) > 0: no cancellation
+  roots->push_back(Eigen::Vector2d(q, a).normalized());
+  roots->push_back(Eigen::Vector2d(c, q).normalized());
+  return Roots::kTwo;
+}
+
+// Sign convention for lines: largest-magnitude component positive.
+Vector CanonicalLine(Vector v) {
+  v.normalize();
+  Eigen::Index i;
+  v.cwiseAbs().maxCoeff(&i);
+  return v(i) < 0 ? Vector(-v) : v;
+}
+
+}  // namespace
+
+std::string ToString(BranchSwitchStatus status) {
+  switch (status) {
+    case BranchSwitchStatus::kOk: return "ok";
+    case BranchSwitchStatus::kFallback: return "fallback";
+    case BranchSwitchStatus::kRegular: return "regular";
+    case BranchSwitchStatus::kUnderdetermined: return "underdetermined";
+    case BranchSwitchStatus::kNoRoots: return "no-roots";
+    case BranchSwitchStatus::kEvaluationFailed: return "evaluation-failed";
+  }
+  return "unknown";
+}
+
+std::string BranchSwitchOptions::Validate() const {
+  std::ostringstream out;
+  if (!(rank_tolerance > 0 && rank_tolerance < 1)) {
+    out << "BranchSwitchOptions::rank_tolerance = " << rank_tolerance << " must lie in (0, 1)";
+  } else if (!(fd_step > 0)) {
+    out << "BranchSwitchOptions::fd_step = " << fd_step << " must be > 0";
+  } else if (!(degeneracy_tolerance >= 0)) {
+    out << "BranchSwitchOptions::degeneracy_tolerance = " << degeneracy_tolerance << " must be >= 0";
+  } else if (!(abe_tolerance > 0)) {
+    out << "BranchSwitchOptions::abe_tolerance = " << abe_tolerance << " must be > 0";
+  }
+  return out.str();
+}
+
+std::string StartOptions::Validate() const {
+  std::string error = switching.Validate();
+  if (!error.empty()) return "StartOptions::switching: " + error;
+  for (size_t i = 0; i < conditions.size(); ++i) {
+    if (conditions[i].coefficients.empty()) {
+      return "StartOptions::conditions[" + std::to_string(i) + "] has no coefficients";
+    }
+  }
+  return "";
+}
+
+std::string BranchDirections::BriefReport() const {
+  std::ostringstream out;
+  out << "Singular point: " << ToString(status) << ", kernel dimension " << kernel_dimension << ", "
+      << directions.size() << " branch directions";
+  if (!message.empty()) out << " (" << message << ")";
+  return out.str();
+}
+
+std::string BranchSwitch::BriefReport() const {
+  std::ostringstream out;
+  out << "Branch switch: " << ToString(status) << ", ABE (" << a << ", " << b << ", " << c
+      << "), incoming root angle " << incoming_root_angle << ", sigma_min/max(1, sigma_max) " << sigma_ratio;
+  if (!message.empty()) out << " (" << message << ")";
+  return out.str();
+}
+
+BranchDirections AnalyzeSingularPoint(ZeroProblem* problem, const Vector& u0, const StartOptions& options) {
+  if (const std::string error = options.Validate(); !error.empty()) throw std::invalid_argument(error);
+  const int n = problem->num_unknowns();
+  if (u0.size() != n) {
+    throw std::invalid_argument("AnalyzeSingularPoint: u0 has size " + std::to_string(u0.size()) +
+                                ", expected " + std::to_string(n));
+  }
+  Matrix C(static_cast<Eigen::Index>(options.conditions.size()), n);
+  C.setZero();
+  for (size_t i = 0; i < options.conditions.size(); ++i) {
+    for (const auto& [name, coefficient] : options.conditions[i].coefficients) {
+      const int index = problem->UnknownIndex(name);
+      if (index < 0) throw std::invalid_argument("StartOptions::conditions: \"" + name + "\" is not an unknown");
+      C(static_cast<Eigen::Index>(i), index) += coefficient;
+    }
+  }
+
+  BranchDirections out;
+  Matrix dr;
+  if (const EvaluationStatus status = problem->Evaluate(u0, nullptr, &dr); !status.ok) {
+    out.status = BranchSwitchStatus::kEvaluationFailed;
+    out.message = status.message;
+    return out;
+  }
+  Eigen::JacobiSVD<Matrix> svd(dr, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  out.singular_values = svd.singularValues();
+  const double threshold = options.switching.rank_tolerance * std::max(1.0, out.singular_values.maxCoeff());
+  int rank = 0;
+  while (rank < out.singular_values.size() && out.singular_values(rank) > threshold) ++rank;
+  out.kernel_dimension = n - rank;
+  out.cokernel_dimension = static_cast<int>(dr.rows()) - rank;
+  out.kernel = svd.matrixV().rightCols(out.kernel_dimension);
+  out.cokernel = svd.matrixU().rightCols(out.cokernel_dimension);
+  if (out.kernel_dimension == 1) {
+    out.status = BranchSwitchStatus::kRegular;
+    out.directions.push_back(CanonicalLine(out.kernel.col(0)));
+    return out;
+  }
+
+  // Restrict the kernel by the conditions: Φ Z with Z spanning the null space of C Φ.
+  Matrix Z = Matrix::Identity(out.kernel_dimension, out.kernel_dimension);
+  if (C.rows() > 0) {
+    const Matrix CPhi = C * out.kernel;
+    Eigen::JacobiSVD<Matrix> csvd(CPhi, Eigen::ComputeFullV);
+    const double cmax = std::max(1.0, csvd.singularValues().size() ? csvd.singularValues().maxCoeff() : 0.0);
+    int crank = 0;
+    while (crank < csvd.singularValues().size() && csvd.singularValues()(crank) > options.switching.rank_tolerance * cmax) {
+      ++crank;
+    }
+    Z = csvd.matrixV().rightCols(out.kernel_dimension - crank);
+  }
+  const Matrix basis = out.kernel * Z;
+  if (basis.cols() == 0) {
+    out.status = BranchSwitchStatus::kNoRoots;
+    out.message = "the linear conditions exclude every kernel direction";
+    return out;
+  }
+  if (basis.cols() == 1) {
+    out.status = BranchSwitchStatus::kOk;
+    out.message = "direction selected by the linear conditions alone";
+    out.directions.push_back(CanonicalLine(basis.col(0)));
+    return out;
+  }
+  if (basis.cols() > 2) {
+    out.status = BranchSwitchStatus::kUnderdetermined;
+    out.message = "kernel dimension " + std::to_string(out.kernel_dimension) + " restricted to " +
+                  std::to_string(basis.cols()) + " by the conditions; give " + std::to_string(basis.cols() - 2) +
+                  " more linear condition(s)";
+    return out;
+  }
+  std::vector<Matrix> forms;
+  if (!QuadraticForms(problem, u0, basis, out.cokernel, options.switching.fd_step, &forms, &out.message)) {
+    out.status = BranchSwitchStatus::kEvaluationFailed;
+    return out;
+  }
+  // The dominant form gives the candidate roots; the others must vanish there too.
+  size_t dominant = 0;
+  for (size_t j = 1; j < forms.size(); ++j) {
+    if (forms[j].norm() > forms[dominant].norm()) dominant = j;
+  }
+  std::vector<Eigen::Vector2d> roots;
+  const Roots kind = QuadraticRoots(forms[dominant], options.switching.degeneracy_tolerance, &roots);
+  if (kind == Roots::kNone) {
+    out.status = BranchSwitchStatus::kNoRoots;
+    out.message = "the algebraic bifurcation equation has no real roots (or vanishes identically)";
+    return out;
+  }
+  // A double root is one branch line: with a 2-dim kernel a degenerate (non-simple) point, after
+  // restriction by conditions the usual case (the other branches lie outside the restricted plane).
+  if (kind == Roots::kDouble) out.message = "double root of the algebraic bifurcation equation";
+  for (const Eigen::Vector2d& root : roots) {
+    bool common = true;
+    for (const Matrix& form : forms) {
+      if (std::abs(root.dot(form * root)) > options.switching.abe_tolerance * std::max(form.norm(), 1e-300) &&
+          form.norm() > options.switching.abe_tolerance * forms[dominant].norm()) {
+        common = false;
+      }
+    }
+    if (common) out.directions.push_back(CanonicalLine(basis * root));
+  }
+  out.status = out.directions.empty() ? BranchSwitchStatus::kNoRoots : BranchSwitchStatus::kOk;
+  if (out.directions.empty()) out.message = "the roots of the dominant form do not solve the other forms";
+  if (out.directions.size() == 2 && std::abs(out.directions[0].dot(out.directions[1])) > 1 - 1e-12) {
+    out.directions.pop_back();
+  }
+  return out;
+}
+
+std::vector<Vector> BranchDirectionsAt(ZeroProblem& problem, const Vector& u0, const StartOptions& options) {
+  return AnalyzeSingularPoint(&problem, u0, options).directions;
+}
+
+BranchSwitch SwitchDirectionAt(ZeroProblem* problem, const SpecialPoint& sb, const BranchSwitchOptions& options) {
+  if (const std::string error = options.Validate(); !error.empty()) throw std::invalid_argument(error);
+  BranchSwitch out;
+  Matrix dr;
+  if (const EvaluationStatus status = problem->Evaluate(sb.u, nullptr, &dr); !status.ok) {
+    out.status = BranchSwitchStatus::kEvaluationFailed;
+    out.message = status.message;
+    return out;
+  }
+  const Eigen::Index n = dr.cols(), rows = dr.rows();
+  Eigen::JacobiSVD<Matrix> svd(dr, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Vector& sigma = svd.singularValues();
+  out.sigma_ratio = sigma(rows - 1) / std::max(sigma(0), 1.0);
+  const Matrix kernel = svd.matrixV().rightCols(2);
+  const Matrix cokernel = svd.matrixU().rightCols(1);
+  // Basis φ₁ ∥ (incoming tangent projected on the kernel), φ₂ ⟂ φ₁ in the kernel.
+  // The tangent at the located point (the limit from the incoming side), else the last one before it.
+  const Vector incoming = sb.tangent.size() == n && sb.tangent.allFinite() ? sb.tangent : sb.tangent_before;
+  Eigen::Vector2d c1 = kernel.transpose() * incoming;
+  if (!(c1.norm() > 0)) c1 = Eigen::Vector2d(1, 0);
+  c1.normalize();
+  Matrix basis(n, 2);
+  basis.col(0) = kernel * c1;
+  basis.col(1) = kernel * Eigen::Vector2d(-c1(1), c1(0));
+
+  std::vector<Matrix> forms;
+  if (!QuadraticForms(problem, sb.u, basis, cokernel, options.fd_step, &forms, &out.message)) {
+    out.status = BranchSwitchStatus::kEvaluationFailed;
+    return out;
+  }
+  out.a = forms[0](0, 0);
+  out.b = forms[0](0, 1);
+  out.c = forms[0](1, 1);
+  std::vector<Eigen::Vector2d> roots;
+  if (QuadraticRoots(forms[0], options.degeneracy_tolerance, &roots) != Roots::kTwo) {
+    out.status = BranchSwitchStatus::kFallback;
+    out.message = "degenerate algebraic bifurcation equation (discriminant b^2 - ac = " +
+                  std::to_string(out.b * out.b - out.a * out.c) +
+                  "): using the kernel direction orthogonal to the incoming tangent";
+    out.direction = basis.col(1);
+    out.incoming_direction = basis.col(0);
+    return out;
+  }
+  // Transverse root: smallest |α₁| (least aligned with the incoming tangent).
+  const bool first_transverse = std::abs(roots[0](0)) < std::abs(roots[1](0));
+  const Eigen::Vector2d transverse = first_transverse ? roots[0] : roots[1];
+  const Eigen::Vector2d along = first_transverse ? roots[1] : roots[0];
+  out.direction = (basis * transverse).normalized();
+  out.incoming_direction = (basis * along).normalized();
+  if (out.incoming_direction.dot(incoming) < 0) out.incoming_direction = -out.incoming_direction;
+  out.incoming_root_angle = std::acos(std::clamp(std::abs(along(0)), 0.0, 1.0));
+  out.status = BranchSwitchStatus::kOk;
+  return out;
+}
+
+std::vector<Branch> TraceSwitchedBranches(ZeroProblem* problem, const SpecialPoint& sb,
+                                          const BranchSwitch& branch_switch, const ContinuationOptions& options) {
+  std::vector<Branch> branches;
+  for (const int d : {+1, -1}) {
+    ContinuationStepper stepper(problem, options, static_cast<int>(branches.size()));
+    StepStatus status = stepper.StartAtSingularPoint(sb.u, d * branch_switch.direction);
+    while (status == StepStatus::kContinuing) status = stepper.Step();
+    Branch branch = stepper.TakeBranch();
+    branch.direction = d;
+    branch.parent_special_point = sb.id;
+    branches.push_back(std::move(branch));
+  }
+  return branches;
+}
+
+}  // namespace hybridcont

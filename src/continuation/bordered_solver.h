@@ -1,0 +1,43 @@
+// Internal: the one place where bordered systems are factorized and solved.
+//
+//        [ A  ]  N rows        A = dr(u), N x (N+1)
+//    B = [----]                                         B x = rhs,   B is (N+1) x (N+1)
+//        [ bᵀ ]  1 row         b = tangent, c of a constraint, or a reference direction
+//
+// Every Newton step, every tangent and every determinant test function of the continuation engine goes
+// through this class, so a block-bordered or sparse solver (multiple shooting with many phases, linear
+// cost in the number of phases) can replace the dense LU here without touching the algorithms.
+#ifndef HYBRIDCONT_SRC_CONTINUATION_BORDERED_SOLVER_H_
+#define HYBRIDCONT_SRC_CONTINUATION_BORDERED_SOLVER_H_
+
+#include <Eigen/LU>
+
+#include "hybridcont/types.h"
+
+namespace hybridcont::internal {
+
+class BorderedSolver {
+ public:
+  // Factorizes [A; bᵀ]. Returns false if the matrix is not finite or numerically singular (smallest pivot
+  // of the LU below kSingularPivotRatio times the largest). Storage is reused between calls of equal size.
+  bool Factorize(const Matrix& A, const Vector& b);
+  // x = B⁻¹ rhs for the last successful factorization; x is resized only when its size differs.
+  void Solve(const Vector& rhs, Vector* x) const;
+  // log|det B| and sign(det B) of the last factorization (never formed as a product: it over/underflows
+  // for hundreds of unknowns).
+  double LogAbsDeterminant() const;
+  int DeterminantSign() const;
+
+  // Pivot ratio below which B counts as singular: ~ the unit round-off times a small safety factor. Kept
+  // this small on purpose: points within ~1e-12 of a bifurcation point must still be solvable while the
+  // location of that point is refined (their Newton systems are ill-conditioned but consistent).
+  static constexpr double kSingularPivotRatio = 1e-15;
+
+ private:
+  Matrix B_;
+  Eigen::PartialPivLU<Matrix> lu_;
+};
+
+}  // namespace hybridcont::internal
+
+#endif  // HYBRIDCONT_SRC_CONTINUATION_BORDERED_SOLVER_H_

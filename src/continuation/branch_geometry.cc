@@ -1,0 +1,193 @@
+#include "continuation/branch_geometry.h"
+
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace hybridcont::internal {
+
+Vector KernelByQR(const Matrix& dr) {
+  const Eigen::Index n = dr.cols();
+  Eigen::HouseholderQR<Matrix> qr(dr.transpose());
+  Matrix q = qr.householderQ() * Matrix::Identity(n, n);
+  return q.col(n - 1).normalized();
+}
+
+double LogRowScale(const Matrix& dr) {
+  double log_rows = 0;
+  for (Eigen::Index i = 0; i < dr.rows(); ++i) {
+    const double norm = dr.row(i).norm();
+    if (norm > 0) log_rows += std::log(norm);
+  }
+  return log_rows;
+}
+
+bool InducedTangent(BorderedSolver* solver, const Matrix& dr, const Vector& reference, Vector* tangent,
+                    double* sb_own, double* sb_reference, const double* log_row_scale) {
+  const Eigen::Index n = dr.cols();
+  if (!solver->Factorize(dr, reference)) return false;
+  solver->Solve(Vector::Unit(n, n - 1), tangent);
+  const double v_norm = tangent->norm();
+  if (!(v_norm > 0) || !std::isfinite(v_norm)) return false;
+  *tangent /= v_norm;
+  // log of the Hadamard bound ∏||rows||; a zero row (possible only at singular points) counts as 1.
+  const double log_rows = log_row_scale != nullptr ? *log_row_scale : LogRowScale(dr);
+  const double log_reference = std::log(reference.norm());
+  const double log_det = solver->LogAbsDeterminant() - log_rows - log_reference;
+  const double sign = solver->DeterminantSign();
+  // det([dr; τᵀ]) = det([dr; refᵀ]) · ||v|| (Cramer: v = cofactors / det), see special_point.h.
+  if (sb_own != nullptr) *sb_own = std::copysign(std::exp(log_det + std::log(v_norm) + log_reference), sign);
+  if (sb_reference != nullptr) *sb_reference = std::copysign(std::exp(log_det), sign);
+  return true;
+}
+
+Segment::Segment(Corrector* corrector, BorderedSolver* solver, ZeroProblem* problem,
+                 const ContinuationPoint& a, const ContinuationPoint& b, bool with_sb_test)
+    : corrector_(corrector),
+      solver_(solver),
+      problem_(problem),
+      with_sb_test_(with_sb_test),
+      a_(a),
+      b_(b),
+      sigma_b_(a.tangent.dot(b.u - a.u)) {}
+
+bool Segment::Evaluate(double sigma, const Probe& left, double sigma_left, const Probe& right,
+                       double sigma_right, Probe* probe, std::string* message) {
+  const double w = sigma_right - sigma_left;
+  const double t = (sigma - sigma_left) / w;
+  const double h00 = (1 + 2 * t) * (1 - t) * (1 - t), h10 = t * (1 - t) * (1 - t);
+  const double h01 = t * t * (3 - 2 * t), h11 = t * t * (t - 1);
+  // du/dσ = τ / (τ_a·τ) along the curve.
+  const Vector predictor = h00 * left.u + h01 * right.u +
+                           (h10 * w / a_.tangent.dot(left.tangent)) * left.tangent +
+                           (h11 * w / a_.tangent.dot(right.tangent)) * right.tangent;
+  const double saved_distance = corrector_->options().max_distance;
+  corrector_->set_max_distance((b_.u - a_.u).norm() + 1e-12);
+  const CorrectorResult result = corrector_->CorrectPseudoArclength(predictor, a_.tangent, &probe->u);
+  corrector_->set_max_distance(saved_distance);
+  if (!result.converged()) {
+    *message = "trial point at sigma = " + std::to_string(sigma) + " not corrected: " + result.BriefReport();
+    return false;
+  }
+  probe->residual = result.residual_norm;
+  if (!InducedTangent(solver_, corrector_->jacobian(), a_.tangent, &probe->tangent, nullptr,
+                      &probe->sb_test, &log_row_scale_)) {
+    // Exactly on a singular point: the test function is zero there, the tangent is the incoming one.
+    probe->tangent = a_.tangent;
+    probe->sb_test = 0;
+  }
+  return true;
+}
+
+bool Segment::EndProbe(bool at_b, Probe* probe, std::string* message) {
+  const ContinuationPoint& p = at_b ? b_ : a_;
+  probe->u = p.u;
+  probe->tangent = p.tangent;
+  probe->sb_test = 0;
+  if (!with_sb_test_) return true;
+  if (const EvaluationStatus status = problem_->Evaluate(p.u, nullptr, &dr_); !status.ok) {
+    *message = "evaluation at a bracketing point failed: " + status.message;
+    return false;
+  }
+  if (!at_b) log_row_scale_ = LogRowScale(dr_);
+  Vector tangent;
+  if (!InducedTangent(solver_, dr_, a_.tangent, &tangent, nullptr, &probe->sb_test, &log_row_scale_)) {
+    *message = "bracketing point is singular";
+    return false;
+  }
+  return true;
+}
+
+RootLocation LocateRoot(Segment* segment, const std::function<double(const Segment::Probe&)>& test,
+                        double tolerance, int max_iterations) {
+  RootLocation out;
+  Segment::Probe lo_probe, hi_probe;
+  std::string message;
+  double lo = 0, hi = segment->sigma_b();
+  if (!segment->EndProbe(false, &lo_probe, &message) || !segment->EndProbe(true, &hi_probe, &message)) {
+    out.message = message;
+    out.lo = lo;
+    out.hi = hi;
+    out.estimate = segment->sigma_b() > 0 ? hi_probe : lo_probe;
+    out.u_lo = segment->a().u;
+    out.u_hi = segment->b().u;
+    return out;
+  }
+  double g_lo = test(lo_probe), g_hi = test(hi_probe);
+  // Illinois factors: the value of an end retained twice is halved.
+  double f_lo = g_lo, f_hi = g_hi;
+  int side = 0;
+  double width_at_check = hi - lo;
+  int last_side = 0;
+  // The estimate is a bracket end: with |test| smaller, or the most recent one on a tie (a test function
+  // that jumps at its root has equal |test| on both sides).
+  auto finish = [&](bool located) {
+    out.located = located;
+    out.lo = lo;
+    out.hi = hi;
+    const bool use_hi = std::abs(g_hi) < std::abs(g_lo) || (std::abs(g_hi) == std::abs(g_lo) && last_side == +1);
+    out.estimate = use_hi ? hi_probe : lo_probe;
+    out.sigma = use_hi ? hi : lo;
+    out.test = use_hi ? g_hi : g_lo;
+    out.u_lo = lo_probe.u;
+    out.u_hi = hi_probe.u;
+    return out;
+  };
+  for (int it = 1; it <= max_iterations; ++it) {
+    const double width = hi - lo;
+    if (width <= tolerance) return finish(true);
+    double x = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+    if (it % 3 == 0) {
+      if (width > 0.5 * width_at_check) x = 0.5 * (lo + hi);
+      width_at_check = width;
+    }
+    // Keep every trial point strictly inside, at least tolerance/4 from the ends, so the bracket shrinks.
+    const double margin = std::min(0.25 * tolerance, 0.25 * width);
+    if (!std::isfinite(x)) x = 0.5 * (lo + hi);
+    x = std::clamp(x, lo + margin, hi - margin);
+    // A trial point exactly on the root of the SB test is exactly singular (regula falsi hits it for a
+    // linear test function): retry half a tolerance to either side, which still brackets the root.
+    Segment::Probe probe;
+    bool corrected = false;
+    for (const double shift : {0.0, 0.5 * tolerance, -0.5 * tolerance}) {
+      const double trial = std::clamp(x + shift, lo + margin, hi - margin);
+      if (segment->Evaluate(trial, lo_probe, lo, hi_probe, hi, &probe, &message)) {
+        x = trial;
+        corrected = true;
+        break;
+      }
+    }
+    if (!corrected) {
+      out.message = message;
+      out.iterations = it;
+      return finish(false);
+    }
+    out.iterations = it;
+    const double g = test(probe);
+    if (g == 0) {
+      lo = hi = x;
+      lo_probe = hi_probe = probe;
+      return finish(true);
+    }
+    if (std::signbit(g) == std::signbit(g_lo)) {
+      lo = x;
+      g_lo = f_lo = g;
+      lo_probe = std::move(probe);
+      last_side = -1;
+      if (side == -1) f_hi *= 0.5;
+      side = -1;
+    } else {
+      hi = x;
+      g_hi = f_hi = g;
+      hi_probe = std::move(probe);
+      last_side = +1;
+      if (side == +1) f_lo *= 0.5;
+      side = +1;
+    }
+  }
+  out.message = "root finder budget of " + std::to_string(max_iterations) + " iterations spent";
+  return finish(hi - lo <= tolerance);
+}
+
+}  // namespace hybridcont::internal

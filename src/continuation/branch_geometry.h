@@ -1,0 +1,98 @@
+// Internal: tangents, the SB test function, and locating a root of a test function between two branch
+// points (special points, stops). Shared by the stepper (continuation), branch switching and exploration.
+#ifndef HYBRIDCONT_SRC_CONTINUATION_BRANCH_GEOMETRY_H_
+#define HYBRIDCONT_SRC_CONTINUATION_BRANCH_GEOMETRY_H_
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include "continuation/bordered_solver.h"
+#include "hybridcont/continuation.h"
+#include "hybridcont/corrector.h"
+#include "hybridcont/types.h"
+
+namespace hybridcont::internal {
+
+// Angle (radians) between two unit vectors, robust to rounding just outside [−1, 1].
+inline double AngleBetween(const Vector& a, const Vector& b) { return std::acos(std::clamp(a.dot(b), -1.0, 1.0)); }
+
+// Unit vector spanning the kernel of a full-rank dr (N x (N+1)): last column of Q in drᵀ = QR.
+Vector KernelByQR(const Matrix& dr);
+
+// The tangent induced by dr and oriented by `reference` (eq. tangentvector, continuous orientation):
+// v = [dr; referenceᵀ]⁻¹ e_{N+1}, τ = v / ||v||, so τ·reference > 0. Also returns the Hadamard-normalized
+// determinants with τ and with the reference as last row (special_point.h):
+//   own        = det([dr; τᵀ]) / ∏||dr rows||
+//   reference  = det([dr; referenceᵀ]) / (∏||dr rows|| ||reference||)  (= own · τ·reference/||reference||)
+// With log_row_scale != nullptr, *log_row_scale replaces log ∏||dr rows|| in both normalizations (a
+// constant scale along a segment keeps the test function smooth where a row of dr vanishes).
+// Returns false if the bordered matrix is singular.
+bool InducedTangent(BorderedSolver* solver, const Matrix& dr, const Vector& reference, Vector* tangent,
+                    double* sb_own, double* sb_reference, const double* log_row_scale = nullptr);
+
+// log ∏ᵢ ||row i of dr||, a zero row counting as 1.
+double LogRowScale(const Matrix& dr);
+
+// The branch between two consecutive points a and b, parametrized by σ = τ_aᵀ(u − u_a) ∈ [0, σ_b].
+class Segment {
+ public:
+  struct Probe {
+    Vector u;
+    Vector tangent;        // oriented by τ_a
+    // det([dr(u); τ_aᵀ]) / ∏||rows of dr(u_a)||: a constant scale, so smooth (≈ linear) in σ, also where
+    // a row of dr vanishes at the SB point (N = 1: dr itself vanishes there).
+    double sb_test = 0;
+    double residual = 0;
+  };
+  // with_sb_test: evaluate dr at a (and b) once for the scale of Probe::sb_test; otherwise sb_test is 0.
+  Segment(Corrector* corrector, BorderedSolver* solver, ZeroProblem* problem, const ContinuationPoint& a,
+          const ContinuationPoint& b, bool with_sb_test);
+  // The point of the curve at σ ∈ (σ_left, σ_right), with its tangent. Predictor: the cubic Hermite
+  // interpolant of the two bracketing probes in σ (error O(width⁴); it lies on the hyperplane
+  // τ_aᵀ(u − u_a) = σ because the cubic Hermite interpolant of a linear function is exact). Corrector:
+  // pseudo-arclength on that hyperplane. Near an SB point the Newton basin shrinks like the distance to
+  // it, which a chord predictor (error O(width²)) would miss. Returns false (and sets *message) if the
+  // trial point cannot be corrected.
+  bool Evaluate(double sigma, const Probe& left, double sigma_left, const Probe& right, double sigma_right,
+                Probe* probe, std::string* message);
+  double sigma_b() const { return sigma_b_; }
+  const ContinuationPoint& a() const { return a_; }
+  const ContinuationPoint& b() const { return b_; }
+  // Probes at the two ends, from the stored points (plus one evaluation of dr for the SB test).
+  // Returns false if that evaluation fails.
+  bool EndProbe(bool at_b, Probe* probe, std::string* message);
+
+ private:
+  Corrector* corrector_;
+  BorderedSolver* solver_;
+  ZeroProblem* problem_;
+  bool with_sb_test_;
+  double log_row_scale_ = 0;
+  Matrix dr_;
+  const ContinuationPoint& a_;
+  const ContinuationPoint& b_;
+  double sigma_b_;
+};
+
+struct RootLocation {
+  bool located = false;       // bracket narrower than the tolerance (or exact zero)
+  double lo = 0, hi = 0;      // final bracket in σ
+  double sigma = 0;           // σ of the estimate
+  Segment::Probe estimate;    // the trial point with the smallest |test|
+  Vector u_lo, u_hi;          // curve points at the bracket ends
+  double test = 0;
+  int iterations = 0;
+  std::string message;        // why only bracketed
+};
+
+// Safeguarded Illinois iteration for test(σ) = 0 on [0, σ_b], given test values of opposite sign at the
+// ends. Illinois (regula falsi with halving of a retained end value) converges superlinearly from both
+// sides; a bisection every third iteration without halving of the bracket guards against stagnation.
+RootLocation LocateRoot(Segment* segment, const std::function<double(const Segment::Probe&)>& test,
+                        double tolerance, int max_iterations);
+
+}  // namespace hybridcont::internal
+
+#endif  // HYBRIDCONT_SRC_CONTINUATION_BRANCH_GEOMETRY_H_

@@ -1,0 +1,197 @@
+#include "hybridcont/corrector.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "continuation/bordered_solver.h"
+
+namespace hybridcont {
+
+std::string ToString(CorrectorStatus status) {
+  switch (status) {
+    case CorrectorStatus::kConverged: return "converged";
+    case CorrectorStatus::kMaxIterations: return "max-iterations";
+    case CorrectorStatus::kDiverged: return "diverged";
+    case CorrectorStatus::kSingular: return "singular";
+    case CorrectorStatus::kEvaluationFailed: return "evaluation-failed";
+  }
+  return "unknown";
+}
+
+std::string ToString(CorrectorType type) {
+  return type == CorrectorType::kMoorePenrose ? "moore-penrose" : "pseudo-arclength";
+}
+
+bool StringToCorrectorType(const std::string& text, CorrectorType* type) {
+  if (text == "pseudo-arclength") {
+    *type = CorrectorType::kPseudoArclength;
+  } else if (text == "moore-penrose") {
+    *type = CorrectorType::kMoorePenrose;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+std::string CorrectorOptions::Validate() const {
+  std::ostringstream out;
+  if (max_iterations < 1) {
+    out << "CorrectorOptions::max_iterations = " << max_iterations << " must be >= 1";
+  } else if (!(residual_tolerance > 0)) {
+    out << "CorrectorOptions::residual_tolerance = " << residual_tolerance << " must be > 0";
+  } else if (!(step_tolerance > 0)) {
+    out << "CorrectorOptions::step_tolerance = " << step_tolerance << " must be > 0";
+  } else if (!(max_contraction > 0)) {
+    out << "CorrectorOptions::max_contraction = " << max_contraction << " must be > 0";
+  } else if (!(max_distance > 0)) {
+    out << "CorrectorOptions::max_distance = " << max_distance << " must be > 0";
+  }
+  return out.str();
+}
+
+std::string CorrectorResult::BriefReport() const {
+  std::ostringstream out;
+  out << "Corrector: " << ToString(status) << ", " << iterations << " iterations, |F| = " << residual_norm
+      << ", |du| = " << step_norm << ", kappa = " << contraction;
+  if (!message.empty()) out << " (" << message << ")";
+  return out.str();
+}
+
+// Scratch space sized once per problem (STYLE.md practice 6): the Newton loop allocates nothing after the
+// first call.
+struct Corrector::Workspace {
+  Vector r, F, delta, kernel, unit_last, border;
+  Matrix dr;
+  internal::BorderedSolver solver;
+};
+
+Corrector::Corrector(ZeroProblem* problem, const CorrectorOptions& options)
+    : problem_(problem), options_(options), workspace_(std::make_unique<Workspace>()) {
+  if (problem_ == nullptr) throw std::invalid_argument("Corrector: problem is null");
+  const std::string error = options_.Validate();
+  if (!error.empty()) throw std::invalid_argument(error);
+  const int n = problem_->num_unknowns();
+  workspace_->F.resize(n);
+  workspace_->delta.resize(n);
+  workspace_->kernel.resize(n);
+  workspace_->unit_last = Vector::Unit(n, n - 1);
+}
+
+Corrector::~Corrector() = default;
+Corrector::Corrector(Corrector&&) noexcept = default;
+Corrector& Corrector::operator=(Corrector&&) noexcept = default;
+
+const Vector& Corrector::residual() const { return workspace_->r; }
+const Matrix& Corrector::jacobian() const { return workspace_->dr; }
+
+CorrectorResult Corrector::CorrectPseudoArclength(const Vector& u_pred, const Vector& tau, Vector* u) {
+  return Run(Border::kArclength, u_pred, tau, 0.0, u);
+}
+CorrectorResult Corrector::CorrectMoorePenrose(const Vector& u_pred, const Vector& tau, Vector* u) {
+  return Run(Border::kMoorePenrose, u_pred, tau, 0.0, u);
+}
+CorrectorResult Corrector::CorrectWithConstraint(const Vector& u_pred, const Vector& c, double value,
+                                                 Vector* u) {
+  return Run(Border::kConstraint, u_pred, c, value, u);
+}
+CorrectorResult Corrector::CorrectFixedComponent(const Vector& u_pred, int index, double target, Vector* u) {
+  if (index < 0 || index >= problem_->num_unknowns()) {
+    throw std::invalid_argument("Corrector::CorrectFixedComponent: index " + std::to_string(index) +
+                                " outside [0, " + std::to_string(problem_->num_unknowns()) + ")");
+  }
+  return Run(Border::kConstraint, u_pred, Vector::Unit(problem_->num_unknowns(), index), target, u);
+}
+CorrectorResult Corrector::Correct(CorrectorType type, const Vector& u_pred, const Vector& tau, Vector* u) {
+  return type == CorrectorType::kMoorePenrose ? CorrectMoorePenrose(u_pred, tau, u)
+                                              : CorrectPseudoArclength(u_pred, tau, u);
+}
+
+CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector& b, double value,
+                               Vector* u_out) {
+  const int n = problem_->num_unknowns();
+  if (u_pred.size() != n || b.size() != n) {
+    throw std::invalid_argument("Corrector: u_pred has size " + std::to_string(u_pred.size()) +
+                                " and the border vector " + std::to_string(b.size()) + ", expected " +
+                                std::to_string(n) + " (= num_unknowns())");
+  }
+  Workspace& w = *workspace_;
+  Vector& u = *u_out;
+  u = u_pred;
+  w.border = b;
+  if (border != Border::kConstraint) w.border.normalize();
+
+  CorrectorResult result;
+  double last_step = 0, previous_step = 0;
+  for (int k = 0;; ++k) {
+    const EvaluationStatus evaluation = problem_->Evaluate(u, &w.r, &w.dr);
+    ++result.evaluations;
+    if (!evaluation.ok) {
+      result.status = CorrectorStatus::kEvaluationFailed;
+      result.message = evaluation.message;
+      return result;
+    }
+    w.F.head(n - 1) = w.r;
+    switch (border) {
+      case Border::kArclength: w.F(n - 1) = w.border.dot(u - u_pred); break;
+      case Border::kConstraint: w.F(n - 1) = w.border.dot(u) - value; break;
+      case Border::kMoorePenrose: w.F(n - 1) = 0; break;
+    }
+    result.residual_norm = w.F.norm();
+    result.distance = (u - u_pred).norm();
+    if (!std::isfinite(result.residual_norm) || !w.dr.allFinite()) {
+      result.status = CorrectorStatus::kDiverged;
+      result.message = "non-finite residual or Jacobian";
+      return result;
+    }
+    if (k > 0 && result.residual_norm <= options_.residual_tolerance) {
+      const bool small_step = last_step <= options_.step_tolerance * (1.0 + u.norm());
+      // At the rounding floor the steps stop contracting; the residual test decides there.
+      const bool at_floor = k >= 2 && last_step >= 0.5 * previous_step;
+      if (small_step || at_floor) {
+        result.status = CorrectorStatus::kConverged;
+        return result;
+      }
+    }
+    if (k >= 2 && last_step > options_.max_contraction * previous_step) {
+      result.status = CorrectorStatus::kDiverged;
+      result.message = "Newton steps grow: |du| " + std::to_string(previous_step) + " -> " +
+                       std::to_string(last_step);
+      return result;
+    }
+    if (k == options_.max_iterations) {
+      result.status = CorrectorStatus::kMaxIterations;
+      result.message = "|F| = " + std::to_string(result.residual_norm) + " after " + std::to_string(k) +
+                       " iterations";
+      return result;
+    }
+    if (!w.solver.Factorize(w.dr, w.border)) {
+      result.status = CorrectorStatus::kSingular;
+      result.message = "bordered matrix [dr; b^T] singular at iteration " + std::to_string(k);
+      return result;
+    }
+    w.F = -w.F;
+    w.solver.Solve(w.F, &w.delta);
+    if (border == Border::kMoorePenrose) {
+      // Kernel update (Allgower–Georg): the new border is the tangent induced by dr(u_k), oriented like
+      // the old one (its last equation is τ_kᵀ v = 1 > 0).
+      w.solver.Solve(w.unit_last, &w.kernel);
+      w.border = w.kernel / w.kernel.norm();
+    }
+    previous_step = last_step;
+    last_step = w.delta.norm();
+    result.step_norm = last_step;
+    if (k == 1) result.contraction = previous_step > 0 ? last_step / previous_step : 0.0;
+    u += w.delta;
+    result.iterations = k + 1;
+    if ((u - u_pred).norm() > options_.max_distance) {
+      result.status = CorrectorStatus::kDiverged;
+      result.message = "iterate left the ball of radius max_distance = " +
+                       std::to_string(options_.max_distance) + " around the predictor";
+      return result;
+    }
+  }
+}
+
+}  // namespace hybridcont

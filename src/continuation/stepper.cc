@@ -1,0 +1,437 @@
+// ContinuationStepper: predictor, corrector, step control, stops, special points (continuation.h).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "continuation/bordered_solver.h"
+#include "continuation/branch_geometry.h"
+#include "hybridcont/continuation.h"
+
+namespace hybridcont {
+namespace {
+
+// A stop that is a level set of a linear functional cᵀu (targets, bounds, sum bounds).
+struct LinearStop {
+  enum class Kind { kTarget, kLower, kUpper };
+  Vector c;
+  double value = 0;
+  Kind kind = Kind::kTarget;
+  std::string label;
+
+  double f(const Vector& u) const { return c.dot(u) - value; }
+  bool Crossed(double f_a, double f_b) const {
+    switch (kind) {
+      case Kind::kTarget: return f_a != 0 && (f_b == 0 || std::signbit(f_a) != std::signbit(f_b));
+      case Kind::kLower: return f_a >= 0 && f_b < 0;
+      case Kind::kUpper: return f_a <= 0 && f_b > 0;
+    }
+    return false;
+  }
+  bool Violated(double f_u) const {
+    return (kind == Kind::kLower && f_u < 0) || (kind == Kind::kUpper && f_u > 0);
+  }
+  TerminationReason reason() const {
+    return kind == Kind::kTarget ? TerminationReason::kTargetReached : TerminationReason::kBoundReached;
+  }
+};
+
+}  // namespace
+
+class ContinuationStepper::Impl {
+ public:
+  Impl(ZeroProblem* problem, const ContinuationOptions& options, int branch_id)
+      : problem_(problem), options_(options), corrector_(problem, options.corrector), h_(options.initial_step) {
+    names_ = problem_->unknown_names();
+    const std::string error = options_.ValidateFor(names_);
+    if (!error.empty()) throw std::invalid_argument(error);
+    branch_.id = branch_id;
+    branch_.direction = options_.direction;
+    const int n = problem_->num_unknowns();
+    std::vector<std::string> turning = options_.turning_point_components;
+    if (turning.empty() && problem_->UnknownIndex("H") >= 0) turning.push_back("H");
+    for (const std::string& name : turning) turning_.push_back(problem_->UnknownIndex(name));
+    for (const std::string& name : options_.progress_components) progress_.push_back(problem_->UnknownIndex(name));
+    for (const ComponentTarget& target : options_.targets) {
+      stops_.push_back({Vector::Unit(n, problem_->UnknownIndex(target.component)), target.value,
+                        LinearStop::Kind::kTarget, target.component + " = " + std::to_string(target.value)});
+    }
+    auto add_bounds = [this](const Vector& c, double lower, double upper, const std::string& label) {
+      if (std::isfinite(lower)) stops_.push_back({c, lower, LinearStop::Kind::kLower, label + " >= " + std::to_string(lower)});
+      if (std::isfinite(upper)) stops_.push_back({c, upper, LinearStop::Kind::kUpper, label + " <= " + std::to_string(upper)});
+    };
+    for (const ComponentBound& bound : options_.bounds) {
+      add_bounds(Vector::Unit(n, problem_->UnknownIndex(bound.component)), bound.lower, bound.upper, bound.component);
+    }
+    for (const SumBound& bound : options_.sum_bounds) {
+      Vector c = Vector::Zero(n);
+      std::string label;
+      for (const std::string& name : bound.components) {
+        c(problem_->UnknownIndex(name)) += 1.0;
+        label += (label.empty() ? "" : "+") + name;
+      }
+      add_bounds(c, bound.lower, bound.upper, label);
+    }
+  }
+
+  StepStatus Start(const Vector& u0, const Vector* hint) {
+    CheckSize(u0, "start point");
+    if (hint != nullptr) CheckSize(*hint, "direction hint");
+    Vector u = u0;
+    Matrix dr;
+    if (options_.correct_start_point) {
+      if (const EvaluationStatus status = problem_->Evaluate(u0, nullptr, &dr); !status.ok) {
+        return Finish(TerminationReason::kStartFailed, "evaluation at the start point failed: " + status.message);
+      }
+      const CorrectorResult result = corrector_.CorrectMoorePenrose(u0, internal::KernelByQR(dr), &u);
+      branch_.newton_iterations += result.iterations;
+      if (!result.converged()) {
+        return Finish(TerminationReason::kStartFailed, "start point not corrected: " + result.BriefReport());
+      }
+      dr = corrector_.jacobian();
+    } else if (const EvaluationStatus status = problem_->Evaluate(u0, nullptr, &dr); !status.ok) {
+      return Finish(TerminationReason::kStartFailed, "evaluation at the start point failed: " + status.message);
+    }
+    ContinuationPoint start;
+    start.u = u;
+    const Vector reference = hint != nullptr ? *hint : internal::KernelByQR(dr);
+    if (!internal::InducedTangent(&solver_, dr, reference, &start.tangent, &start.sb_test, nullptr)) {
+      return Finish(TerminationReason::kStartFailed,
+                    "dr is singular at the start point (kernel dimension >= 2): use BranchDirectionsAt and "
+                    "StartAtSingularPoint");
+    }
+    if (hint == nullptr) {
+      // Paper's convention det([dr; τᵀ]) > 0, then the direction d of eq. IVP.
+      const double sign = (std::signbit(start.sb_test) ? -1.0 : 1.0) * options_.direction;
+      start.tangent *= sign;
+      start.sb_test *= sign;
+    }
+    return Begin(std::move(start), false);
+  }
+
+  StepStatus StartAtSingularPoint(const Vector& u0, const Vector& tangent) {
+    CheckSize(u0, "start point");
+    CheckSize(tangent, "tangent");
+    if (!(tangent.norm() > 0)) throw std::invalid_argument("StartAtSingularPoint: tangent is zero");
+    ContinuationPoint start;
+    start.u = u0;
+    start.tangent = tangent.normalized();
+    start.sb_test = 0;
+    return Begin(std::move(start), true);
+  }
+
+  StepStatus Step() {
+    if (finished()) return StepStatus::kFinished;
+    const ContinuationPoint& a = branch_.points.back();
+    Vector direction = a.tangent;
+    if (options_.predictor == PredictorType::kSecant && branch_.points.size() >= 2) {
+      const Vector chord = a.u - branch_.points[branch_.points.size() - 2].u;
+      if (chord.norm() > 0) direction = chord.normalized();
+    }
+    ContinuationPoint b;
+    double next_h = h_;
+    double sb_reference = 0;
+    std::string last_failure;
+    for (;;) {
+      if (h_ < options_.min_step * (1 - 1e-12)) {
+        return Finish(TerminationReason::kStepTooSmall,
+                      "step fell below min_step = " + std::to_string(options_.min_step) + "; last failure: " +
+                          last_failure);
+      }
+      const Vector predictor = a.u + h_ * direction;
+      corrector_.set_max_distance(options_.max_corrector_distance * h_);
+      const CorrectorResult result = corrector_.Correct(options_.corrector_type, predictor, direction, &b.u);
+      branch_.newton_iterations += result.iterations;
+      if (!result.converged()) {
+        last_failure = "h = " + std::to_string(h_) + ": " + result.BriefReport();
+        Reject(0.5);
+        continue;
+      }
+      if (!internal::InducedTangent(&solver_, corrector_.jacobian(), a.tangent, &b.tangent, &b.sb_test,
+                                    &sb_reference)) {
+        last_failure = "h = " + std::to_string(h_) + ": corrected point is singular";
+        Reject(0.5);
+        continue;
+      }
+      // Allgower–Georg deceleration factor (continuation.h).
+      const double f = std::max({std::sqrt(result.contraction / options_.nominal_contraction),
+                                 std::sqrt(result.distance / options_.nominal_distance),
+                                 internal::AngleBetween(a.tangent, b.tangent) / options_.nominal_angle});
+      const bool at_min_step = h_ <= options_.min_step * (1 + 1e-12);
+      if (f > 2 && !at_min_step) {
+        last_failure = "h = " + std::to_string(h_) + ": step control rejected (f = " + std::to_string(f) + ")";
+        Reject(std::max(0.5 / (f / 2), 0.25));  // h / f, but never below h / 4
+        continue;
+      }
+      next_h = std::clamp(h_ / std::max(f, 0.5), options_.min_step, options_.max_step);
+      b.step = h_;
+      b.newton_iterations = result.iterations;
+      b.contraction = result.contraction;
+      break;
+    }
+    b.arclength = a.arclength + (b.u - a.u).norm();
+
+    TerminationReason reason = TerminationReason::kNotFinished;
+    std::string message;
+    if (!stops_.empty() && !ApplyStops(a, &b, &reason, &message)) return StepStatus::kFinished;
+    if (reason == TerminationReason::kNotFinished && options_.detect_closed_loop && ClosesLoop(a, b)) {
+      const double arclength = a.arclength + (branch_.points.front().u - a.u).norm();
+      b = branch_.points.front();
+      b.arclength = arclength;
+      b.step = h_;
+      reason = TerminationReason::kClosedLoop;
+      message = "the branch returned to its start point";
+    }
+    branch_.points.push_back(std::move(b));
+    const size_t count = branch_.points.size();
+    const bool from_singular = (count == 2 && start_singular_) ||
+                               (reason == TerminationReason::kClosedLoop && start_singular_);
+    if (!from_singular) DetectSpecialPoints(count - 2);
+    h_ = next_h;
+    const ContinuationPoint& added = branch_.points.back();
+    if (reason == TerminationReason::kNotFinished) {
+      if (options_.stop_predicate && options_.stop_predicate(added.u)) {
+        reason = TerminationReason::kUserStop;
+        message = "stop_predicate returned true";
+      } else if (static_cast<int>(count) >= options_.max_points) {
+        reason = TerminationReason::kMaxPoints;
+        message = "max_points = " + std::to_string(options_.max_points) + " reached";
+      }
+    }
+    Report();
+    if (reason != TerminationReason::kNotFinished) return Finish(reason, message);
+    return StepStatus::kContinuing;
+  }
+
+  void Terminate(TerminationReason reason, const std::string& message) { Finish(reason, message); }
+  bool finished() const { return branch_.termination != TerminationReason::kNotFinished; }
+  double step_size() const { return h_; }
+  const Branch& branch() const { return branch_; }
+  Branch TakeBranch() {
+    if (!finished()) Finish(TerminationReason::kUserStop, "branch taken from the stepper before it finished");
+    return std::move(branch_);
+  }
+
+ private:
+  void CheckSize(const Vector& v, const char* what) const {
+    if (v.size() != problem_->num_unknowns()) {
+      throw std::invalid_argument(std::string("ContinuationStepper: ") + what + " has size " +
+                                  std::to_string(v.size()) + ", expected num_unknowns() = " +
+                                  std::to_string(problem_->num_unknowns()));
+    }
+  }
+
+  StepStatus Begin(ContinuationPoint start, bool singular) {
+    if (!branch_.points.empty()) throw std::invalid_argument("ContinuationStepper: already started");
+    start_singular_ = singular;
+    branch_.points.push_back(std::move(start));
+    Report();
+    for (const LinearStop& stop : stops_) {
+      if (stop.Violated(stop.f(branch_.points.front().u))) {
+        return Finish(TerminationReason::kBoundReached, "start point violates " + stop.label);
+      }
+    }
+    if (options_.max_points <= 1) return Finish(TerminationReason::kMaxPoints, "max_points = 1");
+    return StepStatus::kContinuing;
+  }
+
+  StepStatus Finish(TerminationReason reason, const std::string& message) {
+    if (!finished()) {
+      branch_.termination = reason;
+      branch_.message = message;
+    }
+    return StepStatus::kFinished;
+  }
+
+  // Shrinks h; the last try before giving up is made with exactly min_step.
+  void Reject(double factor) {
+    ++branch_.rejected_steps;
+    const bool at_min_step = h_ <= options_.min_step * (1 + 1e-12);
+    h_ = at_min_step ? h_ * factor : std::max(h_ * factor, options_.min_step);
+  }
+
+  // The earliest linear stop crossed in (a, b]: b is replaced by the point exactly on it. Returns false if
+  // the branch ends at a (stop crossed right at the start point).
+  bool ApplyStops(const ContinuationPoint& a, ContinuationPoint* b, TerminationReason* reason,
+                  std::string* message) {
+    const LinearStop* first = nullptr;
+    double first_theta = 2;
+    for (const LinearStop& stop : stops_) {
+      const double f_a = stop.f(a.u), f_b = stop.f(b->u);
+      if (!stop.Crossed(f_a, f_b)) continue;
+      const double theta = f_a / (f_a - f_b);
+      if (theta < first_theta) {
+        first_theta = theta;
+        first = &stop;
+      }
+    }
+    if (first == nullptr) return true;
+    if (first->f(a.u) == 0) {
+      Finish(first->reason(), "the branch leaves " + first->label + " at its start point");
+      return false;
+    }
+    ContinuationPoint event;
+    const Vector predictor = a.u + first_theta * (b->u - a.u);
+    corrector_.set_max_distance((b->u - a.u).norm() + options_.min_step);
+    const CorrectorResult result = corrector_.CorrectWithConstraint(predictor, first->c, first->value, &event.u);
+    branch_.newton_iterations += result.iterations;
+    bool ok = result.converged() &&
+              InsideSegment(a, *b, event.u) &&
+              internal::InducedTangent(&solver_, corrector_.jacobian(), a.tangent, &event.tangent,
+                                       &event.sb_test, nullptr);
+    if (!ok) {
+      // Fallback: root of cᵀu − value along the branch by the special-point root finder.
+      internal::Segment segment(&corrector_, &solver_, problem_, a, *b, false);
+      const internal::RootLocation root = internal::LocateRoot(
+          &segment, [first](const internal::Segment::Probe& p) { return first->f(p.u); },
+          options_.location_tolerance, options_.max_location_iterations);
+      event.u = root.estimate.u;
+      event.tangent = root.estimate.tangent;
+      // The probe's test uses τ_a as last row: det([dr; τᵀ]) = det([dr; τ_aᵀ]) / (τ·τ_a).
+      event.sb_test = root.estimate.sb_test / a.tangent.dot(event.tangent);
+      if (!root.located) message->append(" (stop only bracketed: " + root.message + ")");
+    }
+    event.step = b->step;
+    event.newton_iterations = b->newton_iterations + result.iterations;
+    event.contraction = b->contraction;
+    event.arclength = a.arclength + (event.u - a.u).norm();
+    *b = std::move(event);
+    *reason = first->reason();
+    message->insert(0, "reached " + first->label);
+    return true;
+  }
+
+  // u lies between a and b along τ_a (up to 1% of the step): the constraint corrector did not run off.
+  static bool InsideSegment(const ContinuationPoint& a, const ContinuationPoint& b, const Vector& u) {
+    const double sigma_b = a.tangent.dot(b.u - a.u);
+    const double sigma = a.tangent.dot(u - a.u);
+    return sigma >= -0.01 * sigma_b && sigma <= 1.01 * sigma_b;
+  }
+
+  // The start point lies on the chord a–b (within the chord sag of the arc) and the tangents agree.
+  bool ClosesLoop(const ContinuationPoint& a, const ContinuationPoint& b) const {
+    if (branch_.points.size() < 3) return false;
+    const ContinuationPoint& start = branch_.points.front();
+    const Vector chord = b.u - a.u;
+    const double length = chord.norm();
+    if (!(length > 0) || a.arclength < 2 * length) return false;
+    const double t = chord.dot(start.u - a.u) / (length * length);
+    if (t < 0 || t > 1) return false;
+    const double distance = (a.u + t * chord - start.u).norm();
+    const double sag = length * (internal::AngleBetween(a.tangent, b.tangent) / 4 + 1e-3) + 1e-9 * (1 + start.u.norm());
+    return distance <= sag && start.tangent.dot(chord) > 0.9 * length;
+  }
+
+  // Sign changes of the SB test and of τ_k between points [index] and [index + 1], each located.
+  void DetectSpecialPoints(size_t index) {
+    const ContinuationPoint& a = branch_.points[index];
+    const ContinuationPoint& b = branch_.points[index + 1];
+    std::vector<SpecialPoint> found;
+    auto locate = [&](SpecialPointType type, int k, const std::function<double(const internal::Segment::Probe&)>& test) {
+      internal::Segment segment(&corrector_, &solver_, problem_, a, b, type == SpecialPointType::kSimpleBifurcation);
+      const internal::RootLocation root =
+          internal::LocateRoot(&segment, test, options_.location_tolerance, options_.max_location_iterations);
+      SpecialPoint point;
+      point.type = type;
+      point.status = root.located ? LocationStatus::kLocated : LocationStatus::kBracketed;
+      point.branch_id = branch_.id;
+      point.index = static_cast<int>(index);
+      point.arclength = a.arclength + root.sigma;
+      point.component_index = k;
+      if (k >= 0) point.component = names_[k];
+      point.u = root.estimate.u;
+      point.tangent = root.estimate.tangent;
+      point.tangent_before = a.tangent;
+      point.tangent_after = b.tangent;
+      point.test_value = root.test;
+      point.interval_lo = a.arclength + root.lo;
+      point.interval_hi = a.arclength + root.hi;
+      point.interval_width = (root.u_hi - root.u_lo).cwiseAbs();
+      point.residual_norm = root.estimate.residual;
+      point.iterations = root.iterations;
+      point.message = root.message;
+      branch_.located_iterations += root.iterations;
+      found.push_back(std::move(point));
+    };
+    if (options_.detect_bifurcations && a.sb_test != 0 && b.sb_test != 0 &&
+        std::signbit(a.sb_test) != std::signbit(b.sb_test)) {
+      locate(SpecialPointType::kSimpleBifurcation, -1, [](const internal::Segment::Probe& p) { return p.sb_test; });
+    }
+    for (const int k : turning_) {
+      if (a.tangent(k) * b.tangent(k) < 0) {
+        locate(SpecialPointType::kTurningPoint, k, [k](const internal::Segment::Probe& p) { return p.tangent(k); });
+      }
+    }
+    std::sort(found.begin(), found.end(),
+              [](const SpecialPoint& x, const SpecialPoint& y) { return x.arclength < y.arclength; });
+    for (SpecialPoint& point : found) {
+      point.id = static_cast<int>(branch_.special_points.size());
+      branch_.special_points.push_back(std::move(point));
+    }
+  }
+
+  void Report() const {
+    if (!options_.progress) return;
+    const ContinuationPoint& point = branch_.points.back();
+    ProgressInfo info;
+    info.branch_id = branch_.id;
+    info.point_index = static_cast<int>(branch_.points.size()) - 1;
+    if (progress_.empty()) {
+      info.values.assign(point.u.data(), point.u.data() + point.u.size());
+    } else {
+      for (const int k : progress_) info.values.push_back(point.u(k));
+    }
+    info.step = point.step;
+    info.next_step = h_;
+    info.newton_iterations = point.newton_iterations;
+    info.rejected_steps = branch_.rejected_steps;
+    options_.progress(info);
+  }
+
+  ZeroProblem* problem_;
+  ContinuationOptions options_;
+  Corrector corrector_;
+  internal::BorderedSolver solver_;
+  std::vector<std::string> names_;
+  std::vector<int> turning_;
+  std::vector<int> progress_;
+  std::vector<LinearStop> stops_;
+  Branch branch_;
+  double h_;
+  bool start_singular_ = false;
+};
+
+ContinuationStepper::ContinuationStepper(ZeroProblem* problem, const ContinuationOptions& options, int branch_id) {
+  if (problem == nullptr) throw std::invalid_argument("ContinuationStepper: problem is null");
+  impl_ = std::make_unique<Impl>(problem, options, branch_id);
+}
+ContinuationStepper::~ContinuationStepper() = default;
+ContinuationStepper::ContinuationStepper(ContinuationStepper&&) noexcept = default;
+ContinuationStepper& ContinuationStepper::operator=(ContinuationStepper&&) noexcept = default;
+
+StepStatus ContinuationStepper::Start(const Vector& u0) { return impl_->Start(u0, nullptr); }
+StepStatus ContinuationStepper::Start(const Vector& u0, const Vector& direction_hint) {
+  return impl_->Start(u0, &direction_hint);
+}
+StepStatus ContinuationStepper::StartAtSingularPoint(const Vector& u0, const Vector& tangent) {
+  return impl_->StartAtSingularPoint(u0, tangent);
+}
+StepStatus ContinuationStepper::Step() { return impl_->Step(); }
+void ContinuationStepper::Terminate(TerminationReason reason, const std::string& message) {
+  impl_->Terminate(reason, message);
+}
+bool ContinuationStepper::finished() const { return impl_->finished(); }
+double ContinuationStepper::step_size() const { return impl_->step_size(); }
+const Branch& ContinuationStepper::branch() const { return impl_->branch(); }
+Branch ContinuationStepper::TakeBranch() { return impl_->TakeBranch(); }
+
+Branch TraceBranch(ZeroProblem* problem, const Vector& u0, const ContinuationOptions& options) {
+  ContinuationStepper stepper(problem, options);
+  for (StepStatus status = stepper.Start(u0); status == StepStatus::kContinuing; status = stepper.Step()) {
+  }
+  return stepper.TakeBranch();
+}
+
+}  // namespace hybridcont

@@ -1,0 +1,278 @@
+// Corrector, stepper, stops and located special points on algebraic curves with exact answers.
+#include <cmath>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "continuation_test_problems.h"
+#include "hybridcont/continuation.h"
+#include "hybridcont/corrector.h"
+
+namespace hybridcont {
+namespace {
+
+using testing::Circle;
+using testing::FailsAbove;
+using testing::ParabolaAndLine;
+using testing::Pitchfork;
+using testing::Transcritical;
+
+const double kGoldenRatioConjugate = (std::sqrt(5.0) - 1.0) / 2.0;  // SB of ParabolaAndLine: x = λ
+
+TEST(CorrectorTest, PseudoArclengthStaysOnTheHyperplane) {
+  Circle circle;
+  Corrector corrector(&circle);
+  Vector u;
+  const CorrectorResult result = corrector.CorrectPseudoArclength(Eigen::Vector2d(1.1, 0.2), Eigen::Vector2d(0, 1), &u);
+  ASSERT_EQ(result.status, CorrectorStatus::kConverged) << result.BriefReport();
+  EXPECT_NEAR(u(1), 0.2, 1e-15);                      // τᵀ(u − u_pred) = 0 with τ = e_y
+  EXPECT_NEAR(u(0), std::sqrt(1 - 0.04), 1e-14);
+  EXPECT_GT(result.contraction, 0);
+  EXPECT_LT(result.contraction, 0.1);                 // quadratic convergence from a close predictor
+}
+
+TEST(CorrectorTest, MoorePenroseFindsTheNearestPoint) {
+  Circle circle;
+  Corrector corrector(&circle);
+  Vector u;
+  const Eigen::Vector2d predictor(1.2, 0.9);
+  const CorrectorResult result = corrector.CorrectMoorePenrose(predictor, Eigen::Vector2d(-0.6, 0.8), &u);
+  ASSERT_TRUE(result.converged()) << result.BriefReport();
+  const Vector nearest = predictor.normalized();      // argmin over the circle (eq. corrector)
+  // Newton-like Moore–Penrose iterates converge to a point within O(||u_pred − S||²) of the nearest one.
+  EXPECT_NEAR(u.norm(), 1.0, 1e-14);
+  EXPECT_LT((u - nearest).norm(), 0.02);
+}
+
+TEST(CorrectorTest, FixedComponentAndStatuses) {
+  Circle circle;
+  Corrector corrector(&circle);
+  Vector u;
+  CorrectorResult result = corrector.CorrectFixedComponent(Eigen::Vector2d(0.5, 0.9), 0, 0.6, &u);
+  ASSERT_TRUE(result.converged());
+  EXPECT_EQ(u(0), 0.6);
+  EXPECT_NEAR(u(1), 0.8, 1e-15);
+  // x = 2 does not meet the circle: Newton cannot converge; a status, never an exception.
+  result = corrector.CorrectFixedComponent(Eigen::Vector2d(2, 0.5), 0, 2.0, &u);
+  EXPECT_FALSE(result.converged());
+  // The bordered matrix at the origin (dr = 0) is singular.
+  result = corrector.CorrectPseudoArclength(Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), &u);
+  EXPECT_EQ(result.status, CorrectorStatus::kSingular);
+  FailsAbove failing(&circle, 0, 0.0);
+  Corrector failing_corrector(&failing);
+  result = failing_corrector.CorrectPseudoArclength(Eigen::Vector2d(1, 0), Eigen::Vector2d(0, 1), &u);
+  EXPECT_EQ(result.status, CorrectorStatus::kEvaluationFailed);
+  EXPECT_EQ(result.message, "component above its limit");
+  EXPECT_THROW(corrector.CorrectPseudoArclength(Vector::Zero(3), Vector::Zero(3), &u), std::invalid_argument);
+}
+
+TEST(ContinuationOptionsTest, ValidateNamesFieldValueAndConstraint) {
+  ContinuationOptions options;
+  EXPECT_EQ(options.Validate(), "");
+  options.min_step = 1.0;
+  EXPECT_EQ(options.Validate(), "ContinuationOptions::min_step = 1 must be <= max_step = 0.25");
+  options = ContinuationOptions();
+  options.direction = 0;
+  EXPECT_EQ(options.Validate(), "ContinuationOptions::direction = 0 must be +1 or -1");
+  options = ContinuationOptions();
+  options.targets = {{"H", 2.0}};
+  EXPECT_EQ(options.ValidateFor({"x", "y"}), "ContinuationOptions::targets: \"H\" is not an unknown of the problem");
+  Circle circle;
+  EXPECT_THROW(ContinuationStepper(&circle, options), std::invalid_argument);
+}
+
+TEST(ContinuationTest, CircleTurningPointsAndClosedLoop) {
+  Circle circle;
+  ContinuationOptions options;
+  options.turning_point_components = {"y"};
+  const Branch branch = TraceBranch(&circle, Eigen::Vector2d(1, 0), options);
+  ASSERT_EQ(branch.termination, TerminationReason::kClosedLoop) << branch.FullReport();
+  EXPECT_EQ(branch.points.back().u, branch.points.front().u);  // closes exactly
+  EXPECT_NEAR(branch.points.back().arclength, 2 * M_PI, 0.01);  // chords of one turn, not two
+  ASSERT_EQ(branch.special_points.size(), 2u);
+  // det([dr; τᵀ]) > 0 at (1, 0) with dr = (2, 0): τ = (0, 1), counter-clockwise: (0, 1) first.
+  const double expected_y[] = {1.0, -1.0};
+  for (int i = 0; i < 2; ++i) {
+    const SpecialPoint& point = branch.special_points[i];
+    EXPECT_EQ(point.type, SpecialPointType::kTurningPoint);
+    EXPECT_EQ(point.status, LocationStatus::kLocated);
+    EXPECT_EQ(point.component, "y");
+    EXPECT_NEAR(point.u(0), 0.0, 1e-11);
+    EXPECT_NEAR(point.u(1), expected_y[i], 1e-15);  // an extremum: error quadratic in the bracket
+    EXPECT_LE(point.precision(), options.location_tolerance);
+    EXPECT_LE(point.interval_width(0), 1e-11);
+  }
+  EXPECT_GT(branch.special_points[1].arclength, branch.special_points[0].arclength);
+}
+
+TEST(ContinuationTest, PitchforkSimpleBifurcationLocated) {
+  Pitchfork pitchfork;
+  ContinuationOptions options;
+  options.bounds = {{"lambda", -2, 1}};
+  const Branch branch = TraceBranch(&pitchfork, Eigen::Vector2d(0, -1), options);
+  EXPECT_EQ(branch.termination, TerminationReason::kBoundReached);
+  EXPECT_EQ(branch.points.back().u(1), 1.0);  // stopped exactly on the bound
+  ASSERT_EQ(branch.special_points.size(), 1u);
+  const SpecialPoint& sb = branch.special_points[0];
+  EXPECT_EQ(sb.type, SpecialPointType::kSimpleBifurcation);
+  EXPECT_EQ(sb.status, LocationStatus::kLocated);
+  EXPECT_NEAR(sb.u(0), 0.0, 1e-15);
+  EXPECT_NEAR(sb.u(1), 0.0, 1e-10);
+  EXPECT_LE(sb.precision(), 1e-11);
+  EXPECT_LE(sb.interval_width(1), 1e-11);
+  // The tangent keeps its orientation through the SB point (τ·τ_old > 0) while det([dr; τᵀ]) flips.
+  for (size_t i = 1; i < branch.points.size(); ++i) {
+    EXPECT_GT(branch.points[i].tangent.dot(branch.points[i - 1].tangent), 0.0);
+    EXPECT_EQ(std::signbit(branch.points[i].sb_test), branch.points[i].u(1) > 0);  // det = −λ·(·)
+  }
+}
+
+TEST(ContinuationTest, TranscriticalSimpleBifurcationLocated) {
+  Transcritical transcritical;
+  ContinuationOptions options;
+  options.bounds = {{"lambda", -1, 1}};
+  // Along the line x = λ from (−0.7, −0.7): it meets x = 0 at the origin.
+  const Branch branch = TraceBranch(&transcritical, Eigen::Vector2d(-0.7, -0.7), options);
+  ASSERT_EQ(branch.special_points.size(), 1u) << branch.FullReport();
+  const SpecialPoint& sb = branch.special_points[0];
+  EXPECT_EQ(sb.status, LocationStatus::kLocated);
+  EXPECT_NEAR(sb.u(0), 0.0, 1e-10);
+  EXPECT_NEAR(sb.u(1), 0.0, 1e-10);
+  for (const ContinuationPoint& point : branch.points) EXPECT_NEAR(point.u(0), point.u(1), 1e-14);
+}
+
+TEST(ContinuationTest, FoldFollowedBySimpleBifurcation) {
+  // Parabola λ = 1 − x² from x = −0.5 towards x > 0: fold in λ at (0, 1), then the SB point with the line
+  // x = λ at x = λ = (√5 − 1)/2.
+  ParabolaAndLine curve;
+  ContinuationOptions options;
+  options.turning_point_components = {"lambda"};
+  options.bounds = {{"x", -0.5, 1.0}};
+  ContinuationStepper stepper(&curve, options);
+  StepStatus status = stepper.Start(Eigen::Vector2d(-0.5, 0.75), Eigen::Vector2d(1, 1));  // towards x > 0
+  while (status == StepStatus::kContinuing) status = stepper.Step();
+  const Branch& branch = stepper.branch();
+  ASSERT_EQ(branch.special_points.size(), 2u) << branch.FullReport(curve.unknown_names());
+  const SpecialPoint& fold = branch.special_points[0];
+  const SpecialPoint& sb = branch.special_points[1];
+  EXPECT_EQ(fold.type, SpecialPointType::kTurningPoint);
+  EXPECT_EQ(fold.status, LocationStatus::kLocated);
+  EXPECT_NEAR(fold.u(0), 0.0, 1e-11);
+  EXPECT_NEAR(fold.u(1), 1.0, 1e-15);
+  EXPECT_EQ(sb.type, SpecialPointType::kSimpleBifurcation);
+  EXPECT_EQ(sb.status, LocationStatus::kLocated);
+  EXPECT_NEAR(sb.u(0), kGoldenRatioConjugate, 1e-10);
+  EXPECT_NEAR(sb.u(1), kGoldenRatioConjugate, 1e-10);
+  EXPECT_EQ(branch.termination, TerminationReason::kBoundReached);
+  EXPECT_EQ(branch.points.back().u(0), 1.0);
+  EXPECT_NEAR(branch.points.back().u(1), 0.0, 1e-14);
+}
+
+TEST(ContinuationTest, TargetReachedExactly) {
+  Pitchfork pitchfork;
+  ContinuationOptions options;
+  options.targets = {{"lambda", 2.0}};
+  const Branch branch = TraceBranch(&pitchfork, Eigen::Vector2d(1, 1), options);  // on λ = x²
+  ASSERT_EQ(branch.termination, TerminationReason::kTargetReached) << branch.message;
+  const Vector& u = branch.points.back().u;
+  EXPECT_NEAR(u(1), 2.0, 1e-12);
+  EXPECT_NEAR(u(0), std::sqrt(2.0), 1e-12);
+}
+
+TEST(ContinuationTest, SumBoundAndUserPredicate) {
+  Pitchfork pitchfork;
+  ContinuationOptions options;
+  options.sum_bounds = {{{"x", "lambda"}, -10, 3.0}};  // x + x² <= 3
+  Branch branch = TraceBranch(&pitchfork, Eigen::Vector2d(1, 1), options);
+  ASSERT_EQ(branch.termination, TerminationReason::kBoundReached);
+  const double x_star = (-1 + std::sqrt(13.0)) / 2;
+  EXPECT_NEAR(branch.points.back().u(0), x_star, 1e-12);
+  EXPECT_NEAR(branch.points.back().u.sum(), 3.0, 1e-12);
+
+  options = ContinuationOptions();
+  options.stop_predicate = [](const Vector& u) { return u(1) > 1.5; };
+  branch = TraceBranch(&pitchfork, Eigen::Vector2d(1, 1), options);
+  ASSERT_EQ(branch.termination, TerminationReason::kUserStop);
+  EXPECT_GT(branch.points.back().u(1), 1.5);
+  EXPECT_LE(branch.points[branch.points.size() - 2].u(1), 1.5);
+}
+
+TEST(ContinuationTest, MaxPointsAndStepTooSmallKeepTheBranch) {
+  Pitchfork pitchfork;
+  ContinuationOptions options;
+  options.max_points = 5;
+  Branch branch = TraceBranch(&pitchfork, Eigen::Vector2d(0, -1), options);
+  EXPECT_EQ(branch.termination, TerminationReason::kMaxPoints);
+  EXPECT_EQ(branch.points.size(), 5u);
+
+  FailsAbove failing(&pitchfork, 1, 0.5);  // evaluations fail for λ > 0.5
+  options = ContinuationOptions();
+  options.detect_bifurcations = false;
+  branch = TraceBranch(&failing, Eigen::Vector2d(0, -1), options);
+  ASSERT_EQ(branch.termination, TerminationReason::kStepTooSmall) << branch.message;
+  EXPECT_GT(branch.points.size(), 5u);
+  EXPECT_LE(branch.points.back().u(1), 0.5);
+  EXPECT_GT(branch.points.back().u(1), 0.5 - 2 * options.min_step);  // halved down to min_step
+  EXPECT_GT(branch.rejected_steps, 10);
+  EXPECT_NE(branch.message.find("component above its limit"), std::string::npos);
+}
+
+TEST(ContinuationTest, SecantPredictorAndMoorePenroseTraceTheSameCurve) {
+  Circle circle;
+  for (const CorrectorType corrector : {CorrectorType::kPseudoArclength, CorrectorType::kMoorePenrose}) {
+    ContinuationOptions options;
+    options.predictor = PredictorType::kSecant;
+    options.corrector_type = corrector;
+    options.turning_point_components = {"x"};
+    const Branch branch = TraceBranch(&circle, Eigen::Vector2d(0, 1), options);
+    ASSERT_EQ(branch.termination, TerminationReason::kClosedLoop) << ToString(corrector);
+    for (const ContinuationPoint& point : branch.points) EXPECT_NEAR(point.u.norm(), 1.0, 1e-12);
+    ASSERT_EQ(branch.special_points.size(), 2u);
+    EXPECT_NEAR(std::abs(branch.special_points[0].u(0)), 1.0, 1e-15);
+    EXPECT_NEAR(branch.special_points[0].u(1), 0.0, 1e-11);
+  }
+}
+
+TEST(ContinuationTest, StepperPointByPointEqualsDriver) {
+  ParabolaAndLine curve;
+  ContinuationOptions options;
+  options.turning_point_components = {"lambda"};
+  options.bounds = {{"x", -0.5, 1.0}};
+  int progress_calls = 0;
+  options.progress = [&progress_calls](const ProgressInfo& info) {
+    EXPECT_EQ(info.point_index, progress_calls);
+    ++progress_calls;
+  };
+  const Branch driven = TraceBranch(&curve, Eigen::Vector2d(-0.5, 0.75), options);
+  const int driver_calls = progress_calls;
+  progress_calls = 0;
+  ContinuationStepper stepper(&curve, options);
+  ASSERT_EQ(stepper.Start(Eigen::Vector2d(-0.5, 0.75)), StepStatus::kContinuing);
+  size_t steps = 0;
+  while (stepper.Step() == StepStatus::kContinuing) {
+    ++steps;
+    ASSERT_EQ(stepper.branch().points.size(), steps + 1);  // one point per Step()
+  }
+  const Branch& stepped = stepper.branch();
+  EXPECT_EQ(driver_calls, progress_calls);
+  ASSERT_EQ(stepped.points.size(), driven.points.size());
+  for (size_t i = 0; i < driven.points.size(); ++i) {
+    EXPECT_EQ(stepped.points[i].u, driven.points[i].u);
+    EXPECT_EQ(stepped.points[i].tangent, driven.points[i].tangent);
+  }
+  ASSERT_EQ(stepped.special_points.size(), driven.special_points.size());
+  for (size_t i = 0; i < driven.special_points.size(); ++i) {
+    EXPECT_EQ(stepped.special_points[i].u, driven.special_points[i].u);
+  }
+  EXPECT_EQ(stepped.termination, driven.termination);
+}
+
+TEST(ContinuationTest, SingularStartIsReportedNotThrown) {
+  Pitchfork pitchfork;
+  const Branch branch = TraceBranch(&pitchfork, Eigen::Vector2d(0, 0), ContinuationOptions());
+  EXPECT_EQ(branch.termination, TerminationReason::kStartFailed);
+  EXPECT_EQ(branch.points.size(), 0u);
+}
+
+}  // namespace
+}  // namespace hybridcont

@@ -1,0 +1,115 @@
+// Algebraic zero problems with exact answers, shared by the continuation and exploration tests.
+#ifndef HYBRIDCONT_TESTS_CONTINUATION_TEST_PROBLEMS_H_
+#define HYBRIDCONT_TESTS_CONTINUATION_TEST_PROBLEMS_H_
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hybridcont/zero_problem.h"
+
+namespace hybridcont::testing {
+
+// x² + y² = 1: a closed curve, turning points in y at (0, ±1) and in x at (±1, 0).
+class Circle : public ZeroProblem {
+ public:
+  int num_equations() const override { return 1; }
+  std::vector<std::string> unknown_names() const override { return {"x", "y"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    if (r) *r = Vector::Constant(1, u.squaredNorm() - 1.0);
+    if (dr) *dr = 2.0 * u.transpose();
+    return {};
+  }
+};
+
+// x³ − λx = 0: the trivial branch x = 0 and the parabola λ = x², crossing at the SB point (0, 0).
+class Pitchfork : public ZeroProblem {
+ public:
+  int num_equations() const override { return 1; }
+  std::vector<std::string> unknown_names() const override { return {"x", "lambda"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0), l = u(1);
+    if (r) *r = Vector::Constant(1, x * x * x - l * x);
+    if (dr) {
+      dr->resize(1, 2);
+      *dr << 3 * x * x - l, -x;
+    }
+    return {};
+  }
+};
+
+// x(λ − x) = 0: the lines x = 0 and x = λ, crossing at the SB point (0, 0).
+class Transcritical : public ZeroProblem {
+ public:
+  int num_equations() const override { return 1; }
+  std::vector<std::string> unknown_names() const override { return {"x", "lambda"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0), l = u(1);
+    if (r) *r = Vector::Constant(1, x * (l - x));
+    if (dr) {
+      dr->resize(1, 2);
+      *dr << l - 2 * x, x;
+    }
+    return {};
+  }
+};
+
+// (x² + λ − 1)(x − λ) = 0: the parabola λ = 1 − x² (fold in λ at (0, 1)) and the line x = λ, crossing at
+// the SB points x = λ = (−1 ± √5)/2.
+class ParabolaAndLine : public ZeroProblem {
+ public:
+  int num_equations() const override { return 1; }
+  std::vector<std::string> unknown_names() const override { return {"x", "lambda"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0), l = u(1);
+    const double p = x * x + l - 1, q = x - l;
+    if (r) *r = Vector::Constant(1, p * q);
+    if (dr) {
+      dr->resize(1, 2);
+      *dr << 2 * x * q + p, q - p;
+    }
+    return {};
+  }
+};
+
+// [x·y; λ(x − y)] = 0: the three coordinate axes, all through the origin, where dr = 0 (kernel of
+// dimension 3, cokernel of dimension 2).
+class ThreeAxes : public ZeroProblem {
+ public:
+  int num_equations() const override { return 2; }
+  std::vector<std::string> unknown_names() const override { return {"x", "y", "lambda"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0), y = u(1), l = u(2);
+    if (r) {
+      r->resize(2);
+      *r << x * y, l * (x - y);
+    }
+    if (dr) {
+      dr->resize(2, 3);
+      *dr << y, x, 0, l, -l, x - y;
+    }
+    return {};
+  }
+};
+
+// Wraps a problem and fails every evaluation with component `index` above `limit` (an integrator that
+// gives up): continuation must end with kStepTooSmall and keep its points.
+class FailsAbove : public ZeroProblem {
+ public:
+  FailsAbove(ZeroProblem* inner, int index, double limit) : inner_(inner), index_(index), limit_(limit) {}
+  int num_equations() const override { return inner_->num_equations(); }
+  std::vector<std::string> unknown_names() const override { return inner_->unknown_names(); }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    if (u(index_) > limit_) return EvaluationStatus::Failure("component above its limit");
+    return inner_->Evaluate(u, r, dr);
+  }
+
+ private:
+  ZeroProblem* inner_;
+  int index_;
+  double limit_;
+};
+
+}  // namespace hybridcont::testing
+
+#endif  // HYBRIDCONT_TESTS_CONTINUATION_TEST_PROBLEMS_H_
