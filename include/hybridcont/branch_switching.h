@@ -36,6 +36,8 @@
 //    bracketed and σ_min is not yet below the rank tolerance.
 //  - Directions are reported as lines (unit vectors whose largest-magnitude component is positive); a
 //    line is two half-branches, ±v.
+//  - A double root of the (restricted) ABE is reported as one line: after restriction by linear
+//    conditions this is the usual case (the other branches leave the restricted plane); message says so.
 //  - Fallback when the ABE is degenerate (relative discriminant below degeneracy_tolerance, or no real
 //    root): the kernel direction orthogonal to the incoming tangent, status kFallback, and the message
 //    says so.

@@ -9,11 +9,17 @@
 //   turning point    g_k(u)  = τ_k   (the tangent component of a named unknown, e.g. "H")
 //
 // Scaling decision: det([dr; τᵀ]) alone mixes the units of times, states, ξ and H (entries 0.01..10) and
-// over/underflows for large N, so detection uses only its sign. Location uses the Hadamard-normalized
-// determinant above (|g_SB| <= 1, computed from log|pivots|), and along the bracketing interval the
-// tangent row is frozen to the tangent τ_a of the bracketing point: det([dr(u); τ_aᵀ]) = c(u)·τ_a with c
-// the cofactor vector, c ∥ τ(u), so g_SB stays smooth in the arclength and needs no ill-conditioned
-// tangent solve next to the SB point.
+// over/underflows for large N, so it is never formed as a product (log|pivots| and a sign instead).
+// Detection uses only its sign, stored per point as the Hadamard-normalized value (|g_SB| <= 1).
+// Location needs a smooth function, and the Hadamard normalization is not smooth where a row of dr
+// vanishes at the SB point (N = 1: dr itself vanishes there, and g_SB becomes a step function). Along the
+// bracketing interval [u_a, u_b] the root finder therefore uses
+//
+//   g(σ) = det([dr(u(σ)); τ_aᵀ]) / ∏ᵢ ||row i of dr(u_a)||
+//
+// (tangent row frozen to τ_a, scale frozen at u_a): det([dr(u); τ_aᵀ]) = c(u)·τ_a with c the cofactor
+// vector of dr, c ∥ τ(u), so g has the sign of the SB test, is O(1) at u_a, ≈ linear in σ through the
+// root, and needs no ill-conditioned tangent solve next to the SB point.
 //
 // Location: a safeguarded Illinois (regula falsi) iteration on the test function as a function of the
 // pseudo-arclength σ = τ_aᵀ(u − u_a) from the bracketing point u_a; every trial point is corrected back
