@@ -84,9 +84,10 @@ class Phase {
 
   // The dissipative unfolding of eq. `hybridDynamicsNum`: f~(x, xi) = f(x) + sum_j xi_j dH_j(x)^T,
   // with A = df~/dx = df + sum_j xi_j d2H_j and B = df~/dxi = dH^T (n x k). Hessians are evaluated only
-  // when some xi_j != 0 (their term vanishes exactly otherwise).
+  // when some xi_j != 0 (their term vanishes exactly otherwise) and include_hessian_term is true; a
+  // caller may drop the term when it is provably below its accuracy (see PhaseFlow).
   void UnfoldedVectorField(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
-                           Vector* f_tilde, Matrix* A, Matrix* B) const;
+                           Vector* f_tilde, Matrix* A, Matrix* B, bool include_hessian_term = true) const;
 
  private:
   std::string name_;

@@ -14,19 +14,20 @@ Phase::Phase(std::string name, std::vector<std::string> state_names, int next_di
       typical_state_(std::move(typical_state)) {}
 
 void Phase::UnfoldedVectorField(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
-                                Vector* f_tilde, Matrix* A, Matrix* B) const {
+                                Vector* f_tilde, Matrix* A, Matrix* B, bool include_hessian_term) const {
   const bool dissipative = (xi.array() != 0.0).any();
-  const bool need_hessians = A != nullptr && dissipative;
+  const bool need_hessians = A != nullptr && dissipative && include_hessian_term;
   const bool need_gradients = B != nullptr || dissipative;
   VectorField(x, f_tilde, A);
   if (!need_gradients) return;
-  Vector H;
-  Matrix dH;
-  std::vector<Matrix> d2H;
+  // Per-thread scratch: this runs once per right-hand-side evaluation and must not allocate.
+  thread_local Vector H;
+  thread_local Matrix dH;
+  thread_local std::vector<Matrix> d2H;
   FirstIntegrals(x, &H, &dH, need_hessians ? &d2H : nullptr);
   if (dissipative) {
     f_tilde->noalias() += dH.transpose() * xi;
-    if (A) {
+    if (need_hessians) {
       for (int j = 0; j < xi.size(); ++j) *A += xi(j) * d2H[j];
     }
   }
