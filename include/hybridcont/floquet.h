@@ -1,0 +1,109 @@
+// Monodromy matrix and Floquet multipliers of a periodic orbit (paper §2.5, footnote on Phi_T).
+//
+// From a time-based solution u (timebased_shooting.h) the monodromy is chained from the segments'
+// fundamental matrices and the saltation matrices at the segment ends (eq. `fundamentalMatrixHybrid`):
+//
+//     Phi_T = Phi_{m+1} S_m Phi_m ... S_1 Phi_1,     S_i = D_i + (f~_{i+1}^+ - D_i f~_i^-) de_i / (de_i f~_i^-)
+//
+// with f~^- = f~_i(phi_i(t_i)), f~^+ = f~_{i+1}(Delta_i(phi_i(t_i))). Its eigenvalues are the Floquet
+// multipliers. A conservative orbit always has two of them at +1 (Thm 2.1 and the freedom of phase):
+//     Phi_T f(x0) = f(x0)          (right eigenvector: the flow direction)
+//     dH(x0) Phi_T = dH(x0)         (left eigenvector: the first integral, eq. `leftEigen`)
+// and generically they form a 2x2 Jordan block (the period changes with the energy). A Jordan block
+// splits under a perturbation eps of Phi_T by ~sqrt(eps): with integration errors ~1e-10 the computed
+// "1, 1" are 1 ± 1e-5. So the two trivial multipliers are deflated exactly instead of being read off the
+// eigenvalues: Phi_T maps ker dH into itself and fixes f in it; on the quotient ker dH / span(f),
+// represented by an orthonormal basis B of ker dH orthogonal to f, the reduced matrix
+//     M = B^T Phi_T B     ((n1-2) x (n1-2))
+// carries exactly the n1 - 2 nontrivial multipliers (its eigenvalues are those of the Poincaré map
+// restricted to the energy level). The BP/PD test functions and the stability verdict use M.
+//
+// Tolerances (FloquetOptions) and why:
+//   unit_tolerance   = 1e-6:  a nontrivial multiplier within this of +1 counts as a further unit multiplier
+//                             (normal := none does). Simple multipliers are accurate to ~1e-9 at rtol 1e-10;
+//                             near a collision at +1 they split by sqrt, so 1e-6 flags points within ~1e-12
+//                             in the multiplier's square distance, i.e. the located BP itself.
+//   circle_tolerance = 1e-6:  stable := every nontrivial |mu| <= 1 + circle_tolerance. Conservative systems
+//                             cannot be asymptotically stable: "stable" means linearly (neutrally) stable,
+//                             all multipliers on the unit circle. Same accuracy argument as above.
+//   min_transversality = 1e-8: saltation matrices with |de f~^-| below this fraction of |de||f~^-| are
+//                             refused (kSaltationUndefined): 1/(de f) would amplify the ~1e-10 errors of
+//                             the segment ends to O(1e-2) in Phi_T.
+//
+// Test functions for special points along a branch (sign changes bracket them):
+//   bp_test = prod over nontrivial mu of (mu - 1)    changes sign when a real multiplier crosses +1, or
+//                                                    when a reciprocal pair collides at +1 and leaves the
+//                                                    unit circle (complex pair: |mu-1|^2 > 0; real pair
+//                                                    (l, 1/l): -(l-1)^2/l < 0). Compare the SB points.
+//   pd_test = prod over all mu of (mu + 1)            (the trivial pair contributes 2 * 2 = 4 exactly)
+//                                                    changes sign when a multiplier crosses -1.
+//
+//   TimeBasedShooting shooting(model, IntegratorOptions{});
+//   FloquetResult fl = ComputeFloquet(shooting, u);
+//   if (fl.ok()) { fl.multipliers, fl.normal, fl.stable, fl.bp_test ... }
+#ifndef HYBRIDCONT_FLOQUET_H_
+#define HYBRIDCONT_FLOQUET_H_
+
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "hybridcont/timebased_shooting.h"
+
+namespace hybridcont {
+
+struct FloquetOptions {
+  double unit_tolerance = 1e-6;      // |mu - 1| for a further unit multiplier (see the header comment)
+  double circle_tolerance = 1e-6;    // |mu| <= 1 + this for linear stability
+  double min_transversality = 1e-8;  // saltation refused below this crossing sine
+
+  std::string Validate() const;
+};
+
+enum class FloquetStatus {
+  kSuccess,
+  kEvaluationFailed,     // the time-based map could not be evaluated at u (integration failure)
+  kSaltationUndefined,   // de_i f~_i^- ~ 0 at a segment end: grazing or zero-duration transition
+  kDegenerateOrbit,      // f(x0) = 0 or dH(x0) = 0: an equilibrium, no trivial pair to deflate
+  kEigenFailed,          // Eigen's eigensolver did not converge
+};
+std::string ToString(FloquetStatus status);
+
+struct FloquetResult {
+  FloquetStatus status = FloquetStatus::kSuccess;
+  std::string message;
+  Matrix monodromy;                // Phi_T, n1 x n1
+  std::vector<Matrix> saltations;  // S_1..S_m
+  // All n1 eigenvalues of Phi_T, sorted by |mu - 1| ascending (the computed trivial pair first), ties by
+  // descending imaginary part. Their first two are only ~sqrt(rtol) close to 1 (Jordan block).
+  std::vector<std::complex<double>> multipliers;
+  // The n1 - 2 nontrivial multipliers from the deflated matrix, sorted by modulus descending, then by
+  // descending imaginary part (a conjugate pair: + first).
+  std::vector<std::complex<double>> nontrivial;
+  int num_unit = 0;        // 2 (the trivial pair) + nontrivial multipliers within unit_tolerance of +1
+  bool normal = false;     // num_unit == 2: exactly two multipliers equal 1 (paper: normal conservative orbit)
+  bool stable = false;     // all nontrivial multipliers on (or inside) the unit circle within tolerance
+  double max_modulus = 0;  // largest |mu| of the nontrivial multipliers (1 if there are none)
+  double bp_test = 0;      // prod (mu - 1) over the nontrivial multipliers
+  double pd_test = 0;      // 4 * prod (mu + 1) over the nontrivial multipliers
+  // Residuals of the theory on this orbit (|Phi_T f - f| / |f|, |dH Phi_T - dH| / |dH|): ~integration
+  // error on a periodic orbit; large values mean u is not a periodic orbit at xi = 0.
+  double flow_residual = 0;
+  double first_integral_residual = 0;
+
+  bool ok() const { return status == FloquetStatus::kSuccess; }
+  std::string BriefReport() const;
+};
+
+// Monodromy and multipliers at a time-based point u. Evaluates shooting once with its Jacobian (the
+// segment Phi_i are read from it); x0 = x̄_1, xi from u (multipliers are meaningful for xi = 0).
+FloquetResult ComputeFloquet(TimeBasedShooting& shooting, const Vector& u, const FloquetOptions& options = {});
+
+// The analysis part alone, for a monodromy from elsewhere (e.g. the state-based map's Phi(t^A, x0)):
+// f0 = f(x0), dH0 = dH_1(x0).
+FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const RowVector& dH0,
+                               const FloquetOptions& options = {});
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_FLOQUET_H_

@@ -1,0 +1,167 @@
+#include "hybridcont/floquet.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+
+#include "hybridcont/saltation.h"
+
+namespace hybridcont {
+
+std::string FloquetOptions::Validate() const {
+  std::ostringstream os;
+  auto positive = [&](const char* field, double v) {
+    if (os.tellp() == 0 && (!(v > 0.0) || !std::isfinite(v))) {
+      os << "FloquetOptions::" << field << " = " << v << " must be finite and > 0";
+    }
+  };
+  positive("unit_tolerance", unit_tolerance);
+  positive("circle_tolerance", circle_tolerance);
+  positive("min_transversality", min_transversality);
+  return os.str();
+}
+
+std::string ToString(FloquetStatus status) {
+  switch (status) {
+    case FloquetStatus::kSuccess: return "success";
+    case FloquetStatus::kEvaluationFailed: return "evaluation failed";
+    case FloquetStatus::kSaltationUndefined: return "saltation matrix undefined";
+    case FloquetStatus::kDegenerateOrbit: return "degenerate orbit";
+    case FloquetStatus::kEigenFailed: return "eigenvalue computation failed";
+  }
+  return "unknown";
+}
+
+std::string FloquetResult::BriefReport() const {
+  std::ostringstream os;
+  os << ToString(status);
+  if (!ok()) return os.str() + " (" + message + ")";
+  os << ": " << (normal ? "normal" : "not normal") << ", " << (stable ? "stable" : "unstable") << ", |mu|max "
+     << max_modulus << ", nontrivial multipliers";
+  for (const auto& mu : nontrivial) os << " " << mu.real() << (mu.imag() >= 0 ? "+" : "") << mu.imag() << "i";
+  return os.str();
+}
+
+FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const RowVector& dH0,
+                               const FloquetOptions& options) {
+  FloquetResult res;
+  res.monodromy = monodromy;
+  const int n = static_cast<int>(monodromy.rows());
+  if (!monodromy.allFinite()) {
+    res.status = FloquetStatus::kEigenFailed;
+    res.message = "monodromy matrix has non-finite entries";
+    return res;
+  }
+  if (!(f0.norm() > 0.0) || !(dH0.norm() > 0.0)) {
+    res.status = FloquetStatus::kDegenerateOrbit;
+    res.message = "f(x0) = 0 or dH(x0) = 0 (an equilibrium): no trivial multiplier pair to deflate";
+    return res;
+  }
+  res.flow_residual = (monodromy * f0 - f0).norm() / f0.norm();
+  res.first_integral_residual = (dH0 * monodromy - dH0).norm() / dH0.norm();
+
+  Eigen::EigenSolver<Matrix> full(monodromy, /*computeEigenvectors=*/false);
+  if (full.info() != Eigen::Success) {
+    res.status = FloquetStatus::kEigenFailed;
+    res.message = "EigenSolver failed on the monodromy matrix";
+    return res;
+  }
+  for (int i = 0; i < n; ++i) res.multipliers.push_back(full.eigenvalues()(i));
+  std::sort(res.multipliers.begin(), res.multipliers.end(), [](const auto& a, const auto& b) {
+    const double da = std::abs(a - 1.0), db = std::abs(b - 1.0);
+    return da != db ? da < db : a.imag() > b.imag();
+  });
+
+  // Deflate the trivial pair: B orthonormal, spanning ker dH ∩ f^⊥ (see the header).
+  if (n > 2) {
+    const Matrix Q = Eigen::HouseholderQR<Matrix>(dH0.transpose()).householderQ();
+    const Matrix Q1 = Q.rightCols(n - 1);  // ker dH
+    const Vector c = Q1.transpose() * f0;
+    const Matrix Qc = Eigen::HouseholderQR<Matrix>(c).householderQ();
+    const Matrix B = Q1 * Qc.rightCols(n - 2);
+    const Matrix M = B.transpose() * monodromy * B;
+    Eigen::EigenSolver<Matrix> reduced(M, false);
+    if (reduced.info() != Eigen::Success) {
+      res.status = FloquetStatus::kEigenFailed;
+      res.message = "EigenSolver failed on the deflated monodromy";
+      return res;
+    }
+    for (int i = 0; i < n - 2; ++i) res.nontrivial.push_back(reduced.eigenvalues()(i));
+  }
+  std::sort(res.nontrivial.begin(), res.nontrivial.end(), [](const auto& a, const auto& b) {
+    const double ma = std::abs(a), mb = std::abs(b);
+    return ma != mb ? ma > mb : a.imag() > b.imag();
+  });
+
+  std::complex<double> bp = 1.0, pd = 4.0;
+  res.num_unit = 2;
+  res.max_modulus = 1.0;
+  res.stable = true;
+  for (const auto& mu : res.nontrivial) {
+    bp *= mu - 1.0;
+    pd *= mu + 1.0;
+    if (std::abs(mu - 1.0) <= options.unit_tolerance) ++res.num_unit;
+    if (std::abs(mu) > 1.0 + options.circle_tolerance) res.stable = false;
+  }
+  if (!res.nontrivial.empty()) res.max_modulus = std::abs(res.nontrivial.front());
+  res.bp_test = bp.real();  // conjugate pairs make the products real up to round-off
+  res.pd_test = pd.real();
+  res.normal = res.num_unit == 2;
+  return res;
+}
+
+FloquetResult ComputeFloquet(TimeBasedShooting& shooting, const Vector& u, const FloquetOptions& options) {
+  FloquetResult res;
+  if (const std::string why = options.Validate(); !why.empty()) throw std::invalid_argument(why);
+  Vector r;
+  Matrix dr;
+  if (const EvaluationStatus s = shooting.Evaluate(u, &r, &dr); !s.ok) {
+    res.status = FloquetStatus::kEvaluationFailed;
+    res.message = s.message;
+    return res;
+  }
+  const HybridModel& model = shooting.model();
+  const ShootingLayout& layout = shooting.layout();
+  const int m = model.num_phases();
+  const int k = layout.num_first_integrals();
+  const Vector xi = u.segment(layout.xi_index(), k);
+  Vector f_minus, f_plus, x_plus;
+  Matrix D, S;
+  RowVector de;
+  Matrix Phi_T = Matrix::Identity(layout.dim(0), layout.dim(0));
+  for (int i = 0; i < m; ++i) {
+    const Phase& phase = model.phase(i);
+    const PhaseFlowResult& flow = shooting.segment_flow(i);
+    phase.Reset(flow.x, &x_plus, &D);
+    phase.Event(flow.x, &de);
+    phase.UnfoldedVectorField(flow.x, xi, &f_minus, nullptr, nullptr);
+    model.phase(i + 1).UnfoldedVectorField(x_plus, xi, &f_plus, nullptr, nullptr);
+    if (Saltation(D, f_minus, f_plus, de, &S, options.min_transversality) != SaltationStatus::kSuccess) {
+      std::ostringstream os;
+      os << "segment " << i + 1 << " (phase '" << phase.name() << "', duration " << u(layout.time_index(i))
+         << "): de f~^- = " << de.dot(f_minus) << " is ~0 (grazing or zero-duration transition)";
+      res.status = FloquetStatus::kSaltationUndefined;
+      res.message = os.str();
+      return res;
+    }
+    res.saltations.push_back(S);
+    Phi_T = S * (flow.Phi * Phi_T);
+  }
+  Phi_T = shooting.segment_flow(m).Phi * Phi_T;
+
+  const auto x1 = u.segment(layout.state_offset(0), layout.dim(0));
+  Vector f0, H;
+  Matrix dH;
+  model.phase(0).UnfoldedVectorField(x1, xi, &f0, nullptr, nullptr);
+  model.phase(0).FirstIntegrals(x1, &H, &dH, nullptr);
+  std::vector<Matrix> saltations = std::move(res.saltations);
+  res = AnalyzeMonodromy(Phi_T, f0, dH.row(0), options);
+  res.saltations = std::move(saltations);
+  return res;
+}
+
+}  // namespace hybridcont

@@ -1,0 +1,79 @@
+// Internal: the augmented right-hand side of eqs. `diffState`, `diffParam` as an odeint system.
+//
+// z = [x; vec(Phi); vec(Psi)] (column-major), dz = [f~; A Phi; A Psi + B] with A = df~/dx, B = df~/dxi.
+// The functor is a cheap handle (odeint copies systems by value); its scratch space lives in
+// AugmentedRhsWorkspace, made once per integrator (STYLE.md practice 6). A non-finite model value sets
+// the workspace's flag and time and returns dz = 0, so that the stepper's arithmetic stays finite and
+// the driving loop reports the failure with phase and time.
+#ifndef HYBRIDCONT_SRC_INTEGRATION_AUGMENTED_RHS_H_
+#define HYBRIDCONT_SRC_INTEGRATION_AUGMENTED_RHS_H_
+
+#include "hybridcont/model.h"
+
+namespace hybridcont::internal {
+
+struct AugmentedRhsWorkspace {
+  const Phase* phase = nullptr;
+  Vector xi;
+  int n = 0;
+  int k = 0;
+  bool sensitivities = false;
+  long rhs_evaluations = 0;
+  bool nonfinite = false;
+  double nonfinite_time = 0.0;
+  Vector f;
+  Matrix A, B;
+
+  // Prepares an integration; returns the size of z.
+  int Start(const Phase& p, const Eigen::Ref<const Vector>& xi_in, bool with_sensitivities) {
+    phase = &p;
+    xi = xi_in;
+    n = p.dim();
+    k = p.num_first_integrals();
+    sensitivities = with_sensitivities;
+    rhs_evaluations = 0;
+    nonfinite = false;
+    nonfinite_time = 0.0;
+    return sensitivities ? n + n * n + n * k : n;
+  }
+  // z at t = 0: [x0; I; 0].
+  void InitialState(const Eigen::Ref<const Vector>& x0, Vector* z) const {
+    z->resize(sensitivities ? n + n * n + n * k : n);
+    z->head(n) = x0;
+    if (!sensitivities) return;
+    Eigen::Map<Matrix>(z->data() + n, n, n).setIdentity();
+    Eigen::Map<Matrix>(z->data() + n + n * n, n, k).setZero();
+  }
+  Eigen::Map<const Matrix> Phi(const Vector& z) const { return Eigen::Map<const Matrix>(z.data() + n, n, n); }
+  Eigen::Map<const Matrix> Psi(const Vector& z) const {
+    return Eigen::Map<const Matrix>(z.data() + n + n * n, n, k);
+  }
+
+  void Evaluate(const Vector& z, Vector& dz, double t) {
+    ++rhs_evaluations;
+    dz.resize(z.size());
+    phase->UnfoldedVectorField(z.head(n), xi, &f, sensitivities ? &A : nullptr, sensitivities ? &B : nullptr);
+    if (!f.allFinite() || (sensitivities && (!A.allFinite() || !B.allFinite()))) {
+      if (!nonfinite) nonfinite_time = t;
+      nonfinite = true;
+      dz.setZero();
+      return;
+    }
+    dz.head(n) = f;
+    if (!sensitivities) return;
+    Eigen::Map<Matrix>(dz.data() + n, n, n).noalias() = A * Phi(z);
+    Eigen::Map<Matrix> dPsi(dz.data() + n + n * n, n, k);
+    dPsi.noalias() = A * Psi(z);
+    dPsi += B;
+  }
+};
+
+// The odeint system: a handle on a workspace.
+struct AugmentedRhs {
+  AugmentedRhsWorkspace* w;
+  void operator()(const Vector& z, Vector& dz, double t) const { w->Evaluate(z, dz, t); }
+};
+
+}  // namespace hybridcont::internal
+
+#endif  // HYBRIDCONT_SRC_INTEGRATION_AUGMENTED_RHS_H_
