@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <random>
 
 #include <Eigen/LU>
@@ -152,6 +153,61 @@ TEST(Floquet, ZeroDurationTransitionAndEquilibriaAreStatuses) {
   const HybridModel ball = MakeBouncingBall();
   TimeBasedShooting tb_ball(ball, IntegratorOptions{});
   EXPECT_FALSE(ComputeFloquet(tb_ball, BuiltinStartPoint(ball)).ok());  // u0 = 0: the equilibrium
+}
+
+
+// Bisection on the sign of test(H) along the closed-form hopping-in-place orbits.
+double Bisect(const std::function<double(double)>& test, double a, double b) {
+  const double fa = test(a);
+  EXPECT_LT(fa * test(b), 0.0) << "no sign change in [" << a << ", " << b << "]";
+  double lo = a, hi = b;
+  while (hi - lo > 1e-13) {
+    const double mid = 0.5 * (lo + hi);
+    ((test(mid) < 0.0) == (fa < 0.0) ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+TEST(Floquet, SlipHoppingInPlaceChangesStabilityAtTheSbPointsOfTheContinuation) {
+  // The nontrivial pair is the leg-angle (alpha) mode; hopping in place at k = 40, w2 = 5.
+  // Measured (rtol 1e-10): H = 1.1: mu = 1.70796, -0.350128 (unstable); H = 1.4: mu = 0.645354, -0.543768
+  // (stable: the swing leg is a driven oscillator, the reduced map is not area-preserving, so the
+  // transverse mode can contract).
+  const HybridModel slip = MakeSlip();
+  TimeBasedShooting tb(slip, IntegratorOptions{});
+  auto floquet = [&](double H) { return ComputeFloquet(tb, SlipHoppingInPlace(slip, tb.layout(), H)); };
+  const FloquetResult low = floquet(1.1), mid = floquet(1.4), high = floquet(1.8);
+  ASSERT_TRUE(low.ok() && mid.ok() && high.ok());
+  EXPECT_FALSE(low.stable);
+  EXPECT_NEAR(low.max_modulus, 1.70796, 1e-5);
+  EXPECT_TRUE(mid.stable);
+  EXPECT_NEAR(mid.nontrivial[0].real(), 0.645354, 1e-5);
+  EXPECT_NEAR(mid.nontrivial[1].real(), -0.543768, 1e-5);
+  EXPECT_FALSE(high.stable);
+  for (const FloquetResult* f : {&low, &mid, &high}) EXPECT_TRUE(f->normal);
+  EXPECT_LT(low.bp_test, 0.0);
+  EXPECT_GT(mid.bp_test, 0.0);
+  EXPECT_LT(high.bp_test, 0.0);
+
+  // The +1 crossings, located by bisection on the closed-form orbits, against the SB points the
+  // continuation found at H = 1.24674011004 and H = 1.61443: they agree to ~1e-12 (measured
+  // 1.246740110039 at rtol 1e-10, 1.246740110027 at rtol 1e-12) and 1.614433284724.
+  auto bp = [&](double H) { return floquet(H).bp_test; };
+  const double bp1 = Bisect(bp, 1.1, 1.4);
+  const double bp2 = Bisect(bp, 1.4, 1.8);
+  EXPECT_NEAR(bp1, 1.24674011004, 1e-10);
+  EXPECT_NEAR(bp2, 1.61443, 1e-5);
+  // At the same H a second multiplier passes through -1 (pd changes sign at 1.246740110061, within 1e-10
+  // of bp1), and returns inside the unit circle at H = 1.2828093238: the orbits are linearly stable on
+  // (1.28281, 1.61443), not on the whole interval between the SB points.
+  auto pd = [&](double H) { return floquet(H).pd_test; };
+  EXPECT_NEAR(Bisect(pd, 1.2, 1.25), bp1, 1e-9);
+  const double pd2 = Bisect(pd, 1.25, 1.3);
+  EXPECT_NEAR(pd2, 1.2828093238, 1e-8);
+  EXPECT_FALSE(floquet(pd2 - 1e-4).stable);
+  EXPECT_TRUE(floquet(pd2 + 1e-4).stable);
+  EXPECT_TRUE(floquet(bp2 - 1e-4).stable);
+  EXPECT_FALSE(floquet(bp2 + 1e-4).stable);
 }
 
 }  // namespace
