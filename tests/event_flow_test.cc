@@ -10,16 +10,10 @@
 #include "hybridcont/models.h"
 #include "hybridcont/saltation.h"
 #include "known_orbits.h"
+#include "vector_literal.h"
 
 namespace hybridcont {
 namespace {
-
-Vector Vec(std::initializer_list<double> v) {
-  Vector x(static_cast<int>(v.size()));
-  int i = 0;
-  for (double d : v) x(i++) = d;
-  return x;
-}
 
 TEST(EventFlow, BallFallingFromRestHitsTheGroundAtSqrt2hOverG) {
   HybridModel ball = MakeBouncingBall();
