@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <stdexcept>
 
 namespace hybridcont::app {
@@ -75,7 +76,10 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
   }
   f << fmt::format(",{},{},{:.3e},{},{:.6g}", p.classification.physical ? 1 : 0, ToString(p.classification.reason),
                    p.residual, p.newton_iterations, p.step);
-  for (const auto& [name, value] : p.extra) f << fmt::format(",{:.10g}", value);
+  for (const auto& [name, value] : p.extra) {
+    if (std::isfinite(value)) f << fmt::format(",{:.10g}", value);
+    else f << ",";  // not defined for this point (e.g. Floquet data of a non-physical orbit)
+  }
   f << "\n";
   f.flush();
   ++points_per_branch_[branch_id];

@@ -16,6 +16,9 @@
 #include "commands.h"
 #include "hybridcont/classification.h"
 #include "hybridcont/exploration.h"
+#include "hybridcont/floquet.h"
+#include "hybridcont/replay.h"
+#include "hybridcont/test_function_root.h"
 #include "hybridcont/models.h"
 #include "hybridcont/timebased_shooting.h"
 #include "model_exploration.h"
@@ -129,6 +132,89 @@ int DrawFigures(const fs::path& dir, std::ostream& err) {
   return rc;
 }
 
+
+// Extra CSV columns (order fixed: every row of a branch has the same header).
+constexpr int kBpColumn = 5;
+constexpr int kPdColumn = 6;
+
+// Floquet multipliers, stability and the event-driven replay of a physical orbit (issue 5). A physical
+// point whose replay does not return is reclassified "replay-failed". Columns of non-physical points stay
+// empty: their monodromy has no meaning for the mechanical system.
+void AnalyzePhysicalOrbit(const HybridModel& model, TimeBasedShooting& floquet_map, const ReplayOptions& replay_options,
+                          const Vector& u, PointRecord* record) {
+  const double nan = std::nan("");
+  const int nontrivial = std::max(model.phase(0).dim() - 2, 0);
+  record->extra = {{"replay_error", nan}, {"stable", nan},        {"normal", nan}, {"num_unit", nan},
+                   {"max_multiplier", nan}, {"bp_test", nan},     {"pd_test", nan}};
+  for (int j = 0; j < nontrivial; ++j) {
+    record->extra.push_back({"mu" + std::to_string(j + 1) + "_re", nan});
+    record->extra.push_back({"mu" + std::to_string(j + 1) + "_im", nan});
+  }
+  if (!record->classification.physical) return;
+  const ReplayResult replay = ReplayOrbit(model, u, replay_options);
+  record->extra[0].second = replay.error;
+  if (!replay.physical()) {
+    record->classification = {false, OrbitClass::kReplayFailed, replay.message};
+    return;
+  }
+  const FloquetResult floquet = ComputeFloquet(floquet_map, u);
+  if (!floquet.ok()) return;
+  record->extra[1].second = floquet.stable ? 1 : 0;
+  record->extra[2].second = floquet.normal ? 1 : 0;
+  record->extra[3].second = floquet.num_unit;
+  record->extra[4].second = floquet.max_modulus;
+  record->extra[kBpColumn].second = floquet.bp_test;
+  record->extra[kPdColumn].second = floquet.pd_test;
+  for (int j = 0; j < nontrivial && j < static_cast<int>(floquet.nontrivial.size()); ++j) {
+    record->extra[7 + 2 * j].second = floquet.nontrivial[j].real();
+    record->extra[8 + 2 * j].second = floquet.nontrivial[j].imag();
+  }
+}
+
+// BP (a further multiplier crosses +1) and PD (one crosses -1) points: sign changes of the Floquet test
+// functions between consecutive physical points of a branch, located on the branch (test_function_root.h).
+// Returns report lines; appends the points to special_points.
+std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::map<int, std::vector<double>>& bp,
+                                const std::map<int, std::vector<double>>& pd, TimeBasedShooting& map,
+                                const ShootingLayout& layout, nlohmann::json* special_points) {
+  std::string report = "Floquet special points (multiplier crossings on physical orbits):\n";
+  int count = 0;
+  for (const Branch& b : diagram.branches) {
+    for (const auto& [type, tests] : {std::pair{"BP", &bp}, std::pair{"PD", &pd}}) {
+      const auto it = tests->find(b.id);
+      if (it == tests->end()) continue;
+      const std::vector<double>& values = it->second;
+      for (std::size_t i = 0; i + 1 < values.size() && i + 1 < b.points.size(); ++i) {
+        if (!(values[i] * values[i + 1] < 0.0)) continue;  // NaN (non-physical) compares false
+        const auto test = [&, type = std::string(type)](const Vector& u) {
+          const FloquetResult f = ComputeFloquet(map, u);
+          return f.ok() ? (type == "BP" ? f.bp_test : f.pd_test) : std::nan("");
+        };
+        const TestFunctionRoot root =
+            LocateTestFunctionRoot(&map, b.points[i].u, b.points[i + 1].u, test, TestFunctionRootOptions{});
+        nlohmann::json j = {{"id", static_cast<int>(special_points->size())},
+                            {"type", type},
+                            {"branch", b.id},
+                            {"index", static_cast<int>(i)},
+                            {"H", root.u(layout.H_index())},
+                            {"T", layout.Period(root.u)},
+                            {"status", root.located ? "located" : "bracketed"},
+                            {"precision", root.precision},
+                            {"message", root.message}};
+        j["u"] = std::vector<double>(root.u.data(), root.u.data() + root.u.size());
+        special_points->push_back(j);
+        report += fmt::format("  {} on branch {} after point {}: H = {:.12f}, T = {:.12f} ({}, precision {:.1e}){}\n",
+                              type, b.id, i, root.u(layout.H_index()), layout.Period(root.u),
+                              root.located ? "located" : "bracketed", root.precision,
+                              root.message.empty() ? "" : " " + root.message);
+        ++count;
+      }
+    }
+  }
+  if (count == 0) report += "  none\n";
+  return report;
+}
+
 }  // namespace
 
 int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
@@ -172,6 +258,11 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   // ---- 2. compute, streaming every accepted point
   ResultsWriter writer(dir, model, options_json);
   TimeBasedShooting residual_map(model, setup.integrator);  // separate cache: the engine's stays intact
+  TimeBasedShooting floquet_map(model, setup.integrator);
+  ReplayOptions replay_options;
+  replay_options.poincare.event.integrator.rtol = setup.integrator.rtol;
+  replay_options.poincare.event.integrator.atol = setup.integrator.atol;
+  std::map<int, std::vector<double>> floquet_tests, pd_tests;  // per branch, per point (NaN if undefined)
   std::map<int, int> physical_points;
   int current_branch = -1;
   const auto start_time = std::chrono::steady_clock::now();
@@ -186,6 +277,9 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     record.residual = status.ok ? r.norm() : std::nan("");
     record.newton_iterations = info.newton_iterations;
     record.step = info.step;
+    AnalyzePhysicalOrbit(model, floquet_map, replay_options, u, &record);
+    floquet_tests[info.branch_id].push_back(record.extra[kBpColumn].second);
+    pd_tests[info.branch_id].push_back(record.extra[kPdColumn].second);
     writer.AddPoint(info.branch_id, record);
     if (record.classification.physical) ++physical_points[info.branch_id];
     if (!args.quiet) {
@@ -203,7 +297,10 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
 
   // ---- 3. summary, key-frame orbits, report, figures
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
-  writer.SetSpecialPoints(SpecialPointsJson(diagram, layout));
+  nlohmann::json special_points = SpecialPointsJson(diagram, layout);
+  const std::string floquet_report =
+      LocateFloquetPoints(diagram, floquet_tests, pd_tests, floquet_map, layout, &special_points);
+  writer.SetSpecialPoints(special_points);
   int orbits = 0;
   for (const Branch& b : diagram.branches) {
     if (orbits >= sc.max_keyframe_orbits || physical_points[b.id] == 0) continue;
@@ -228,7 +325,7 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     ++orbits;
   }
   const std::string report =
-      diagram.FullReport() + fmt::format("\nwall time {:.3f} s, {} right-hand-side evaluations in {} map evaluations\n",
+      diagram.FullReport() + floquet_report + fmt::format("\nwall time {:.3f} s, {} right-hand-side evaluations in {} map evaluations\n",
                                          seconds, exploration->shooting().counters().rhs_evaluations,
                                          exploration->shooting().num_evaluations());
   writer.SetReport(report);

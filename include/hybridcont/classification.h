@@ -32,6 +32,7 @@ enum class OrbitClass {
   kMissedEvent,      // the event was crossed earlier in the phase: t_i is not the first crossing
   kMissedAnchor,     // the anchor was crossed earlier in the return segment
   kIntegrationFailed,
+  kReplayFailed,     // passed every check on u, but event-driven re-simulation from x̄_1 does not return
 };
 // Short hyphenated words used in the CSV files ("physical", "reversed-time", ...).
 std::string ToString(OrbitClass c);

@@ -18,6 +18,7 @@ std::string ToString(OrbitClass c) {
     case OrbitClass::kMissedEvent: return "missed-event";
     case OrbitClass::kMissedAnchor: return "missed-anchor";
     case OrbitClass::kIntegrationFailed: return "integration-failed";
+    case OrbitClass::kReplayFailed: return "replay-failed";
   }
   return "unknown";
 }
