@@ -1,6 +1,9 @@
 #include "model_exploration.h"
 
+#include <algorithm>
 #include <stdexcept>
+
+#include "hybridcont/classification.h"
 
 namespace hybridcont::app {
 
@@ -18,20 +21,56 @@ ExplorationOptions ScenarioExplorationOptions(const Scenario& sc) {
   return o;
 }
 
+std::string ToString(Formulation f) { return f == Formulation::kTimeBased ? "time" : "state"; }
+
+bool FromString(const std::string& text, Formulation* f) {
+  if (text == "time") *f = Formulation::kTimeBased;
+  else if (text == "state") *f = Formulation::kStateBased;
+  else return false;
+  return true;
+}
+
 ModelExploration::ModelExploration(const HybridModel& model, const Scenario& scenario,
-                                   const IntegratorOptions& integrator, ExplorationOptions options)
-    : model_(model), scenario_(scenario), shooting_(model, integrator), options_(std::move(options)) {
-  const std::vector<std::string> names = shooting_.unknown_names();
+                                   const IntegratorOptions& integrator, ExplorationOptions options,
+                                   Formulation formulation)
+    : model_(model), scenario_(scenario), integrator_(integrator), formulation_(formulation),
+      shooting_(model, integrator), options_(std::move(options)), time_options_(options_) {
+  if (const std::string why = options_.continuation.ValidateFor(shooting_.unknown_names()); !why.empty()) {
+    throw std::invalid_argument(why);
+  }
+  if (formulation_ == Formulation::kStateBased) {
+    PoincareOptions poincare;
+    poincare.event.integrator = integrator;
+    // odeint has dense output for Dormand–Prince only: event location needs it
+    poincare.event.integrator.method = IntegratorMethod::kDormandPrince54;
+    state_ = std::make_unique<StateBasedShooting>(model, poincare);
+    const auto known = [&](const std::string& name) { return state_->UnknownIndex(name) >= 0; };
+    auto& c = options_.continuation;
+    std::erase_if(c.bounds, [&](const ComponentBound& b) { return !known(b.component); });
+    std::erase_if(c.sum_bounds, [&](const SumBound& b) {
+      return std::any_of(b.components.begin(), b.components.end(), [&](const auto& n) { return !known(n); });
+    });
+    for (const ComponentTarget& t : c.targets) {
+      if (!known(t.component)) {
+        throw std::invalid_argument("target '" + t.component + "' is not an unknown of the state-based map");
+      }
+    }
+    options_.start_conditions.clear();
+  }
+  ZeroProblem& base = problem();
+  const std::vector<std::string> names = base.unknown_names();
   ContinuationOptions& c = options_.continuation;
-  if (const std::string why = c.ValidateFor(names); !why.empty()) throw std::invalid_argument(why);
-  Vector scales = Vector::Ones(shooting_.num_unknowns());
+  Vector scales = Vector::Ones(base.num_unknowns());
   for (const auto& [name, scale] : scenario_.unknown_scales) {
-    const int k = shooting_.UnknownIndex(name);
-    if (k < 0) throw std::invalid_argument("scenario scale for unknown '" + name + "', which the model lacks");
+    const int k = base.UnknownIndex(name);
+    if (k < 0) {
+      if (formulation_ == Formulation::kStateBased) continue;  // scales of durations, x̄_2.. do not apply
+      throw std::invalid_argument("scenario scale for unknown '" + name + "', which the model lacks");
+    }
     scales(k) = scale;
   }
-  scaled_ = std::make_unique<ScaledProblem>(&shooting_, scales);
-  const auto scale_of = [&](const std::string& name) { return scales(shooting_.UnknownIndex(name)); };
+  scaled_ = std::make_unique<ScaledProblem>(&base, scales);
+  const auto scale_of = [&](const std::string& name) { return scales(base.UnknownIndex(name)); };
   for (ComponentBound& b : c.bounds) b.lower /= scale_of(b.component), b.upper /= scale_of(b.component);
   for (ComponentTarget& t : c.targets) t.value /= scale_of(t.component);
   for (SumBound& b : c.sum_bounds) {
@@ -43,17 +82,66 @@ ModelExploration::ModelExploration(const HybridModel& model, const Scenario& sce
   }
   for (LinearCondition& cond : options_.start_conditions) {
     for (auto& [name, coefficient] : cond.coefficients) {
-      if (shooting_.UnknownIndex(name) < 0) throw std::invalid_argument("start condition names unknown '" + name + "'");
+      if (base.UnknownIndex(name) < 0) throw std::invalid_argument("start condition names unknown '" + name + "'");
       coefficient *= scale_of(name);  // c^T du = c^T S dv
     }
   }
   if (const std::string why = options_.Validate(); !why.empty()) throw std::invalid_argument(why);
 }
 
+ZeroProblem& ModelExploration::problem() {
+  if (state_) return *state_;
+  return shooting_;
+}
+
+EvaluationStatus ModelExploration::ToTimeBased(const Vector& u, Vector* u_time) {
+  if (!state_) {
+    *u_time = u;
+    return {};
+  }
+  return state_->ToTimeBased(u, u_time);
+}
+
+FlowCounters ModelExploration::counters() const { return state_ ? state_->counters() : shooting_.counters(); }
+
+long ModelExploration::num_evaluations() const {
+  return state_ ? state_->num_evaluations() : shooting_.num_evaluations();
+}
+
+Vector ModelExploration::FindPhysicalStart(std::string* why) {
+  // Trace the time-based scenario's branches from its start until a point is physical.
+  ExplorationOptions options = time_options_;
+  options.max_depth = 0;
+  Vector found;
+  options.continuation.stop_predicate = [&](const Vector& u) {
+    const OrbitTrace trace(model_, u, integrator_);
+    if (ClassifyOrbit(model_, u, trace, ClassificationOptions{}).physical) found = u;
+    return found.size() > 0;
+  };
+  ModelExploration time_based(model_, scenario_, integrator_, options, Formulation::kTimeBased);
+  time_based.Run();
+  if (found.size() == 0) *why = "no physical orbit on the time-based branches from the start point";
+  return found;
+}
+
 BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {
   ExplorationOptions options = options_;
+  Vector start = scenario_.start;
+  if (state_) {
+    std::string why;
+    const Vector physical = FindPhysicalStart(&why);
+    if (physical.size() == 0) {
+      BifurcationDiagram failed;
+      failed.status = ExplorationStatus::kStartFailed;
+      failed.message = "state-based formulation: " + why;
+      return failed;
+    }
+    start = state_->FromTimeBased(physical);
+  }
   ContinuationOptions& c = options.continuation;
-  const std::function<void(const ProgressInfo&)> user_progress = c.progress;
+  if (c.stop_predicate) {  // the engine sees scaled unknowns; the predicate is written for model units
+    c.stop_predicate = [this, user = c.stop_predicate](const Vector& v) { return user(scaled_->FromScaled(v)); };
+  }
   if (on_point) {
     c.progress_components.clear();  // ProgressInfo::values = all of u
     c.progress = [&](const ProgressInfo& info) {
@@ -61,7 +149,7 @@ BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {
       on_point(info, scaled_->FromScaled(v));
     };
   }
-  BifurcationDiagram diagram = Explore(scaled_.get(), scaled_->ToScaled(scenario_.start), options);
+  BifurcationDiagram diagram = Explore(scaled_.get(), scaled_->ToScaled(start), options);
   for (Branch& b : diagram.branches) {
     for (ContinuationPoint& p : b.points) {
       p.u = scaled_->FromScaled(p.u);

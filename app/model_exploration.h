@@ -15,10 +15,18 @@
 
 #include "hybridcont/exploration.h"
 #include "hybridcont/scaled_problem.h"
+#include "hybridcont/statebased_shooting.h"
 #include "hybridcont/timebased_shooting.h"
 #include "scenario.h"
 
 namespace hybridcont::app {
+
+// Time-based multiple shooting (paper eq. `timebased`, the default) or the state-based map (eq.
+// `statebased`: event-driven integration, saltation matrices, u = [x̄_1; xi; H]).
+enum class Formulation { kTimeBased, kStateBased };
+std::string ToString(Formulation f);
+// "time" / "state"; false for anything else.
+bool FromString(const std::string& text, Formulation* f);
 
 // Bounds, step sizes, depth and branch limits of the scenario.
 ExplorationOptions ScenarioExplorationOptions(const Scenario& scenario);
@@ -27,22 +35,41 @@ class ModelExploration {
  public:
   // options are in the model's units. Throws std::invalid_argument for options that do not fit the
   // model (unknown component names, invalid values).
+  // For the state-based formulation, bounds on components it lacks (durations) are dropped; the start
+  // is the first physical point of the time-based scenario (the paper's singular starts with zero
+  // durations are out of the state-based map's reach, Table `stateVStime`).
   ModelExploration(const HybridModel& model, const Scenario& scenario, const IntegratorOptions& integrator,
-                   ExplorationOptions options);
+                   ExplorationOptions options, Formulation formulation = Formulation::kTimeBased);
 
   using PointCallback = std::function<void(const ProgressInfo& info, const Vector& u)>;
-  // Explores from the scenario's start point; on_point sees every accepted point in model units.
+  // Explores from the start point; on_point sees every accepted point in model units and in the layout of
+  // the formulation's unknowns (ToTimeBased converts state-based points).
   BifurcationDiagram Run(const PointCallback& on_point = PointCallback());
 
+  // The time-based map (also used by the state-based formulation to find its start).
   TimeBasedShooting& shooting() { return shooting_; }
+  ZeroProblem& problem();
+  Formulation formulation() const { return formulation_; }
+  // A point of the formulation's layout as a time-based u (identity for the time-based formulation).
+  EvaluationStatus ToTimeBased(const Vector& u, Vector* u_time);
   const Vector& scales() const { return scaled_->scales(); }
+  // Work of the formulation's map (RHS evaluations, map evaluations).
+  FlowCounters counters() const;
+  long num_evaluations() const;
 
  private:
+  // The first physical point of the time-based scenario, or an empty vector (message in *why).
+  Vector FindPhysicalStart(std::string* why);
+
   const HybridModel& model_;
   Scenario scenario_;
+  IntegratorOptions integrator_;
+  Formulation formulation_;
   TimeBasedShooting shooting_;
+  std::unique_ptr<StateBasedShooting> state_;
   std::unique_ptr<ScaledProblem> scaled_;
   ExplorationOptions options_;  // in scaled units
+  ExplorationOptions time_options_;  // the time-based scenario's (model units), to find a state start
 };
 
 }  // namespace hybridcont::app

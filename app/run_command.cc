@@ -40,7 +40,8 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
   run->add_option("--rtol", args->rtol, "integrator relative tolerance (default 1e-10)");
   run->add_option("--atol", args->atol, "integrator absolute tolerance (default 1e-10)");
   run->add_option("--max-branches", args->max_branches, "maximum number of half-branches traced");
-  run->add_option("--formulation", args->formulation, "shooting formulation: time (default)");
+  run->add_option("--formulation", args->formulation,
+                  "time (default: time-based multiple shooting) or state (event-driven Poincare map)");
   run->add_flag("--quiet", args->quiet, "no progress lines");
   run->add_flag("--no-plots", args->no_plots, "do not draw figures");
 }
@@ -220,8 +221,9 @@ std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::ma
 int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   // ---- 1. validate all input before anything is written
   HybridModel model = MakeModelWithOverrides(args.model, args.assignments);
-  if (args.formulation != "time") {
-    throw std::invalid_argument("--formulation '" + args.formulation + "': expected 'time'");
+  Formulation formulation;
+  if (!FromString(args.formulation, &formulation)) {
+    throw std::invalid_argument("--formulation '" + args.formulation + "': expected 'time' or 'state'");
   }
   RunSetup setup;
   if (args.rtol) setup.integrator.rtol = *args.rtol;
@@ -247,7 +249,7 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   for (const auto& [name, scale] : sc.unknown_scales) options_json["unknown_scales"][name] = scale;
   std::unique_ptr<ModelExploration> exploration;
   try {
-    exploration = std::make_unique<ModelExploration>(model, sc, setup.integrator, setup.exploration);
+    exploration = std::make_unique<ModelExploration>(model, sc, setup.integrator, setup.exploration, formulation);
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(std::string(args.until.empty() ? "" : "--until: ") + e.what());
   }
@@ -266,7 +268,14 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   std::map<int, int> physical_points;
   int current_branch = -1;
   const auto start_time = std::chrono::steady_clock::now();
-  const auto on_point = [&](const ProgressInfo& info, const Vector& u) {
+  const auto on_point = [&](const ProgressInfo& info, const Vector& u_problem) {
+    // Every output uses the time-based layout (durations, x̄_i of every phase) whatever the formulation.
+    Vector u;
+    if (!exploration->ToTimeBased(u_problem, &u).ok) {
+      floquet_tests[info.branch_id].push_back(std::nan(""));  // keep per-point alignment
+      pd_tests[info.branch_id].push_back(std::nan(""));
+      return;
+    }
     PointRecord record;
     record.index = info.point_index;
     record.u = u;
@@ -292,7 +301,20 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
                          ToString(record.classification.reason));
     }
   };
-  const BifurcationDiagram diagram = exploration->Run(on_point);
+  BifurcationDiagram diagram = exploration->Run(on_point);
+  if (formulation == Formulation::kStateBased) {  // everything downstream reads the time-based layout
+    const auto convert = [&](Vector* u) {
+      Vector u_time;
+      if (u->size() && exploration->ToTimeBased(*u, &u_time).ok) *u = u_time;
+      else *u = Vector::Constant(layout.num_unknowns(), std::nan(""));
+    };
+    for (Branch& b : diagram.branches) {
+      for (ContinuationPoint& p : b.points) convert(&p.u), p.tangent.resize(0);
+      for (SpecialPoint& sp : b.special_points) convert(&sp.u), sp.interval_width.resize(0);
+    }
+    for (SpecialPoint& sp : diagram.special_points) convert(&sp.u), sp.interval_width.resize(0);
+    diagram.unknown_names = layout.unknown_names();
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
 
   // ---- 3. summary, key-frame orbits, report, figures
@@ -326,8 +348,7 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   }
   const std::string report =
       diagram.FullReport() + floquet_report + fmt::format("\nwall time {:.3f} s, {} right-hand-side evaluations in {} map evaluations\n",
-                                         seconds, exploration->shooting().counters().rhs_evaluations,
-                                         exploration->shooting().num_evaluations());
+                                         seconds, exploration->counters().rhs_evaluations, exploration->num_evaluations());
   writer.SetReport(report);
   writer.WriteSummary();
   out << report;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -114,6 +115,82 @@ TEST(Cli, RunBouncingBallWritesClassifiedBranchesThatMatchTheClosedForm) {
   EXPECT_GT(reversed, 10);
   EXPECT_GT(at_rest, 10);
   EXPECT_LT(worst, 1e-9);  // T = sqrt(8 H) on every physical point
+}
+
+}  // namespace
+}  // namespace hybridcont::app
+
+namespace hybridcont::app {
+namespace {
+
+std::vector<std::map<std::string, std::string>> ReadCsv(const fs::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  {
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) header.push_back(cell);
+  }
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::map<std::string, std::string> row;
+    std::size_t i = 0;
+    for (std::string cell; std::getline(ss, cell, ',') && i < header.size(); ++i) row[header[i]] = cell;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// Issue 5: the state-based formulation traces the same normal orbits (T(H) of the ball's family).
+TEST(Cli, StateBasedBallAgreesWithTheClosedForm) {
+  const fs::path dir = TempDir("ball_state");
+  const CliResult r = RunTool({"run", "bouncing-ball", "--formulation", "state", "--out", dir.string(), "--quiet",
+                               "--no-plots"});
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  std::ifstream summary_file(dir / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  int physical = 0;
+  double worst = 0.0, worst_replay = 0.0;
+  for (const auto& b : summary["branches"]) {
+    for (const auto& row : ReadCsv(dir / b["file"].get<std::string>())) {
+      if (row.at("physical") != "1") continue;
+      ++physical;
+      worst = std::max(worst, std::abs(std::stod(row.at("T")) - std::sqrt(8.0 * std::stod(row.at("H")))));
+      worst_replay = std::max(worst_replay, std::stod(row.at("replay_error")));
+      EXPECT_EQ(row.at("stable"), "1");  // the ball's orbits are neutrally stable: multipliers all 1
+    }
+  }
+  EXPECT_GT(physical, 5);
+  EXPECT_LT(worst, 1e-8);
+  EXPECT_LT(worst_replay, 1e-8);
+}
+
+// Issue 5: the SB points of the hopping-in-place branch are the +1 crossings of the Floquet multipliers,
+// for both formulations.
+TEST(Cli, SlipSimpleBifurcationsAreFloquetCrossingsInBothFormulations) {
+  for (const char* formulation : {"time", "state"}) {
+    const fs::path dir = TempDir(std::string("slip_") + formulation);
+    const CliResult r = RunTool({"run", "slip", "--formulation", formulation, "--out", dir.string(), "--quiet",
+                                 "--no-plots", "--max-branches", "4"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::ifstream summary_file(dir / "summary.json");
+    const nlohmann::json summary = nlohmann::json::parse(summary_file);
+    std::vector<double> sb, bp;
+    for (const auto& sp : summary["special_points"]) {
+      if (sp["type"] == "SB" && sp["status"] == "located") sb.push_back(sp["H"]);
+      if (sp["type"] == "BP") bp.push_back(sp["H"]);
+    }
+    // the first SB above the start, located by continuation, and the first BP (multiplier +1)
+    const auto near = [](const std::vector<double>& v, double x) {
+      double best = 1e9;
+      for (double y : v) best = std::min(best, std::abs(y - x));
+      return best;
+    };
+    EXPECT_LT(near(sb, 1.24674011004), 1e-9) << formulation;
+    EXPECT_LT(near(bp, 1.24674011004), 1e-9) << formulation;
+  }
 }
 
 }  // namespace
