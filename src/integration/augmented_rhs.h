@@ -18,6 +18,8 @@ struct AugmentedRhsWorkspace {
   int n = 0;
   int k = 0;
   bool sensitivities = false;
+  // Include the xi·d2H term in A (see PhaseFlow::Integrate for when it may be dropped).
+  bool hessian_term = true;
   long rhs_evaluations = 0;
   bool nonfinite = false;
   double nonfinite_time = 0.0;
@@ -31,6 +33,7 @@ struct AugmentedRhsWorkspace {
     n = p.dim();
     k = p.num_first_integrals();
     sensitivities = with_sensitivities;
+    hessian_term = true;
     rhs_evaluations = 0;
     nonfinite = false;
     nonfinite_time = 0.0;
@@ -52,7 +55,8 @@ struct AugmentedRhsWorkspace {
   void Evaluate(const Vector& z, Vector& dz, double t) {
     ++rhs_evaluations;
     dz.resize(z.size());
-    phase->UnfoldedVectorField(z.head(n), xi, &f, sensitivities ? &A : nullptr, sensitivities ? &B : nullptr);
+    phase->UnfoldedVectorField(z.head(n), xi, &f, sensitivities ? &A : nullptr, sensitivities ? &B : nullptr,
+                               hessian_term);
     if (!f.allFinite() || (sensitivities && (!A.allFinite() || !B.allFinite()))) {
       if (!nonfinite) nonfinite_time = t;
       nonfinite = true;

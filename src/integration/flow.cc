@@ -6,6 +6,8 @@
 #include <boost/numeric/odeint.hpp>
 #include <boost/numeric/odeint/external/eigen/eigen.hpp>
 
+#include "integration/augmented_rhs.h"
+
 namespace hybridcont {
 
 namespace odeint = boost::numeric::odeint;
@@ -60,54 +62,13 @@ using Rkf78 = odeint::runge_kutta_fehlberg78<State, double, State, double, odein
 using ControlledDopri5 = odeint::controlled_runge_kutta<Dopri5>;
 using ControlledRkf78 = odeint::controlled_runge_kutta<Rkf78>;
 
-// The augmented right-hand side [f~; A Phi; A Psi + B], with z = [x; vec(Phi); vec(Psi)].
-struct AugmentedSystem {
-  const Phase* phase;
-  const Vector* xi;
-  int n;
-  int k;
-  bool sensitivities;
-  bool hessian_term;
-  long* rhs_evaluations;
-  bool* nonfinite;
-  double* nonfinite_time;
-  // scratch, sized once per integration
-  Vector* f;
-  Matrix* A;
-  Matrix* B;
-
-  void operator()(const State& z, State& dz, double t) const {
-    ++*rhs_evaluations;
-    dz.resize(z.size());
-    phase->UnfoldedVectorField(z.head(n), *xi, f, sensitivities ? A : nullptr, sensitivities ? B : nullptr,
-                               hessian_term);
-    if (!f->allFinite() || (sensitivities && (!A->allFinite() || !B->allFinite()))) {
-      if (!*nonfinite) *nonfinite_time = t;
-      *nonfinite = true;
-      dz.setZero();  // keep the stepper's arithmetic finite; the driver loop reports the failure
-      return;
-    }
-    dz.head(n) = *f;
-    if (!sensitivities) return;
-    Eigen::Map<const Matrix> Phi(z.data() + n, n, n);
-    Eigen::Map<Matrix> dPhi(dz.data() + n, n, n);
-    dPhi.noalias() = *A * Phi;
-    Eigen::Map<const Matrix> Psi(z.data() + n + n * n, n, k);
-    Eigen::Map<Matrix> dPsi(dz.data() + n + n * n, n, k);
-    dPsi.noalias() = *A * Psi;
-    dPsi += *B;
-  }
-};
-
 }  // namespace
 
 struct PhaseFlow::Steppers {
   ControlledDopri5 dopri5;
   ControlledRkf78 rkf78;
   State z;
-  Vector f;
-  Matrix A, B;
-  Vector xi;
+  internal::AugmentedRhsWorkspace rhs;
   Steppers(double atol, double rtol)
       : dopri5(odeint::default_error_checker<double, odeint::vector_space_algebra, odeint::default_operations>(atol, rtol)),
         rkf78(odeint::default_error_checker<double, odeint::vector_space_algebra, odeint::default_operations>(atol, rtol)) {}
@@ -126,34 +87,30 @@ FlowStatus PhaseFlow::Integrate(const Eigen::Ref<const Vector>& x0, const Eigen:
 
 FlowStatus PhaseFlow::Integrate(const Eigen::Ref<const Vector>& x0, const Eigen::Ref<const Vector>& xi, double t,
                                 bool with_sensitivities, PhaseFlowResult* result, const Observer& observer) {
-  const int n = phase_->dim();
-  const int k = phase_->num_first_integrals();
   Steppers& s = *steppers_;
+  internal::AugmentedRhsWorkspace& w = s.rhs;
+  w.Start(*phase_, xi, with_sensitivities);
+  const int n = w.n;
+  const int k = w.k;
   result->counters = FlowCounters();
   result->message.clear();
   result->status = FlowStatus::kSuccess;
 
-  const int size = with_sensitivities ? n + n * n + n * k : n;
   State& z = s.z;
-  z.resize(size);
-  z.head(n) = x0;
-  if (with_sensitivities) {
-    Eigen::Map<Matrix>(z.data() + n, n, n).setIdentity();
-    Eigen::Map<Matrix>(z.data() + n + n * n, n, k).setZero();
-  }
-  s.xi = xi;
+  w.InitialState(x0, &z);
 
   auto finish = [&](FlowStatus status, std::string message) {
+    result->counters.rhs_evaluations = w.rhs_evaluations;
     result->status = status;
     result->message = std::move(message);
     result->x = z.head(n);
     if (with_sensitivities) {
-      result->Phi = Eigen::Map<const Matrix>(z.data() + n, n, n);
-      result->Psi = Eigen::Map<const Matrix>(z.data() + n + n * n, n, k);
+      result->Phi = w.Phi(z);
+      result->Psi = w.Psi(z);
     }
     return status;
   };
-  if (!z.head(n).allFinite() || !s.xi.allFinite()) {
+  if (!z.head(n).allFinite() || !w.xi.allFinite()) {
     return finish(FlowStatus::kNonFinite, "phase '" + phase_->name() + "': non-finite initial state or xi");
   }
   if (!std::isfinite(t)) {
@@ -167,21 +124,17 @@ FlowStatus PhaseFlow::Integrate(const Eigen::Ref<const Vector>& x0, const Eigen:
   // nested-jet Hessians it needs were ~40% of a SLIP exploration. It is dropped only when, at x0,
   // |xi| |d2H| <= 1e-3 rtol max(|df|, 1): the Jacobian stays exact to the integration tolerance, and any
   // sizable xi (the at-rest branches, the derivative checks) keeps the exact term.
-  bool hessian_term = true;
-  if (with_sensitivities && (s.xi.array() != 0.0).any()) {
+  if (with_sensitivities && (w.xi.array() != 0.0).any()) {
     Vector H;
     Matrix df, dH;
     std::vector<Matrix> d2H;
-    phase_->VectorField(z.head(n), &s.f, &df);
+    phase_->VectorField(z.head(n), &w.f, &df);
     phase_->FirstIntegrals(z.head(n), &H, &dH, &d2H);
     double hessian_norm = 0.0;
-    for (int j = 0; j < k; ++j) hessian_norm += std::abs(s.xi(j)) * d2H[j].cwiseAbs().maxCoeff();
-    hessian_term = hessian_norm > 1e-3 * options_.rtol * std::max(df.cwiseAbs().maxCoeff(), 1.0);
+    for (int j = 0; j < k; ++j) hessian_norm += std::abs(w.xi(j)) * d2H[j].cwiseAbs().maxCoeff();
+    w.hessian_term = hessian_norm > 1e-3 * options_.rtol * std::max(df.cwiseAbs().maxCoeff(), 1.0);
   }
-  bool nonfinite = false;
-  double nonfinite_time = 0.0;
-  AugmentedSystem system{phase_, &s.xi, n, k, with_sensitivities, hessian_term, &result->counters.rhs_evaluations,
-                         &nonfinite, &nonfinite_time, &s.f, &s.A, &s.B};
+  const internal::AugmentedRhs system{&w};
   const double direction = t > 0.0 ? 1.0 : -1.0;
   double time = 0.0;
   double dt = direction * std::min(std::abs(t), options_.initial_step);
@@ -202,10 +155,10 @@ FlowStatus PhaseFlow::Integrate(const Eigen::Ref<const Vector>& x0, const Eigen:
     } else {
       step_result = s.rkf78.try_step(system, z, time, dt);
     }
-    if (nonfinite || !z.allFinite()) {
+    if (w.nonfinite || !z.allFinite()) {
       std::ostringstream os;
       os << "phase '" << phase_->name() << "': model returned a non-finite value at t = "
-         << (nonfinite ? nonfinite_time : time) << " (duration " << t << ")";
+         << (w.nonfinite ? w.nonfinite_time : time) << " (duration " << t << ")";
       return finish(FlowStatus::kNonFinite, os.str());
     }
     if (step_result == odeint::success) {
