@@ -343,7 +343,7 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     if (best < 0) continue;
     const Vector& u = b.points[best].u;
     const OrbitTrace trace(model, u, setup.integrator);
-    writer.AddOrbit(trace, b.id, best, u(layout.H_index()), layout.Period(u), "branch " + std::to_string(b.id));
+    writer.AddOrbit(trace, b.id, best, u(layout.H_index()), layout.Period(u), sc.describe(u));
     ++orbits;
   }
   const std::string report =

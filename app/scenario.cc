@@ -19,6 +19,8 @@ std::vector<std::string> Durations(const HybridModel& model) {
 Scenario DefaultScenario(const HybridModel& model) {
   Scenario s;
   s.start = BuiltinStartPoint(model);
+  const ShootingLayout layout(model);
+  s.describe = [](const Vector&) { return std::string("periodic orbit"); };
   // |xi| <= 1 ends the at-rest xi-branches through the equilibria (they exist for every xi).
   s.bounds.push_back({"xi", -1.0, 1.0});
   const std::string& name = model.name();
@@ -47,6 +49,12 @@ Scenario DefaultScenario(const HybridModel& model) {
     s.sum_bounds.push_back({Durations(model), -10.0, 10.0});
     s.start_conditions.push_back({{{"t2", 1.0}, {"t1", -1.0}, {"t3", -1.0}}, "t2 = t1 + t3"});
     s.keyframes = {"T", 0.8};
+    s.describe = [layout](const Vector& u) {
+      const double asymmetry = u(layout.time_index(1)) - u(layout.time_index(0)) - u(layout.time_index(2));
+      return std::string(std::abs(asymmetry) < 1e-6 ? "symmetric orbit (t2 = t1 + t3)"
+                                                    : asymmetry > 0 ? "non-symmetric orbit (t2 > t1 + t3)"
+                                                                    : "non-symmetric orbit (t2 < t1 + t3)");
+    };
     // dalpha = sqrt(2H)/r ~ 100 would dominate every norm of u; r * dalpha is O(1) (an energy-like
     // velocity), and durations are O(0.1).
     for (int i = 1; i <= model.num_phases() + 1; ++i) {
@@ -56,6 +64,10 @@ Scenario DefaultScenario(const HybridModel& model) {
     s.bounds.push_back({"H", 0.0, 2.0});
     s.sum_bounds.push_back({Durations(model), -20.0, 20.0});
     s.keyframes = {"H", 1.8};
+    s.describe = [layout](const Vector& u) {
+      const double dx = u(layout.state_offset(1) + 2);  // x2_dx: forward speed in flight
+      return std::string(std::abs(dx) < 1e-6 ? "hopping in place" : dx > 0 ? "forward hopping" : "backward hopping");
+    };
   } else {
     throw std::invalid_argument("model '" + name + "' has no default run scenario");
   }

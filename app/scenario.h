@@ -9,6 +9,7 @@
 #ifndef HYBRIDCONT_APP_SCENARIO_H_
 #define HYBRIDCONT_APP_SCENARIO_H_
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,8 @@ struct Scenario {
   std::vector<std::pair<std::string, double>> unknown_scales;
   KeyframeTarget keyframes{"H", 0.5};
   int max_keyframe_orbits = 4;
+  // A short description of a physical orbit u (time-based layout) for figure titles.
+  std::function<std::string(const Vector& u)> describe;
 };
 
 // Throws std::invalid_argument for a model without a paper scenario.
