@@ -7,6 +7,7 @@
 //   build/bench/hybridcont_bench --benchmark_filter=FullRun
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <map>
 
 #include "hybridcont/corrector.h"
@@ -119,6 +120,37 @@ void BM_FullRun(benchmark::State& state) {
   state.counters["rhs_over_floor"] = static_cast<double>(rhs) / (floor_rhs * static_cast<double>(points));
 }
 BENCHMARK(BM_FullRun)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace
+}  // namespace hybridcont::app
+
+namespace hybridcont::app {
+namespace {
+
+// Scaling in the number of phases (issue 6): one corrector solve on the ball-chain with m phases from a
+// perturbed closed-form orbit; reported per Newton iteration (an r + dr evaluation and a bordered solve).
+void BM_ScalingNewtonStep(benchmark::State& state) {
+  const int m = static_cast<int>(state.range(0));
+  const HybridModel chain = MakeBallChain(m);
+  TimeBasedShooting shooting(chain, IntegratorOptions{});
+  const Vector exact = BallChainOrbit(chain, 0.5);
+  Vector guess = exact;
+  for (int i = 0; i < guess.size() - 2; ++i) guess(i) += 1e-4 * std::sin(1.0 + i);
+  Corrector corrector(&shooting);
+  Vector u;
+  long iterations = 0;
+  for (auto _ : state) {
+    const CorrectorResult r = corrector.CorrectFixedComponent(guess, shooting.layout().H_index(), 0.5, &u);
+    if (!r.converged()) state.SkipWithError(r.message.c_str());
+    iterations += r.iterations;
+  }
+  state.counters["N"] = shooting.num_equations();
+  state.counters["newton_iterations"] =
+      benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
+  state.counters["seconds_per_newton_step"] = benchmark::Counter(
+      static_cast<double>(iterations), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_ScalingNewtonStep)->Arg(1)->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace hybridcont::app

@@ -62,7 +62,7 @@ TEST(TimeBasedShooting, SlipHoppingInPlaceIsAZero) {
 }
 
 TEST(TimeBasedShooting, PaperStartPointsAreSingularZeros) {
-  for (const std::string& name : BuiltinModelNames()) {
+  for (const std::string name : {"bouncing-ball", "rocking-block", "bouncing-rod", "slip"}) {
     const HybridModel model = MakeBuiltinModel(name);
     TimeBasedShooting shooting(model, IntegratorOptions{});
     const Vector u0 = BuiltinStartPoint(model);

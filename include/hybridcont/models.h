@@ -34,6 +34,12 @@ HybridModel MakeRockingBlock();
 HybridModel MakeBouncingRod();
 HybridModel MakeSlip();
 
+// The scalable test model "ball-chain": a ball bouncing num_phases times per period, one phase per bounce
+// (the registry builds it with 10 phases). BallChainOrbit is its closed-form orbit at level H (period
+// 2 num_phases sqrt(2H/g) for m = 1).
+HybridModel MakeBallChain(int num_phases);
+Vector BallChainOrbit(const HybridModel& chain, double H);
+
 }  // namespace hybridcont
 
 #endif  // HYBRIDCONT_MODELS_H_

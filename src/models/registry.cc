@@ -19,6 +19,7 @@ const std::vector<Entry>& Registry() {
       {"rocking-block", &MakeRockingBlock},
       {"bouncing-rod", &MakeBouncingRod},
       {"slip", &MakeSlip},
+      {"ball-chain", [] { return MakeBallChain(10); }},
   };
   return entries;
 }
@@ -57,6 +58,7 @@ Vector BuiltinStartPoint(const HybridModel& model) {
     u(layout.state_offset(2) + 1) = l0;                    // x3_l
     u(layout.H_index()) = m * g * l0;
   }
+  if (model.name() == "ball-chain") return BallChainOrbit(model, 0.5);  // a regular point
   return u;  // equilibria at H = 0 for the ball, the block and the rod
 }
 
