@@ -27,6 +27,20 @@
 // [σ_lo, σ_hi] is narrower than location_tolerance (status kLocated) or when a trial point cannot be
 // corrected / the iteration budget is spent (status kBracketed: the interval is still reported).
 //
+// Located to the noise level (shooting maps, residual noise ~1e-12..1e-10): next to an SB point the
+// bordered matrix [dr; τ_aᵀ] is singular for every border (rank dr = N − 1 at the SB), so Newton amplifies
+// the residual noise along the second kernel direction, and a trial point either leaves the bracket or
+// lands on the crossing branch (a correction longer than a quarter of the bracket width counts as failed).
+// When such a trial point's interpolant already has a residual at the corrector's tolerance, the curve
+// cannot be resolved further on the bracket's scale: the point counts as located, `message` says "located
+// to the noise level", and precision() is the bracket width reached (e.g. ~2e-8 in arclength for the
+// bouncing rod's SB, not location_tolerance).
+//
+// Tangent of an SB point: the induced tangent is undefined there and next to it numerically meaningless
+// when dr is noisy (it mixes the two branch directions). SpecialPoint::tangent is the estimate's induced
+// tangent only when it lies within the cone of the regular tangents at the bracketing points, otherwise
+// their interpolation: branch switching identifies the incoming ABE root by this tangent.
+//
 // Tiny example (pitchfork x³ − λx traced along x = 0 from λ = −1):
 //
 //   Branch branch = TraceBranch(&pitchfork, u0, options);
@@ -66,7 +80,7 @@ struct SpecialPoint {
   std::string component;       // turning points: the unknown that turns; empty otherwise
   int component_index = -1;
   Vector u;                    // best estimate of the point
-  Vector tangent;              // tangent of the branch at u (for SB points: limit from the incoming side)
+  Vector tangent;              // tangent of the branch at u (SB points: see "Tangent of an SB point")
   Vector tangent_before;       // tangent at branch point [index]
   Vector tangent_after;        // tangent at branch point [index + 1]
   double test_value = 0;       // test function at u (normalized determinant or τ_k)

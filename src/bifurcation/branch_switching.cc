@@ -244,7 +244,8 @@ BranchSwitch SwitchDirectionAt(ZeroProblem* problem, const SpecialPoint& sb, con
   const Matrix kernel = svd.matrixV().rightCols(2);
   const Matrix cokernel = svd.matrixU().rightCols(1);
   // Basis φ₁ ∥ (incoming tangent projected on the kernel), φ₂ ⟂ φ₁ in the kernel.
-  // The tangent at the located point (the limit from the incoming side), else the last one before it.
+  // The tangent at the located point (special_point.h: never the meaningless induced tangent next to the
+  // SB), else the last one before it.
   const Vector incoming = sb.tangent.size() == n && sb.tangent.allFinite() ? sb.tangent : sb.tangent_before;
   Eigen::Vector2d c1 = kernel.transpose() * incoming;
   if (!(c1.norm() > 0)) c1 = Eigen::Vector2d(1, 0);

@@ -2,10 +2,20 @@
 
 #include <Eigen/QR>
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <utility>
 
 namespace hybridcont::internal {
+namespace {
+
+std::string FormatShort(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3g", value);
+  return text;
+}
+
+}  // namespace
 
 Vector KernelByQR(const Matrix& dr) {
   const Eigen::Index n = dr.cols();
@@ -58,26 +68,58 @@ bool Segment::Evaluate(double sigma, const Probe& left, double sigma_left, const
   const double t = (sigma - sigma_left) / w;
   const double h00 = (1 + 2 * t) * (1 - t) * (1 - t), h10 = t * (1 - t) * (1 - t);
   const double h01 = t * t * (3 - 2 * t), h11 = t * t * (t - 1);
-  // du/dσ = τ / (τ_a·τ) along the curve.
-  const Vector predictor = h00 * left.u + h01 * right.u +
-                           (h10 * w / a_.tangent.dot(left.tangent)) * left.tangent +
-                           (h11 * w / a_.tangent.dot(right.tangent)) * right.tangent;
-  const double saved_distance = corrector_->options().max_distance;
-  corrector_->set_max_distance((b_.u - a_.u).norm() + 1e-12);
-  const CorrectorResult result = corrector_->CorrectPseudoArclength(predictor, a_.tangent, &probe->u);
-  corrector_->set_max_distance(saved_distance);
+  // du/dσ = τ / (τ_a·τ) along the curve. The interpolant is accurate to O(w⁴): a correction of a quarter
+  // of the bracket width is not a correction but a jump — next to an SB point to the crossing branch,
+  // which meets the hyperplane close to the parent branch (at distance ~ sqrt(|σ − σ*|) for a pitchfork).
+  auto correct = [&](const Vector& tangent_left, const Vector& tangent_right, Vector* predictor) {
+    *predictor = h00 * left.u + h01 * right.u + (h10 * w / a_.tangent.dot(tangent_left)) * tangent_left +
+                 (h11 * w / a_.tangent.dot(tangent_right)) * tangent_right;
+    const double saved_distance = corrector_->options().max_distance;
+    corrector_->set_max_distance(0.25 * w + kDistanceFloor * (1 + predictor->norm()));
+    const CorrectorResult result = corrector_->CorrectPseudoArclength(*predictor, a_.tangent, &probe->u);
+    corrector_->set_max_distance(saved_distance);
+    return result;
+  };
+  Vector predictor;
+  const CorrectorResult result =
+      correct(ReliableTangent(left, sigma_left), ReliableTangent(right, sigma_right), &predictor);
+  probe->noise_limited = false;
   if (!result.converged()) {
     *message = "trial point at sigma = " + std::to_string(sigma) + " not corrected: " + result.BriefReport();
+    // Next to an SB point the bordered matrix is singular for every border (rank dr = N − 1 there), and
+    // Newton amplifies the residual noise of a shooting map (~1e-12) along the second kernel direction.
+    // When the interpolant's residual is already at the corrector's tolerance, the failure says that the
+    // curve cannot be resolved on the scale of the bracket: the bracket is as good as the noise allows.
+    Vector r;
+    if (const EvaluationStatus status = problem_->Evaluate(predictor, &r, nullptr);
+        status.ok && r.norm() <= corrector_->options().residual_tolerance) {
+      probe->noise_limited = true;
+      probe->residual = r.norm();
+    }
     return false;
   }
   probe->residual = result.residual_norm;
-  if (!InducedTangent(solver_, corrector_->jacobian(), a_.tangent, &probe->tangent, nullptr,
-                      &probe->sb_test, &log_row_scale_)) {
+  if (!InducedTangent(solver_, corrector_->jacobian(), a_.tangent, &probe->tangent, nullptr, &probe->sb_test,
+                      &log_row_scale_)) {
     // Exactly on a singular point: the test function is zero there, the tangent is the incoming one.
     probe->tangent = a_.tangent;
     probe->sb_test = 0;
   }
   return true;
+}
+
+Vector Segment::ReliableTangent(const Probe& probe, double sigma) const {
+  if (!with_sb_test_) return probe.tangent;
+  Vector interpolated = InterpolatedTangent(sigma);
+  // The tangent of a smooth arc between a and b deviates from the interpolation by far less than half
+  // the angle between τ_a and τ_b; a probe tangent outside that cone is the numerical artefact.
+  const double cone = 0.5 * AngleBetween(a_.tangent, b_.tangent) + kTangentNoise;
+  return AngleBetween(probe.tangent, interpolated) <= cone ? probe.tangent : interpolated;
+}
+
+Vector Segment::InterpolatedTangent(double sigma) const {
+  const double theta = sigma_b_ != 0 ? std::clamp(sigma / sigma_b_, 0.0, 1.0) : 0.0;
+  return ((1 - theta) * a_.tangent + theta * b_.tangent).normalized();
 }
 
 bool Segment::EndProbe(bool at_b, Probe* probe, std::string* message) {
@@ -159,8 +201,15 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
       }
     }
     if (!corrected) {
-      out.message = message;
       out.iterations = it;
+      if (probe.noise_limited) {
+        out.noise_limited = true;
+        out.message = "located to the noise level: the trial point inside the bracket has |r| = " +
+                      FormatShort(probe.residual) + " before any correction, but Newton's correction of that " +
+                      "residual leaves the bracket (the bracket width is the precision)";
+        return finish(true);
+      }
+      out.message = message;
       return finish(false);
     }
     out.iterations = it;

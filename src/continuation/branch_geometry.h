@@ -45,7 +45,12 @@ class Segment {
     // a row of dr vanishes at the SB point (N = 1: dr itself vanishes there).
     double sb_test = 0;
     double residual = 0;
+    // Set when Evaluate fails although the interpolant's residual is already at the corrector's
+    // tolerance: Newton's correction of that residual noise leaves the bracket (next to an SB point).
+    bool noise_limited = false;
   };
+  // Absolute part of the largest accepted correction of a trial point, · (1 + ||u||).
+  static constexpr double kDistanceFloor = 1e-12;
   // with_sb_test: evaluate dr at a (and b) once for the scale of Probe::sb_test; otherwise sb_test is 0.
   Segment(Corrector* corrector, BorderedSolver* solver, ZeroProblem* problem, const ContinuationPoint& a,
           const ContinuationPoint& b, bool with_sb_test);
@@ -53,10 +58,22 @@ class Segment {
   // interpolant of the two bracketing probes in σ (error O(width⁴); it lies on the hyperplane
   // τ_aᵀ(u − u_a) = σ because the cubic Hermite interpolant of a linear function is exact). Corrector:
   // pseudo-arclength on that hyperplane. Near an SB point the Newton basin shrinks like the distance to
-  // it, which a chord predictor (error O(width²)) would miss. Returns false (and sets *message) if the
-  // trial point cannot be corrected.
+  // it, which a chord predictor (error O(width²)) would miss. A correction longer than a quarter of the
+  // bracket width counts as a failure (a jump to the crossing branch). Returns false (and sets *message)
+  // if the trial point cannot be corrected; probe->noise_limited then says whether the interpolant's
+  // residual was already at the corrector's tolerance (the curve is not resolved on the bracket's scale).
   bool Evaluate(double sigma, const Probe& left, double sigma_left, const Probe& right, double sigma_right,
                 Probe* probe, std::string* message);
+  // The regular tangents at a and b, linearly interpolated in σ and normalized: accurate to O(σ_b · angle
+  // between them). Near an SB point the induced tangent is not (dr has a second singular value near zero,
+  // and the computed kernel mixes the two branch directions), so this is the SB point's tangent.
+  Vector InterpolatedTangent(double sigma) const;
+  // The tangent used by the interpolant at a probe: its own (induced) tangent when it lies in the cone
+  // of the interpolated one (half the angle between τ_a and τ_b, plus kTangentNoise), else the
+  // interpolated tangent. Only SB segments check; elsewhere every induced tangent is reliable.
+  Vector ReliableTangent(const Probe& probe, double sigma) const;
+  // Angle (radians) by which the integrator noise may turn a correct induced tangent.
+  static constexpr double kTangentNoise = 1e-6;
   double sigma_b() const { return sigma_b_; }
   const ContinuationPoint& a() const { return a_; }
   const ContinuationPoint& b() const { return b_; }
@@ -84,6 +101,10 @@ struct RootLocation {
   Vector u_lo, u_hi;          // curve points at the bracket ends
   double test = 0;
   int iterations = 0;
+  // Located to the noise level: a trial point inside the bracket had a residual at the corrector's
+  // tolerance already, yet Newton's correction of it left the bracket (Segment::Evaluate). The bracket,
+  // between corrected points with test values of opposite sign, is then the honest precision.
+  bool noise_limited = false;
   std::string message;        // why only bracketed
 };
 

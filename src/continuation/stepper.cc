@@ -343,6 +343,12 @@ class ContinuationStepper::Impl {
       if (k >= 0) point.component = names_[k];
       point.u = root.estimate.u;
       point.tangent = root.estimate.tangent;
+      if (type == SpecialPointType::kSimpleBifurcation) {
+        // The induced tangent is undefined at an SB point, and next to it can be numerically meaningless
+        // (dr has a second near-zero singular value, so a noisy dr mixes both branch directions in the
+        // computed kernel). Kept only inside the cone of the bracketing points' regular tangents.
+        point.tangent = segment.ReliableTangent(root.estimate, root.sigma);
+      }
       point.tangent_before = a.tangent;
       point.tangent_after = b.tangent;
       point.test_value = root.test;
