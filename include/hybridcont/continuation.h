@@ -10,7 +10,9 @@
 //                   f = max( sqrt(κ/κ̃), sqrt(δ/δ̃), α/α̃ )        (κ̃, δ̃, α̃ the nominal values)
 //               rejects the step when f > 2 (retry with h/2) and otherwise sets h ← h / max(f, 1/2),
 //               clamped to [min_step, max_step]. A failed corrector also halves h; below min_step the
-//               branch ends with kStepTooSmall and keeps its points.
+//               branch ends with kStepTooSmall and keeps its points. κ is the smaller of the step and the
+//               residual contraction (corrector.h; 0 when the predictor's residual is already at the
+//               corrector's tolerance), and h does not grow on the step after a rejection.
 //
 // The tangent is the solution of the bordered system [dr(uⁱ⁺¹); τⁱᵀ] v = e_{N+1}, normalized: its last
 // equation τⁱᵀv = 1 is the continuous orientation, so the curve passes straight through simple

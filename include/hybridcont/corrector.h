@@ -50,7 +50,7 @@ namespace hybridcont {
 enum class CorrectorStatus {
   kConverged,         // residual and step tests met
   kMaxIterations,     // still iterating after max_iterations Newton steps
-  kDiverged,          // steps grew, the iterate left max_distance, or a value became NaN/Inf
+  kDiverged,          // steps and residual grew, the iterate left max_distance, or a value became NaN/Inf
   kSingular,          // the bordered matrix [dr; bᵀ] is numerically singular
   kEvaluationFailed,  // ZeroProblem::Evaluate reported a failure (message copied)
 };
@@ -74,7 +74,10 @@ struct CorrectorOptions {
   // Last Newton step ||Δ||₂ / (1 + ||u||₂). With quadratic convergence the error after a step of 1e-10 is
   // ~1e-20, so accepted points are accurate to the rounding level.
   double step_tolerance = 1e-10;
-  // A step ratio ||Δ_{k+1}|| / ||Δ_k|| above this is divergence: Newton inside its basin contracts.
+  // A step ratio ||Δ_{k+1}|| / ||Δ_k|| above this, with a residual that did not decrease either, is
+  // divergence: Newton inside its basin contracts. (Steps alone may grow once: a first step overshooting
+  // along a nearly singular direction of the bordered matrix is taken back by the second, while the
+  // residual drops — the bouncing rod next to its SB point; max_iterations still bounds that case.)
   double max_contraction = 1.0;
   // ||u − u_pred||₂ above this is divergence: keeps the corrector from jumping to another branch.
   // The stepper sets it per step (a multiple of the step length); infinite for a bare corrector.
@@ -94,6 +97,12 @@ struct CorrectorResult {
   // Allgower–Georg contraction estimate κ = ||Δ₁|| / ||Δ₀|| (0 when Newton stopped after one step): the
   // step controller's main signal.
   double contraction = 0;
+  // The same in the residual: ||F(u₁)|| / ||F(u₀)|| (affine contravariant, Deuflhard §2.2; 0 when Newton
+  // stopped at u₀). Unlike κ it does not see a first step that overshoots along a nearly singular
+  // direction of the bordered matrix and the second step that takes the overshoot back (|Δ₁| ≈ |Δ₀|
+  // although Newton converges): the residual of that overshoot is small.
+  double residual_contraction = 0;
+  double predictor_residual_norm = 0;  // ||F(u₀)||₂ at the predictor
   double distance = 0;        // ||u − u_pred||₂ at the returned u
 
   bool converged() const { return status == CorrectorStatus::kConverged; }

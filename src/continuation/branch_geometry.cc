@@ -74,15 +74,16 @@ bool Segment::Evaluate(double sigma, const Probe& left, double sigma_left, const
   auto correct = [&](const Vector& tangent_left, const Vector& tangent_right, Vector* predictor) {
     *predictor = h00 * left.u + h01 * right.u + (h10 * w / a_.tangent.dot(tangent_left)) * tangent_left +
                  (h11 * w / a_.tangent.dot(tangent_right)) * tangent_right;
-    const double saved_distance = corrector_->options().max_distance;
-    corrector_->set_max_distance(0.25 * w + kDistanceFloor * (1 + predictor->norm()));
-    const CorrectorResult result = corrector_->CorrectPseudoArclength(*predictor, a_.tangent, &probe->u);
-    corrector_->set_max_distance(saved_distance);
-    return result;
+    return CorrectFrom(*predictor, 0.25 * w, probe);
   };
   Vector predictor;
-  const CorrectorResult result =
-      correct(ReliableTangent(left, sigma_left), ReliableTangent(right, sigma_right), &predictor);
+  CorrectorResult result;
+  if (with_sb_test_ && nodes_.size() >= 4) {
+    predictor = InterpolateNodes(sigma);
+    result = CorrectFrom(predictor, 0.25 * w, probe);
+  } else {
+    result = correct(ReliableTangent(left, sigma_left), ReliableTangent(right, sigma_right), &predictor);
+  }
   probe->noise_limited = false;
   if (!result.converged()) {
     *message = "trial point at sigma = " + std::to_string(sigma) + " not corrected: " + result.BriefReport();
@@ -99,6 +100,7 @@ bool Segment::Evaluate(double sigma, const Probe& left, double sigma_left, const
     return false;
   }
   probe->residual = result.residual_norm;
+  if (with_sb_test_) nodes_.push_back({sigma, probe->u});
   if (!InducedTangent(solver_, corrector_->jacobian(), a_.tangent, &probe->tangent, nullptr, &probe->sb_test,
                       &log_row_scale_)) {
     // Exactly on a singular point: the test function is zero there, the tangent is the incoming one.
@@ -106,6 +108,34 @@ bool Segment::Evaluate(double sigma, const Probe& left, double sigma_left, const
     probe->sb_test = 0;
   }
   return true;
+}
+
+CorrectorResult Segment::CorrectFrom(const Vector& predictor, double max_distance, Probe* probe) {
+  const double saved_distance = corrector_->options().max_distance;
+  corrector_->set_max_distance(max_distance + kDistanceFloor * (1 + predictor.norm()));
+  const CorrectorResult result = corrector_->CorrectPseudoArclength(predictor, a_.tangent, &probe->u);
+  corrector_->set_max_distance(saved_distance);
+  return result;
+}
+
+Vector Segment::InterpolateNodes(double sigma) const {
+  // The kNodes corrected points nearest to σ; Lagrange interpolation in σ (on the hyperplane σ exactly:
+  // every node lies on its own hyperplane and interpolation reproduces the linear function τ_aᵀ(u − u_a)).
+  std::vector<const std::pair<double, Vector>*> nearest;
+  for (const auto& node : nodes_) nearest.push_back(&node);
+  const size_t count = std::min<size_t>(kNodes, nearest.size());
+  std::partial_sort(nearest.begin(), nearest.begin() + count, nearest.end(), [sigma](const auto* x, const auto* y) {
+    return std::abs(x->first - sigma) < std::abs(y->first - sigma);
+  });
+  Vector u = Vector::Zero(a_.u.size());
+  for (size_t i = 0; i < count; ++i) {
+    double weight = 1;
+    for (size_t j = 0; j < count; ++j) {
+      if (j != i) weight *= (sigma - nearest[j]->first) / (nearest[i]->first - nearest[j]->first);
+    }
+    u += weight * nearest[i]->second;
+  }
+  return u;
 }
 
 Vector Segment::ReliableTangent(const Probe& probe, double sigma) const {
@@ -125,6 +155,7 @@ Vector Segment::InterpolatedTangent(double sigma) const {
 bool Segment::EndProbe(bool at_b, Probe* probe, std::string* message) {
   const ContinuationPoint& p = at_b ? b_ : a_;
   probe->u = p.u;
+  if (with_sb_test_) nodes_.push_back({at_b ? sigma_b_ : 0.0, p.u});
   probe->tangent = p.tangent;
   probe->sb_test = 0;
   if (!with_sb_test_) return true;

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "continuation/bordered_solver.h"
 #include "hybridcont/continuation.h"
@@ -72,6 +74,8 @@ class Segment {
   // of the interpolated one (half the angle between τ_a and τ_b, plus kTangentNoise), else the
   // interpolated tangent. Only SB segments check; elsewhere every induced tangent is reliable.
   Vector ReliableTangent(const Probe& probe, double sigma) const;
+  // Nodes of the interpolant that locates SB points once kNodes corrected points of the segment are known.
+  static constexpr size_t kNodes = 4;
   // Angle (radians) by which the integrator noise may turn a correct induced tangent.
   static constexpr double kTangentNoise = 1e-6;
   double sigma_b() const { return sigma_b_; }
@@ -87,6 +91,13 @@ class Segment {
   ZeroProblem* problem_;
   bool with_sb_test_;
   double log_row_scale_ = 0;
+  // SB segments: (σ, u) of every corrected point (ends and trial points). Next to the SB the induced
+  // tangents of the probes are unreliable, so the interpolant is built from the points alone: Lagrange
+  // through the kNodes nearest ones, error ~ |u⁗| Π|σ − σ_i|, below the Hermite interpolant's with
+  // interpolated tangents (error ~ width · tangent error) as soon as the bracket is small.
+  std::vector<std::pair<double, Vector>> nodes_;
+  CorrectorResult CorrectFrom(const Vector& predictor, double max_distance, Probe* probe);
+  Vector InterpolateNodes(double sigma) const;
   Matrix dr_;
   const ContinuationPoint& a_;
   const ContinuationPoint& b_;

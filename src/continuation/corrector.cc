@@ -123,7 +123,7 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
   if (border != Border::kConstraint) w.border.normalize();
 
   CorrectorResult result;
-  double last_step = 0, previous_step = 0;
+  double last_step = 0, previous_step = 0, previous_residual = 0;
   for (int k = 0;; ++k) {
     const EvaluationStatus evaluation = problem_->Evaluate(u, &w.r, &w.dr);
     ++result.evaluations;
@@ -140,6 +140,10 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
     }
     result.residual_norm = w.F.norm();
     result.distance = (u - u_pred).norm();
+    if (k == 0) result.predictor_residual_norm = result.residual_norm;
+    if (k == 1 && result.predictor_residual_norm > 0) {
+      result.residual_contraction = result.residual_norm / result.predictor_residual_norm;
+    }
     if (!std::isfinite(result.residual_norm) || !w.dr.allFinite()) {
       result.status = CorrectorStatus::kDiverged;
       result.message = "non-finite residual or Jacobian";
@@ -154,12 +158,17 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
         return result;
       }
     }
-    if (k >= 2 && last_step > options_.max_contraction * previous_step) {
+    // Growing steps alone are not divergence: a first step that overshoots along a nearly singular
+    // direction of B is taken back by the second one (|Δ₁| ≈ |Δ₀|) while the residual drops.
+    if (k >= 2 && last_step > options_.max_contraction * previous_step &&
+        result.residual_norm >= previous_residual) {
       result.status = CorrectorStatus::kDiverged;
-      result.message = "Newton steps grow: |du| " + std::to_string(previous_step) + " -> " +
-                       std::to_string(last_step);
+      result.message = "Newton steps and residual grow: |du| " + std::to_string(previous_step) + " -> " +
+                       std::to_string(last_step) + ", |F| " + std::to_string(previous_residual) + " -> " +
+                       std::to_string(result.residual_norm);
       return result;
     }
+    previous_residual = result.residual_norm;
     if (k == options_.max_iterations) {
       result.status = CorrectorStatus::kMaxIterations;
       result.message = "|F| = " + std::to_string(result.residual_norm) + " after " + std::to_string(k) +
