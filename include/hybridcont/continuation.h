@@ -44,6 +44,11 @@
 //    branch with only its start point; a start point outside a bound ends it at once (kBoundReached).
 //  - The first interval of a branch started at a singular point (branch switching, singular starts) is
 //    not searched for special points: its start point is the bifurcation point itself.
+//  - A branch started at a singular point whose first predictor already has a singular bordered matrix
+//    and a kernel of dr of dimension k >= 2 (relative rank tolerance 1e-8) ends at once with kStartFailed,
+//    "dr has a kernel of dimension k along this direction: not a simple curve": a curve of singular
+//    points, such as the bouncing rod's at-rest ξ-line (kernel dimension 2 for every ξ), cannot be traced
+//    by a predictor–corrector method, and halving h would only repeat the failure ~20 times.
 //  - Closed loop: the start point lies within the chord-sag tolerance of the last chord and the tangents
 //    agree; the start point is then appended as the last point, so the curve closes exactly.
 #ifndef HYBRIDCONT_CONTINUATION_H_

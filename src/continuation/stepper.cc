@@ -1,4 +1,5 @@
 // ContinuationStepper: predictor, corrector, step control, stops, special points (continuation.h).
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -147,6 +148,16 @@ class ContinuationStepper::Impl {
       branch_.newton_iterations += result.iterations;
       if (!result.converged()) {
         last_failure = "h = " + std::to_string(h_) + ": " + result.BriefReport();
+        if (start_singular_ && branch_.points.size() == 1 && result.status == CorrectorStatus::kSingular &&
+            result.iterations == 0) {
+          // [dr; pᵀ] singular at the very predictor: along a curve of singular points (e.g. the rod's
+          // at-rest ξ-line) halving h cannot help. Said once, instead of ~20 rejected steps.
+          if (const int k = KernelDimension(corrector_.jacobian()); k >= 2) {
+            return Finish(TerminationReason::kStartFailed,
+                          "dr has a kernel of dimension " + std::to_string(k) +
+                              " along this direction: not a simple curve (at h = " + std::to_string(h_) + ")");
+          }
+        }
         Reject(0.5);
         continue;
       }
@@ -247,6 +258,15 @@ class ContinuationStepper::Impl {
     }
     return StepStatus::kFinished;
   }
+
+  // N + 1 − rank dr, singular values below kRankTolerance · max(1, σ_max) counting as zero (the rank
+  // decision of branch_switching.h).
+  static int KernelDimension(const Matrix& dr) {
+    const Vector sigma = dr.jacobiSvd().singularValues();
+    const double threshold = kRankTolerance * std::max(1.0, sigma.size() > 0 ? sigma(0) : 0.0);
+    return static_cast<int>(dr.cols() - (sigma.array() > threshold).count());
+  }
+  static constexpr double kRankTolerance = 1e-8;
 
   // The Newton contraction the step controller reads: the smaller of κ = ||Δ₁||/||Δ₀|| and the residual
   // contraction ||F(u₁)||/||F(u₀)||. Both estimate the Kantorovich quantity of the predictor (affine
