@@ -230,6 +230,51 @@ TEST(ExplorationTest, ParabolaAndLineTwoSimpleBifurcationsNoBranchTwice) {
   EXPECT_EQ(known, 0) << diagram.FullReport();
 }
 
+// x(ελ − x) = 0: the lines x = 0 and x = ελ, crossing at the origin at the small angle atan ε.
+class ShallowCrossing : public ZeroProblem {
+ public:
+  explicit ShallowCrossing(double epsilon) : epsilon_(epsilon) {}
+  int num_equations() const override { return 1; }
+  std::vector<std::string> unknown_names() const override { return {"x", "lambda"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0), l = u(1);
+    if (r) *r = Vector::Constant(1, x * (epsilon_ * l - x));
+    if (dr) {
+      dr->resize(1, 2);
+      *dr << epsilon_ * l - 2 * x, epsilon_ * x;
+    }
+    return {};
+  }
+
+ private:
+  double epsilon_;
+};
+
+// Branches that meet at a small angle are still two branches: the new line x = ελ lies within the old
+// known-branch tolerances (chord sag, 8° for "same ray" and "parallel tangent") of x = 0 near the SB.
+TEST(ExplorationTest, BranchesCrossingAtASmallAngleAreBothTraced) {
+  for (const double epsilon : {0.1, 0.02, 0.005}) {
+    ShallowCrossing curve(epsilon);
+    ExplorationOptions options;
+    options.continuation.bounds = {{"lambda", -1, 1}};
+    const BifurcationDiagram diagram = Explore(&curve, Eigen::Vector2d(0, -0.5), options);
+    ASSERT_EQ(diagram.status, ExplorationStatus::kCompleted) << diagram.FullReport();
+    ASSERT_EQ(diagram.special_points.size(), 1u) << diagram.FullReport();
+    EXPECT_EQ(diagram.special_points[0].status, LocationStatus::kLocated);
+    EXPECT_LE(diagram.special_points[0].u.lpNorm<Eigen::Infinity>(), 1e-10);
+    ASSERT_EQ(diagram.branches.size(), 4u) << "epsilon = " << epsilon << "\n" << diagram.FullReport();
+    auto trivial = [](const Vector& u) { return u(0) == 0; };
+    auto line = [epsilon](const Vector& u) { return std::abs(u(0) - epsilon * u(1)) < 1e-13; };
+    EXPECT_EQ(CountBranches(diagram, trivial, [](const Vector& u) { return u(1) == 1; }), 1);
+    EXPECT_EQ(CountBranches(diagram, trivial, [](const Vector& u) { return u(1) == -1; }), 1);
+    EXPECT_EQ(CountBranches(diagram, line, [](const Vector& u) { return u(1) == 1; }), 1) << diagram.FullReport();
+    EXPECT_EQ(CountBranches(diagram, line, [](const Vector& u) { return u(1) == -1; }), 1) << diagram.FullReport();
+    for (const Branch& branch : diagram.branches) {
+      EXPECT_EQ(branch.termination, TerminationReason::kBoundReached) << branch.FullReport();
+    }
+  }
+}
+
 TEST(ExplorationTest, ValidateAndReports) {
   ExplorationOptions options;
   EXPECT_EQ(options.Validate(), "");

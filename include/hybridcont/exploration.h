@@ -16,10 +16,11 @@
 //   3. For a queued SB point within max_depth: the transverse ABE root v (SwitchDirectionAt) gives the two
 //      half-branches ±v, each traced unless a branch already leaves the point in that direction.
 //   4. Never twice: a "ray" (point, direction) is recorded for every branch leaving, passing through or
-//      returning to a special point; a new half-branch whose ray matches one (|cos| >=
-//      same_direction_cosine) is not traced. Independently, the first known_branch_check_points points of
-//      every new branch are compared with all traced branches (distance to a chord within the chord sag,
-//      parallel tangent); a match ends the new branch at once with kKnownBranch.
+//      returning to a special point; a new half-branch whose ray matches one (cos >= same_direction_cosine,
+//      or within half the smallest angle between the point's branch lines when the ABE roots are closer
+//      than that) is not traced. Independently, the first known_branch_check_points points of every new
+//      branch are compared with all traced branches (distance to a chord within the chord sag, tangent
+//      within known_branch_angle of the interpolated one); a match ends the new branch with kKnownBranch.
 //
 // Tiny example (pitchfork x³ − λx from a regular point of the trivial branch):
 //
@@ -65,6 +66,11 @@ struct ExplorationOptions {
   int known_branch_check_points = 3;
   // Absolute part of the "lies on a traced branch" distance, · (1 + ||u||), added to the chord sag.
   double known_branch_tolerance = 1e-6;
+  // Angle (radians) by which a point's tangent may differ from the traced branch's interpolated tangent
+  // (plus a quarter of the angle across that chord) and still run along it. A branch crossing a traced
+  // one at a small angle stays within the chord sag near the crossing but not within this angle;
+  // 1e-3 is far above the tangents' error from integrator noise (~1e-6).
+  double known_branch_angle = 1e-3;
 
   std::string Validate() const;
 };

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <deque>
 #include <functional>
 #include <sstream>
@@ -81,6 +82,7 @@ class Explorer {
     start.u = u0;
     start.message = diagram_.start.BriefReport();
     const int id = AddUnique(std::move(start), 0);
+    NoteLines(id, diagram_.start.directions);
     for (const Vector& line : diagram_.start.directions) {
       for (const int d : {+1, -1}) TraceFromPoint(id, d * line, d, 1);
     }
@@ -155,6 +157,7 @@ class Explorer {
     point.duplicate_of = -1;
     diagram_.special_points.push_back(std::move(point));
     depth_.push_back(depth);
+    line_angle_.push_back(std::numbers::pi / 2);
     return diagram_.special_points.back().id;
   }
 
@@ -164,11 +167,24 @@ class Explorer {
     rays_.push_back({id, -point.tangent});
   }
 
+  // A ray matches a known one within same_direction_cosine, or within half the smallest angle between
+  // the branch lines through the point when that is smaller (branches crossing at a small angle).
   bool RayKnown(int id, const Vector& direction) const {
     const Vector unit = direction.normalized();
+    const double cosine = std::max(options_.same_direction_cosine, std::cos(0.5 * line_angle_[id]));
     return std::any_of(rays_.begin(), rays_.end(), [&](const Ray& ray) {
-      return ray.point == id && ray.direction.dot(unit) >= options_.same_direction_cosine;
+      return ray.point == id && ray.direction.dot(unit) >= cosine;
     });
+  }
+
+  // Records the smallest angle between branch lines through special point `id`.
+  void NoteLines(int id, const std::vector<Vector>& lines) {
+    for (size_t i = 0; i < lines.size(); ++i) {
+      for (size_t j = i + 1; j < lines.size(); ++j) {
+        const double c = std::abs(lines[i].normalized().dot(lines[j].normalized()));
+        line_angle_[id] = std::min(line_angle_[id], std::acos(std::min(1.0, c)));
+      }
+    }
   }
 
   // Id of a traced branch that p lies on (within the chord sag of one of its chords, parallel tangent), or −1.
@@ -185,9 +201,14 @@ class Explorer {
         const double distance = (a.u + t * chord - p.u).norm();
         const double allowed = options_.known_branch_tolerance * (1 + p.u.norm()) +
                                length * (internal::AngleBetween(a.tangent, b.tangent) / 4 + 1e-3);
-        if (distance <= allowed && std::abs(p.tangent.dot(chord)) >= options_.same_direction_cosine * length) {
-          return branch.id;
-        }
+        // Parallel tangent: p's tangent against the known branch's tangent at the projection (the two end
+        // tangents interpolated, exact to far less than a quarter of their angle). A branch crossing the
+        // known one at a small angle θ stays within the chord sag near the crossing, but its tangent is θ
+        // off everywhere.
+        const Vector known_tangent = ((1 - t) * a.tangent + t * b.tangent).normalized();
+        const double angle = std::acos(std::min(1.0, std::abs(p.tangent.dot(known_tangent))));
+        const double allowed_angle = internal::AngleBetween(a.tangent, b.tangent) / 4 + options_.known_branch_angle;
+        if (distance <= allowed && angle <= allowed_angle) return branch.id;
       }
     }
     return -1;
@@ -202,6 +223,7 @@ class Explorer {
       record.special_point = id;
       record.result = SwitchDirectionAt(problem_, diagram_.special_points[id], options_.switching);
       if (record.result.status == BranchSwitchStatus::kOk || record.result.status == BranchSwitchStatus::kFallback) {
+        NoteLines(id, {record.result.direction, record.result.incoming_direction});
         for (const int d : {+1, -1}) {
           if (diagram_.status != ExplorationStatus::kCompleted) break;
           if (TraceFromPoint(id, d * record.result.direction, d, depth_[id] + 1)) {
@@ -219,6 +241,7 @@ class Explorer {
   ExplorationOptions options_;
   BifurcationDiagram diagram_;
   std::vector<int> depth_;  // per unique special point: depth of the branch it was found on
+  std::vector<double> line_angle_;  // per unique special point: smallest angle between its branch lines
   std::vector<Ray> rays_;
   std::deque<int> queue_;
 };
@@ -252,6 +275,8 @@ std::string ExplorationOptions::Validate() const {
     out << "ExplorationOptions::known_branch_check_points = " << known_branch_check_points << " must be >= 0";
   } else if (!(known_branch_tolerance >= 0)) {
     out << "ExplorationOptions::known_branch_tolerance = " << known_branch_tolerance << " must be >= 0";
+  } else if (!(known_branch_angle >= 0 && known_branch_angle < 1)) {
+    out << "ExplorationOptions::known_branch_angle = " << known_branch_angle << " must lie in [0, 1)";
   }
   return out.str();
 }
