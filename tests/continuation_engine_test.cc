@@ -267,6 +267,101 @@ TEST(ContinuationTest, StepperPointByPointEqualsDriver) {
   EXPECT_EQ(stepped.termination, driven.termination);
 }
 
+// x(λ − x) = 0 (transcritical) with a deterministic "integrator noise": |δr| ~ 1e-12, |δdr| ~ 1e-10,
+// a different value at every u, as a shooting map at rtol 1e-10 has.
+class NoisyTranscritical : public ZeroProblem {
+ public:
+  int num_equations() const override { return 1; }
+  std::vector<std::string> unknown_names() const override { return {"x", "lambda"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0), l = u(1);
+    if (r) *r = Vector::Constant(1, x * (l - x) + 1e-12 * Noise(u, 1));
+    if (dr) {
+      dr->resize(1, 2);
+      *dr << l - 2 * x + 1e-10 * Noise(u, 2), x + 1e-10 * Noise(u, 3);
+    }
+    return {};
+  }
+
+ private:
+  // In [−1, 1], changing completely when u changes by ~1e-15.
+  static double Noise(const Vector& u, int salt) {
+    const double phase = std::sin(1e15 * u(0) + 7.3e14 * u(1) + salt);
+    return phase;
+  }
+};
+
+// Next to an SB point the bordered matrix is singular for every border, so Newton corrections of the
+// residual noise (1e-12 / distance) leave the bracket: located to the noise level, the bracket honest.
+TEST(ContinuationTest, SimpleBifurcationOfANoisyMapLocatedToTheNoiseLevel) {
+  NoisyTranscritical curve;
+  ContinuationOptions options;
+  options.bounds = {{"lambda", -1, 1}};
+  ContinuationStepper stepper(&curve, options);
+  StepStatus status = stepper.Start(Eigen::Vector2d(0, -0.5), Eigen::Vector2d(0, 1));
+  while (status == StepStatus::kContinuing) status = stepper.Step();
+  const Branch& branch = stepper.branch();
+  ASSERT_EQ(branch.termination, TerminationReason::kBoundReached) << branch.FullReport();
+  ASSERT_EQ(branch.special_points.size(), 1u) << branch.FullReport();
+  const SpecialPoint& sb = branch.special_points[0];
+  EXPECT_EQ(sb.status, LocationStatus::kLocated) << sb.BriefReport();
+  EXPECT_NE(sb.message.find("located to the noise level"), std::string::npos) << sb.BriefReport();
+  // Honest precision: the exact SB (0, 0) lies in the bracket, which is far wider than location_tolerance
+  // (the noise allows ~1e-6) and far narrower than a step.
+  EXPECT_GT(sb.precision(), options.location_tolerance);
+  EXPECT_LT(sb.precision(), 1e-4);
+  // The exact SB (0, 0) within the precision, in every component (the estimate may be a trial point that
+  // Newton took to the crossing line x = λ: still within the bracket width of the SB).
+  EXPECT_LE(sb.u.lpNorm<Eigen::Infinity>(), sb.precision()) << sb.BriefReport();
+  // The SB tangent is the branch's (λ axis), not a mixture of the two kernel directions.
+  EXPECT_NEAR(std::abs(sb.tangent(1)), 1.0, 1e-12);
+}
+
+// Curve x = 0, y = λ² whose bordered matrix has a singular value δ in the x direction and a residual
+// quadratic in the predictor's error e = y − λ²: r₂ = δx + e². Newton's first step overshoots by e²/δ
+// along x and the second one takes it back exactly: |Δ₁| ≈ |Δ₀| although Newton converges in three steps.
+// The step contraction then pins h where e²/δ ~ e (the bouncing rod next to its non-symmetric family);
+// the residual contraction does not.
+class OvershootingCurve : public ZeroProblem {
+ public:
+  int num_equations() const override { return 2; }
+  std::vector<std::string> unknown_names() const override { return {"x", "y", "lambda"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0), y = u(1), l = u(2), e = y - l * l;
+    if (r) {
+      r->resize(2);
+      *r << e, kDelta * x + e * e;
+    }
+    if (dr) {
+      dr->resize(2, 3);
+      *dr << 0, 1, -2 * l, kDelta, 2 * e, -4 * e * l;
+    }
+    return {};
+  }
+  static constexpr double kDelta = 1e-5;
+};
+
+TEST(ContinuationTest, StepControlIsNotPinnedByAnOvershootingFirstNewtonStep) {
+  OvershootingCurve curve;
+  ContinuationOptions options;
+  options.bounds = {{"lambda", -1, 1}};
+  options.max_points = 400;
+  ContinuationStepper stepper(&curve, options);
+  StepStatus status = stepper.Start(Eigen::Vector3d(0, 0.81, -0.9), Eigen::Vector3d(0, 0, 1));
+  while (status == StepStatus::kContinuing) status = stepper.Step();
+  const Branch& branch = stepper.branch();
+  ASSERT_EQ(branch.termination, TerminationReason::kBoundReached) << branch.FullReport();
+  EXPECT_EQ(branch.points.back().u(2), 1.0);
+  for (const ContinuationPoint& point : branch.points) {
+    // x is resolved to residual_tolerance / δ only (r₂ = δx at e = 0).
+    EXPECT_LE(std::abs(point.u(0)), options.corrector.residual_tolerance / OvershootingCurve::kDelta);
+    EXPECT_NEAR(point.u(1), point.u(2) * point.u(2), 1e-12);
+  }
+  // Arclength of y = λ² over [−0.9, 1] is 2.8; the step contraction alone (h ~ 5e-3) did not reach λ = 1
+  // within the 400 points.
+  EXPECT_LT(branch.points.size(), 150u) << branch.FullReport();
+}
+
 TEST(ContinuationTest, SingularStartIsReportedNotThrown) {
   Pitchfork pitchfork;
   const Branch branch = TraceBranch(&pitchfork, Eigen::Vector2d(0, 0), ContinuationOptions());

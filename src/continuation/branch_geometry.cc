@@ -85,6 +85,19 @@ bool Segment::Evaluate(double sigma, const Probe& left, double sigma_left, const
     result = correct(ReliableTangent(left, sigma_left), ReliableTangent(right, sigma_right), &predictor);
   }
   probe->noise_limited = false;
+  if (with_sb_test_ && result.converged() &&
+      result.predictor_residual_norm <= corrector_->options().residual_tolerance &&
+      result.distance > kResolvedFraction * w) {
+    // The interpolant was on the curve to the residual noise already, yet Newton moved it across a
+    // sizeable part of the bracket: a correction of noise along the second kernel direction, or a jump
+    // to the crossing branch (transcritical: at distance ~|σ − σ*| tan θ, with a test value of the wrong
+    // sign for this branch). Either way the curve is not resolved on this scale.
+    *message = "trial point at sigma = " + std::to_string(sigma) + ": correction " +
+               std::to_string(result.distance) + " of a predictor at the noise level";
+    probe->noise_limited = true;
+    probe->residual = result.predictor_residual_norm;
+    return false;
+  }
   if (!result.converged()) {
     *message = "trial point at sigma = " + std::to_string(sigma) + " not corrected: " + result.BriefReport();
     // Next to an SB point the bordered matrix is singular for every border (rank dr = N − 1 there), and
@@ -100,13 +113,13 @@ bool Segment::Evaluate(double sigma, const Probe& left, double sigma_left, const
     return false;
   }
   probe->residual = result.residual_norm;
-  if (with_sb_test_) nodes_.push_back({sigma, probe->u});
   if (!InducedTangent(solver_, corrector_->jacobian(), a_.tangent, &probe->tangent, nullptr, &probe->sb_test,
                       &log_row_scale_)) {
     // Exactly on a singular point: the test function is zero there, the tangent is the incoming one.
     probe->tangent = a_.tangent;
     probe->sb_test = 0;
   }
+  if (with_sb_test_) nodes_.push_back({sigma, probe->u});
   return true;
 }
 
@@ -220,24 +233,28 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
     if (!std::isfinite(x)) x = 0.5 * (lo + hi);
     x = std::clamp(x, lo + margin, hi - margin);
     // A trial point exactly on the root of the SB test is exactly singular (regula falsi hits it for a
-    // linear test function): retry half a tolerance to either side, which still brackets the root.
+    // linear test function): retry half a tolerance to either side, which still brackets the root. With
+    // a noisy map the points within ~noise/slope of an SB cannot be corrected at all: then retry halfway
+    // to either bracket end, which still halves the bracket.
     Segment::Probe probe;
-    bool corrected = false;
-    for (const double shift : {0.0, 0.5 * tolerance, -0.5 * tolerance}) {
-      const double trial = std::clamp(x + shift, lo + margin, hi - margin);
+    bool corrected = false, noise_limited = false;
+    const double x0 = x;
+    for (const double trial_point : {x0, x0 + 0.5 * tolerance, x0 - 0.5 * tolerance, 0.5 * (lo + x0), 0.5 * (x0 + hi)}) {
+      const double trial = std::clamp(trial_point, lo + margin, hi - margin);
       if (segment->Evaluate(trial, lo_probe, lo, hi_probe, hi, &probe, &message)) {
         x = trial;
         corrected = true;
         break;
       }
+      noise_limited = noise_limited || probe.noise_limited;
     }
     if (!corrected) {
       out.iterations = it;
-      if (probe.noise_limited) {
+      if (noise_limited) {
         out.noise_limited = true;
-        out.message = "located to the noise level: the trial point inside the bracket has |r| = " +
-                      FormatShort(probe.residual) + " before any correction, but Newton's correction of that " +
-                      "residual leaves the bracket (the bracket width is the precision)";
+        out.message = "located to the noise level: a trial point inside the bracket has |r| = " +
+                      FormatShort(probe.residual) + " before any correction, and Newton's correction of that " +
+                      "noise is not small against the bracket (the bracket width is the precision)";
         return finish(true);
       }
       out.message = message;

@@ -76,6 +76,9 @@ class Segment {
   Vector ReliableTangent(const Probe& probe, double sigma) const;
   // Nodes of the interpolant that locates SB points once kNodes corrected points of the segment are known.
   static constexpr size_t kNodes = 4;
+  // An SB trial point whose interpolant already had a residual at the corrector's tolerance and which
+  // Newton moved by more than this fraction of the bracket width is noise, not a correction (Evaluate).
+  static constexpr double kResolvedFraction = 1.0 / 16;
   // Angle (radians) by which the integrator noise may turn a correct induced tangent.
   static constexpr double kTangentNoise = 1e-6;
   double sigma_b() const { return sigma_b_; }
