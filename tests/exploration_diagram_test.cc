@@ -275,6 +275,27 @@ TEST(ExplorationTest, BranchesCrossingAtASmallAngleAreBothTraced) {
   }
 }
 
+// The λ-axis of ThreeAxes is a curve of singular points (dr = [[0, 0, 0], [λ, −λ, 0]]: kernel of
+// dimension 2 for every λ), like the bouncing rod's at-rest ξ-line: both half-branches end at once with
+// kStartFailed and the kernel dimension, without rejected steps.
+TEST(ExplorationTest, CurveOfSingularPointsIsRefusedAtOnce) {
+  ThreeAxes axes;
+  ExplorationOptions options;
+  options.continuation.bounds = {{"lambda", -1, 1}};
+  options.start_conditions = {{{{"x", 1.0}, {"y", -1.0}}}};
+  const BifurcationDiagram diagram = Explore(&axes, Eigen::Vector3d(0, 0, 0), options);
+  ASSERT_EQ(diagram.branches.size(), 2u) << diagram.FullReport();
+  for (const Branch& branch : diagram.branches) {
+    EXPECT_EQ(branch.termination, TerminationReason::kStartFailed) << branch.FullReport();
+    EXPECT_EQ(branch.rejected_steps, 0);
+    EXPECT_EQ(branch.points.size(), 1u);
+    EXPECT_NE(branch.message.find("dr has a kernel of dimension 2 along this direction: not a simple curve"),
+              std::string::npos)
+        << branch.message;
+  }
+  EXPECT_EQ(diagram.status, ExplorationStatus::kStartFailed);
+}
+
 TEST(ExplorationTest, ValidateAndReports) {
   ExplorationOptions options;
   EXPECT_EQ(options.Validate(), "");
