@@ -78,3 +78,24 @@ TEST(Classification, EventReachedUpwardIsWrongDirection) {
 
 }  // namespace
 }  // namespace hybridcont
+
+namespace hybridcont {
+namespace {
+
+TEST(Classification, PhaseStartingBeyondItsGuardIsNotPhysical) {
+  // Segment 1 starts 0.1 below the ground moving up (a penetration), rises through y = 0 and comes back
+  // down through it at t1 = 1 + sqrt(0.8): the end crossing is downward and there is no earlier downward
+  // crossing, but the trajectory was beyond its guard: the replay of such an orbit never finds the event.
+  const HybridModel ball = MakeBouncingBall();
+  const ShootingLayout layout(ball);
+  Vector u = BallOrbit(layout, 0.5);
+  u(layout.state_offset(0)) = -0.1;
+  u(layout.state_offset(0) + 1) = 1.0;
+  u(layout.time_index(0)) = 1.0 + std::sqrt(0.8);
+  const Classification c = Classify(ball, u);
+  EXPECT_EQ(c.reason, OrbitClass::kMissedEvent) << c.detail;
+  EXPECT_NE(c.detail.find("t = 0 "), std::string::npos) << c.detail;
+}
+
+}  // namespace
+}  // namespace hybridcont

@@ -6,8 +6,9 @@
 //   every t_i > 0 ("reversed-time" if some t_i < 0, "zero-duration" if some t_i = 0),
 //   every event is crossed downward at the end of its phase (de·f < 0; "wrong-direction", "grazing"),
 //   the anchor is crossed downward at the end of the return segment ("anchor-grazing"),
-//   no earlier downward crossing of the phase's event inside the phase ("missed-event") and no earlier
-//   anchor crossing in the return segment ("missed-anchor"), searched on the dense output (orbit_trace.h).
+//   the phase's event stays non-negative inside the phase — no earlier downward crossing and no start
+//   beyond the guard, e.g. an end of the rod below the ground ("missed-event") — and no earlier anchor
+//   crossing in the return segment ("missed-anchor"), searched on the dense output (orbit_trace.h).
 //
 //   Classification c = ClassifyOrbit(model, u, trace, ClassificationOptions{});
 //   if (c.physical) ...; else std::cout << ToString(c.reason) << ": " << c.detail;
@@ -29,7 +30,7 @@ enum class OrbitClass {
   kWrongDirection,   // an event reached upward (de·f > 0)
   kGrazing,          // an event reached tangentially (de·f = 0, As2 violated)
   kAnchorGrazing,    // the anchor is not crossed transversally downward
-  kMissedEvent,      // the event was crossed earlier in the phase: t_i is not the first crossing
+  kMissedEvent,      // the event was crossed earlier in the phase, or the phase starts beyond it
   kMissedAnchor,     // the anchor was crossed earlier in the return segment
   kIntegrationFailed,
   kReplayFailed,     // passed every check on u, but event-driven re-simulation from x̄_1 does not return
@@ -44,7 +45,8 @@ struct ClassificationOptions {
   double duration_tolerance = 1e-7;
   // Normalized crossing speed (de·f) / (|de| |f|) above -this counts as grazing.
   double grazing_tolerance = 1e-6;
-  // Interpolant evaluations per integrator step when searching earlier crossings.
+  // Least interpolant evaluations per integrator step when searching earlier crossings (more where the
+  // state moves fast: no component moves by more than 0.02 between samples).
   int samples_per_step = 8;
 };
 

@@ -33,21 +33,36 @@ double Guard(const HybridModel& model, int i, const Vector& x, RowVector* grad) 
   return model.anchor().Evaluate(x, grad);
 }
 
-// First downward crossing (g > 0, then g <= 0) of the guard strictly before the end of the segment, on
-// the Hermite interpolant of every step. Returns the local time or NaN if none.
-double EarlierDownwardCrossing(const HybridModel& model, const OrbitTrace& trace, int i, int samples_per_step) {
+// The first time inside the segment (before its end) at which the trajectory is beyond its guard: a
+// downward crossing (g > 0, then g <= 0), or for an event guard any value g < -penetration, including at
+// the start (the end of a rod below the ground right after the other end's impact). Searched on the
+// Hermite interpolant of every step. Returns the local time or NaN if none.
+double FirstViolation(const HybridModel& model, const OrbitTrace& trace, int i, int samples_per_step,
+                      bool forbid_negative) {
   const auto& nodes = trace.segment(i);
   const double end = trace.duration(i);
   // Crossings within this fraction of the segment's end are the end crossing itself.
   const double end_slack = 1e-9 * std::max(1.0, std::abs(end));
+  // Round-off below zero at the start of a phase (a reset onto its own guard) is not a penetration.
+  constexpr double kPenetration = 1e-9;
   double previous = Guard(model, i, nodes.front().x, nullptr);
+  if (forbid_negative && previous < -kPenetration) return 0.0;
   for (std::size_t j = 0; j + 1 < nodes.size(); ++j) {
-    for (int s = 1; s <= samples_per_step; ++s) {
-      const double t = nodes[j].t + (nodes[j + 1].t - nodes[j].t) * s / samples_per_step;
+    // Samples follow the motion, not just the steps: an exactly integrable flight (the rod's) is crossed in
+    // a few large steps while the guard oscillates (sin of a fast angle). Sub-intervals are short enough
+    // that no state component moves by more than kMaxMotion between samples.
+    constexpr double kMaxMotion = 0.02;
+    constexpr int kMaxSamplesPerStep = 100000;
+    const double h = std::abs(nodes[j + 1].t - nodes[j].t);
+    const double speed = std::max(nodes[j].f.cwiseAbs().maxCoeff(), nodes[j + 1].f.cwiseAbs().maxCoeff());
+    const int samples = static_cast<int>(std::min<double>(
+        kMaxSamplesPerStep, std::max<double>(samples_per_step, std::ceil(speed * h / kMaxMotion))));
+    for (int s = 1; s <= samples; ++s) {
+      const double t = nodes[j].t + (nodes[j + 1].t - nodes[j].t) * s / samples;
       if (std::abs(end - t) <= end_slack) return std::nan("");
-      const Vector x = s == samples_per_step ? nodes[j + 1].x : trace.Interpolate(i, static_cast<int>(j), t);
+      const Vector x = s == samples ? nodes[j + 1].x : trace.Interpolate(i, static_cast<int>(j), t);
       const double g = Guard(model, i, x, nullptr);
-      if (previous > 0.0 && g <= 0.0) return t;
+      if ((previous > 0.0 && g <= 0.0) || (forbid_negative && g < -kPenetration)) return t;
       previous = g;
     }
   }
@@ -99,11 +114,12 @@ Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const Or
                          os.str());
     }
   }
-  // First crossing: no earlier downward crossing inside the segment.
+  // First crossing: the trajectory stays on the positive side of its event inside the phase (no earlier
+  // downward crossing, no start beyond it), and the anchor is not crossed earlier in the return segment.
   for (int i = 0; i <= m; ++i) {
-    const double t = EarlierDownwardCrossing(model, trace, i, options.samples_per_step);
+    const double t = FirstViolation(model, trace, i, options.samples_per_step, /*forbid_negative=*/i < m);
     if (!std::isnan(t)) {
-      os << (i < m ? "event" : "anchor") << " of segment " << i + 1 << " crossed at t = " << t << " < "
+      os << (i < m ? "event" : "anchor") << " of segment " << i + 1 << " violated at t = " << t << " < "
          << trace.duration(i);
       return NonPhysical(i < m ? OrbitClass::kMissedEvent : OrbitClass::kMissedAnchor, os.str());
     }

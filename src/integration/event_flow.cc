@@ -172,6 +172,7 @@ EventFlowStatus EventFlow::Integrate(const Eigen::Ref<const Vector>& x0, const E
     return finish(EventFlowStatus::kZeroDuration, os.str(), 0.0, w.z, g_prev, g_dot_prev);
   }
 
+  double speed_prev = w.f.cwiseAbs().maxCoeff();  // |f~|_inf at the start of the current step
   DenseDopri5& dense = with_sensitivities ? w.dense_sensitivities : w.dense_plain;
   dense.initialize(w.z, 0.0, options_.integrator.initial_step);
   double t_prev = 0.0;
@@ -194,19 +195,47 @@ EventFlowStatus EventFlow::Integrate(const Eigen::Ref<const Vector>& x0, const E
     }
     ++accepted;
     const Vector& z_new = dense.current_state();
-    const double t_new = span.second;
+    double t_new = span.second;
     if (rhs.nonfinite || !z_new.allFinite()) {
       const double t_bad = rhs.nonfinite ? rhs.nonfinite_time : t_new;
       return finish(EventFlowStatus::kNonFinite, at(t_bad) + "the model returned a non-finite value", t_bad,
                     dense.previous_state(), g_prev, g_dot_prev);
     }
     double g_new = 0.0;
-    const double g_dot_new = w.GuardRate(guard, z_new.head(n), &g_new);
+    double g_dot_new = w.GuardRate(guard, z_new.head(n), &g_new);
     if (!std::isfinite(g_new) || !std::isfinite(g_dot_new)) {
       return finish(EventFlowStatus::kNonFinite, at(t_new) + "guard or vector field non-finite", t_new, z_new, g_new,
                     g_dot_new);
     }
 
+    // An exactly integrable flight (the rod's) is crossed in a few long steps while the guard oscillates
+    // (sin of a fast angle): sample g on the interpolant so that no state component moves by more than
+    // kMaxMotion between samples, and take the first downward sign change (the same rule as the physical
+    // classification on the time-based trace, classification.h).
+    constexpr double kMaxMotion = 0.02;
+    constexpr int kMaxSamplesPerStep = 100000;
+    const double speed_new = w.f.cwiseAbs().maxCoeff();
+    const int samples = static_cast<int>(std::min<double>(
+        kMaxSamplesPerStep, std::ceil(std::max(speed_prev, speed_new) * (t_new - t_prev) / kMaxMotion)));
+    speed_prev = speed_new;
+    double t_a = t_prev, g_a = g_prev;
+    for (int k = 1; k < samples; ++k) {
+      const double t_b = t_prev + (t_new - t_prev) * k / samples;
+      const double g_b = g_at(t_b);
+      if (g_a > 0.0 && g_b <= 0.0) {
+        t_new = t_b;  // the crossing lies in (t_a, t_b]: treat that sub-interval as the step
+        g_new = g_b;
+        t_prev = t_a;
+        g_prev = g_a;
+        break;
+      }
+      t_a = t_b;
+      g_a = g_b;
+    }
+    if (t_a > t_prev && g_a > 0.0 && g_new <= 0.0) {  // the crossing lies in the last sub-interval
+      t_prev = t_a;
+      g_prev = g_a;
+    }
     // A downward crossing inside (t_prev, t_new]: g changes sign across the step, or g dips to <= 0 and
     // back inside it (two crossings within one step: found at the local minimum, where g_dot = 0).
     bool crossing = g_prev > 0.0 && g_new <= 0.0;
