@@ -6,55 +6,17 @@
 
 #include "hybridcont/models.h"
 #include "hybridcont/shooting_layout.h"
+#include "models/ball_flight.h"
 
 namespace hybridcont {
-namespace {
-
-struct ChainParameters {
-  double m = 1.0;  // mass
-  double g = 1.0;  // gravity
-};
-
-struct Flight {
-  template <class T>
-  static StateVector<T> VectorField(const StateVector<T>& x, const ChainParameters& p) {
-    StateVector<T> f(2);
-    f << x(1), T(-p.g);
-    return f;
-  }
-  template <class T>
-  static T FirstIntegral(const StateVector<T>& x, const ChainParameters& p) {
-    return 0.5 * p.m * x(1) * x(1) + p.m * p.g * x(0);
-  }
-  template <class T>
-  static T Event(const StateVector<T>& x, const ChainParameters&) {
-    return x(0);
-  }
-  template <class T>
-  static StateVector<T> Reset(const StateVector<T>& x, const ChainParameters&) {
-    StateVector<T> y(2);
-    y << x(0), -x(1);
-    return y;
-  }
-};
-
-struct Apex {
-  template <class T>
-  static T Anchor(const StateVector<T>& x, const ChainParameters&) {
-    return x(1);
-  }
-};
-
-}  // namespace
 
 HybridModel MakeBallChain(int num_phases) {
   if (num_phases < 1) throw std::invalid_argument("ball-chain: number of phases must be >= 1");
-  ModelBuilder<ChainParameters> b("ball-chain", "ball bouncing m times per period, one phase per bounce");
-  b.Parameter("m", &ChainParameters::m, "mass").Parameter("g", &ChainParameters::g, "gravity");
+  auto b = internal::BallBuilder("ball-chain", "ball bouncing m times per period, one phase per bounce");
   Vector typical(2);
   typical << 0.5, 0.3;
-  for (int i = 0; i < num_phases; ++i) b.AddPhase<Flight>("flight-" + std::to_string(i + 1), {"y", "dy"}, typical);
-  b.SetAnchor<Apex>();
+  for (int i = 0; i < num_phases; ++i) b.AddPhase<internal::BallFlight>("flight-" + std::to_string(i + 1), {"y", "dy"}, typical);
+  b.SetAnchor<internal::BallApex>();
   return b.Build();
 }
 

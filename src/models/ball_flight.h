@@ -1,0 +1,55 @@
+// Internal: the ballistic flight phase of a ball with an elastic ground impact, and its apex anchor —
+// shared by the bouncing ball (paper §4.1) and the scalable ball-chain test model.
+#ifndef HYBRIDCONT_SRC_MODELS_BALL_FLIGHT_H_
+#define HYBRIDCONT_SRC_MODELS_BALL_FLIGHT_H_
+
+#include "hybridcont/model.h"
+
+namespace hybridcont::internal {
+
+struct BallParameters {
+  double m = 1.0;  // mass
+  double g = 1.0;  // gravity
+};
+
+// x = [y, dy]
+struct BallFlight {
+  template <class T>
+  static StateVector<T> VectorField(const StateVector<T>& x, const BallParameters& p) {
+    StateVector<T> f(2);
+    f << x(1), T(-p.g);
+    return f;
+  }
+  template <class T>
+  static T FirstIntegral(const StateVector<T>& x, const BallParameters& p) {
+    return 0.5 * p.m * x(1) * x(1) + p.m * p.g * x(0);
+  }
+  template <class T>
+  static T Event(const StateVector<T>& x, const BallParameters&) {
+    return x(0);  // ground contact
+  }
+  template <class T>
+  static StateVector<T> Reset(const StateVector<T>& x, const BallParameters&) {
+    StateVector<T> y(2);
+    y << x(0), -x(1);  // elastic impact
+    return y;
+  }
+};
+
+struct BallApex {
+  template <class T>
+  static T Anchor(const StateVector<T>& x, const BallParameters&) {
+    return x(1);
+  }
+};
+
+// The builder with the two parameters registered.
+inline ModelBuilder<BallParameters> BallBuilder(const std::string& name, const std::string& description) {
+  ModelBuilder<BallParameters> b(name, description);
+  b.Parameter("m", &BallParameters::m, "mass").Parameter("g", &BallParameters::g, "gravity");
+  return b;
+}
+
+}  // namespace hybridcont::internal
+
+#endif  // HYBRIDCONT_SRC_MODELS_BALL_FLIGHT_H_
