@@ -259,13 +259,13 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
 
   // ---- 2. compute, streaming every accepted point
   ResultsWriter writer(dir, model, options_json);
-  TimeBasedShooting residual_map(model, setup.integrator);  // separate cache: the engine's stays intact
+  // One map for residuals and Floquet data, separate from the engine's (whose cache stays intact).
   TimeBasedShooting floquet_map(model, setup.integrator);
   ReplayOptions replay_options;
   replay_options.poincare.event.integrator.rtol = setup.integrator.rtol;
   replay_options.poincare.event.integrator.atol = setup.integrator.atol;
   std::map<int, std::vector<double>> floquet_tests, pd_tests;  // per branch, per point (NaN if undefined)
-  std::map<int, int> physical_points;
+  std::map<int, std::vector<bool>> physical;  // per branch, per accepted point
   int current_branch = -1;
   const auto start_time = std::chrono::steady_clock::now();
   const auto on_point = [&](const ProgressInfo& info, const Vector& u_problem) {
@@ -274,6 +274,7 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     if (!exploration->ToTimeBased(u_problem, &u).ok) {
       floquet_tests[info.branch_id].push_back(std::nan(""));  // keep per-point alignment
       pd_tests[info.branch_id].push_back(std::nan(""));
+      physical[info.branch_id].push_back(false);
       return;
     }
     PointRecord record;
@@ -281,16 +282,18 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     record.u = u;
     const OrbitTrace trace(model, u, setup.integrator);
     record.classification = ClassifyOrbit(model, u, trace, ClassificationOptions{});
-    Vector r;
-    const EvaluationStatus status = residual_map.Evaluate(u, &r, nullptr);
-    record.residual = status.ok ? r.norm() : std::nan("");
     record.newton_iterations = info.newton_iterations;
     record.step = info.step;
+    // Floquet data first: its r + dr evaluation leaves r in the map's cache, so the residual below costs
+    // no second integration on physical points.
     AnalyzePhysicalOrbit(model, floquet_map, replay_options, u, &record);
+    Vector r;
+    const EvaluationStatus status = floquet_map.Evaluate(u, &r, nullptr);
+    record.residual = status.ok ? r.norm() : std::nan("");
     floquet_tests[info.branch_id].push_back(record.extra[kBpColumn].second);
     pd_tests[info.branch_id].push_back(record.extra[kPdColumn].second);
     writer.AddPoint(info.branch_id, record);
-    if (record.classification.physical) ++physical_points[info.branch_id];
+    physical[info.branch_id].push_back(record.classification.physical);
     if (!args.quiet) {
       if (info.branch_id != current_branch) {
         out << fmt::format("branch {}\n", info.branch_id);
@@ -325,20 +328,17 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   writer.SetSpecialPoints(special_points);
   int orbits = 0;
   for (const Branch& b : diagram.branches) {
-    if (orbits >= sc.max_keyframe_orbits || physical_points[b.id] == 0) continue;
-    // the physical point of this branch closest to the key-frame target
+    if (orbits >= sc.max_keyframe_orbits) continue;
+    // the physical point of this branch closest to the key-frame target (classified during the run)
+    const std::vector<bool>& flags = physical[b.id];
     int best = -1;
     double best_distance = 1e300;
-    for (int i = 0; i < static_cast<int>(b.points.size()); ++i) {
+    for (int i = 0; i < static_cast<int>(b.points.size()) && i < static_cast<int>(flags.size()); ++i) {
+      if (!flags[i]) continue;
       const Vector& u = b.points[i].u;
       const double value = sc.keyframes.component == "T" ? layout.Period(u) : u(layout.H_index());
       const double distance = std::abs(value - sc.keyframes.value);
-      if (distance < best_distance) {
-        const OrbitTrace trace(model, u, setup.integrator);
-        if (!ClassifyOrbit(model, u, trace, ClassificationOptions{}).physical) continue;
-        best = i;
-        best_distance = distance;
-      }
+      if (distance < best_distance) best = i, best_distance = distance;
     }
     if (best < 0) continue;
     const Vector& u = b.points[best].u;
