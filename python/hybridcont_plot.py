@@ -586,8 +586,10 @@ def figure_slip_speed(res, svg, written):
     ax2.set_ylabel(axis_label("speed"))
     ax2.axhline(0.0, color="0.6", lw=0.8, zorder=1)
     ax1.set_title(r"period and forward speed over $\bar{H}$: " + model_title(res), fontsize=10)
-    place_legend(fig, ax1, legend_handles(res, drawn, sp_styles, res.has_stable()))
+    # layout first: an outside legend placed before tight_layout squeezes the axes (savefig's
+    # bbox_inches="tight" keeps the legend in the image)
     fig.tight_layout()
+    place_legend(fig, ax1, legend_handles(res, drawn, sp_styles, res.has_stable()))
     save(fig, res, "slip_speed", svg, written)
 
 
@@ -600,8 +602,10 @@ def figure_rod_t2(res, svg, written):
     ax1.set_title(r"(a) $\bar{H}$ over $t_2$", fontsize=10)
     ax2.set_title(r"(b) asymmetry $t_2-(t_1+t_3)$ over $T$ (0: symmetric orbits)", fontsize=10)
     fig.suptitle(model_title(res), fontsize=10)
-    place_legend(fig, ax2, legend_handles(res, drawn, sp_styles, res.has_stable()))
+    # layout first: an outside legend placed before tight_layout squeezes the axes (savefig's
+    # bbox_inches="tight" keeps the legend in the image)
     fig.tight_layout()
+    place_legend(fig, ax2, legend_handles(res, drawn, sp_styles, res.has_stable()))
     save(fig, res, "rod_t2", svg, written)
 
 
