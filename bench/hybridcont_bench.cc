@@ -64,6 +64,24 @@ void BM_ShootingEvaluate(benchmark::State& state) {
 }
 BENCHMARK(BM_ShootingEvaluate)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
 
+// r alone (no sensitivities): what a chord-Newton iteration costs.
+void BM_ShootingResidual(benchmark::State& state) {
+  const std::string name = kModels[state.range(0)];
+  const HybridModel model = MakeBuiltinModel(name);
+  const Representative& rep = RepresentativePoint(name);
+  TimeBasedShooting shooting(model, IntegratorOptions{});
+  Vector u = rep.u, r;
+  for (auto _ : state) {
+    u(0) += 1e-15;  // defeat the cache
+    shooting.Evaluate(u, &r, nullptr);
+    benchmark::DoNotOptimize(r.data());
+  }
+  state.SetLabel(name);
+  state.counters["rhs_per_eval"] =
+      static_cast<double>(shooting.counters().rhs_evaluations) / static_cast<double>(shooting.num_evaluations());
+}
+BENCHMARK(BM_ShootingResidual)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
+
 void BM_CorrectorSolve(benchmark::State& state) {
   const std::string name = kModels[state.range(0)];
   const HybridModel model = MakeBuiltinModel(name);
