@@ -33,8 +33,9 @@
 // lands on the crossing branch (a correction longer than a quarter of the bracket width counts as failed).
 // When such a trial point's interpolant already has a residual at the corrector's tolerance, the curve
 // cannot be resolved further on the bracket's scale: the point counts as located, `message` says "located
-// to the noise level", and precision() is the bracket width reached (e.g. ~2e-8 in arclength for the
-// bouncing rod's SB, not location_tolerance).
+// to the noise level", and precision() is the bracket reached, widened on both sides by its own width
+// (or by the noisy correction, if larger): its ends are themselves points inside the noise (e.g. ~5e-8 in
+// arclength for the bouncing rod's SB, not location_tolerance).
 //
 // Tangent of an SB point: the induced tangent is undefined there and next to it numerically meaningless
 // when dr is noisy (it mixes the two branch directions). SpecialPoint::tangent is the estimate's induced

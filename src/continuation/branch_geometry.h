@@ -50,6 +50,9 @@ class Segment {
     // Set when Evaluate fails although the interpolant's residual is already at the corrector's
     // tolerance: Newton's correction of that residual noise leaves the bracket (next to an SB point).
     bool noise_limited = false;
+    // For a noise-limited trial that Newton did correct: how far it moved (the scatter of points that
+    // the corrector accepts there, against which the bracket cannot be resolved).
+    double scatter = 0;
   };
   // Absolute part of the largest accepted correction of a trial point, · (1 + ||u||).
   static constexpr double kDistanceFloor = 1e-12;

@@ -22,13 +22,22 @@ std::string ToString(TerminationReason reason) {
   return "unknown";
 }
 
-std::string ToString(PredictorType type) { return type == PredictorType::kSecant ? "secant" : "tangent"; }
+std::string ToString(PredictorType type) {
+  switch (type) {
+    case PredictorType::kTangent: return "tangent";
+    case PredictorType::kSecant: return "secant";
+    case PredictorType::kHermite: return "hermite";
+  }
+  return "unknown";
+}
 
 bool StringToPredictorType(const std::string& text, PredictorType* type) {
   if (text == "tangent") {
     *type = PredictorType::kTangent;
   } else if (text == "secant") {
     *type = PredictorType::kSecant;
+  } else if (text == "hermite") {
+    *type = PredictorType::kHermite;
   } else {
     return false;
   }

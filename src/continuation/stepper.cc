@@ -126,9 +126,10 @@ class ContinuationStepper::Impl {
   StepStatus Step() {
     if (finished()) return StepStatus::kFinished;
     const ContinuationPoint& a = branch_.points.back();
+    const ContinuationPoint* previous = branch_.points.size() >= 2 ? &branch_.points[branch_.points.size() - 2] : nullptr;
     Vector direction = a.tangent;
-    if (options_.predictor == PredictorType::kSecant && branch_.points.size() >= 2) {
-      const Vector chord = a.u - branch_.points[branch_.points.size() - 2].u;
+    if (options_.predictor == PredictorType::kSecant && previous != nullptr) {
+      const Vector chord = a.u - previous->u;
       if (chord.norm() > 0) direction = chord.normalized();
     }
     ContinuationPoint b;
@@ -142,9 +143,13 @@ class ContinuationStepper::Impl {
                       "step fell below min_step = " + std::to_string(options_.min_step) + "; last failure: " +
                           last_failure);
       }
-      const Vector predictor = a.u + h_ * direction;
+      Vector predictor = a.u + h_ * direction;
+      Vector normal = direction;
+      if (options_.predictor == PredictorType::kHermite && previous != nullptr) {
+        HermitePredictor(*previous, a, h_, &predictor, &normal);
+      }
       corrector_.set_max_distance(options_.max_corrector_distance * h_);
-      const CorrectorResult result = corrector_.Correct(options_.corrector_type, predictor, direction, &b.u);
+      const CorrectorResult result = corrector_.Correct(options_.corrector_type, predictor, normal, &b.u);
       branch_.newton_iterations += result.iterations;
       if (!result.converged()) {
         last_failure = "h = " + std::to_string(h_) + ": " + result.BriefReport();
@@ -278,6 +283,23 @@ class ContinuationStepper::Impl {
   double ContractionSignal(const CorrectorResult& result) const {
     if (result.predictor_residual_norm <= options_.corrector.residual_tolerance) return 0.0;
     return std::min(result.contraction, result.residual_contraction);
+  }
+
+  // The cubic Hermite interpolant p(s) of (u_p, τ_p) at s = −d and (u_a, τ_a) at s = 0, d = |u_a − u_p|
+  // (chord ≈ arclength), evaluated at s = h: *predictor = p(h), *normal = p'(h) normalized. Left as the
+  // tangent predictor when there is no chord, the tangents disagree in orientation, or h > 2d (cubic
+  // extrapolation far beyond the data it was fitted to).
+  static void HermitePredictor(const ContinuationPoint& p, const ContinuationPoint& a, double h, Vector* predictor,
+                               Vector* normal) {
+    const double d = (a.u - p.u).norm();
+    if (!(d > 0) || h > 2 * d || p.tangent.dot(a.tangent) <= 0) return;
+    const double t = 1 + h / d;  // t = 0 at u_p, 1 at u_a
+    const double t2 = t * t, t3 = t2 * t;
+    const double h00 = 2 * t3 - 3 * t2 + 1, h10 = t3 - 2 * t2 + t, h01 = -2 * t3 + 3 * t2, h11 = t3 - t2;
+    const double d00 = 6 * t2 - 6 * t, d10 = 3 * t2 - 4 * t + 1, d01 = -6 * t2 + 6 * t, d11 = 3 * t2 - 2 * t;
+    *predictor = h00 * p.u + h01 * a.u + (h10 * d) * p.tangent + (h11 * d) * a.tangent;
+    const Vector slope = (d00 / d) * p.u + (d01 / d) * a.u + d10 * p.tangent + d11 * a.tangent;
+    if (slope.norm() > 0) *normal = slope.normalized();
   }
 
   // Shrinks h; the last try before giving up is made with exactly min_step.
