@@ -35,7 +35,8 @@ struct Scenario {
   std::vector<StartCondition> start_conditions;
   std::vector<ComponentBound> bounds;
   std::vector<SumBound> sum_bounds;
-  int max_branches = 12;
+  // High enough that every default run completes its diagram (the SLIP has 23 half-branches to H = 2).
+  int max_branches = 64;
   int max_depth = 3;
   int max_points = 600;
   double initial_step = 0.02;
