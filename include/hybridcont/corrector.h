@@ -138,6 +138,8 @@ class Corrector {
   // tangent, so a converged point costs no extra evaluation.
   const Vector& residual() const;
   const Matrix& jacobian() const;
+  // The same as a sparse matrix (no dense copy for problems that prefer sparse Jacobians).
+  const SparseMatrix& sparse_jacobian() const;
 
   const CorrectorOptions& options() const { return options_; }
   void set_max_distance(double max_distance) { options_.max_distance = max_distance; }

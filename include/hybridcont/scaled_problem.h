@@ -24,6 +24,8 @@ class ScaledProblem : public ZeroProblem {
   int num_equations() const override { return problem_->num_equations(); }
   std::vector<std::string> unknown_names() const override { return problem_->unknown_names(); }
   EvaluationStatus Evaluate(const Vector& v, Vector* r, Matrix* dr) override;
+  bool prefers_sparse_jacobian() const override { return problem_->prefers_sparse_jacobian(); }
+  EvaluationStatus EvaluateSparse(const Vector& v, Vector* r, SparseMatrix* dr) override;
 
   Vector ToScaled(const Vector& u) const { return u.cwiseQuotient(scales_); }
   Vector FromScaled(const Vector& v) const { return v.cwiseProduct(scales_); }

@@ -47,6 +47,10 @@ class TimeBasedShooting : public ZeroProblem {
   int num_equations() const override { return layout_.num_equations(); }
   std::vector<std::string> unknown_names() const override { return layout_.unknown_names(); }
   EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override;
+  // From kSparseFrom unknowns on (the bordered solver's sparse threshold), dr is assembled as triplets.
+  static constexpr int kSparseFrom = 150;
+  bool prefers_sparse_jacobian() const override { return num_unknowns() >= kSparseFrom; }
+  EvaluationStatus EvaluateSparse(const Vector& u, Vector* r, SparseMatrix* dr) override;
 
   const ShootingLayout& layout() const { return layout_; }
   const HybridModel& model() const { return *model_; }
@@ -67,6 +71,9 @@ class TimeBasedShooting : public ZeroProblem {
 
  private:
   EvaluationStatus Integrate(const Vector& u, bool sensitivities);
+  // r and the blocks of dr (eq. multishootJacobian) into a sink: dense matrix or triplets.
+  template <class Sink>
+  EvaluationStatus Assemble(const Vector& u, Vector* r, Sink* dr);
 
   const HybridModel* model_;
   IntegratorOptions options_;
@@ -85,6 +92,7 @@ class TimeBasedShooting : public ZeroProblem {
   Vector out_, H_;
   Matrix D_, dH_;
   RowVector de_;
+  std::vector<Eigen::Triplet<double>> triplets_;
 };
 
 }  // namespace hybridcont

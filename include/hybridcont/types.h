@@ -9,12 +9,15 @@
 #define HYBRIDCONT_TYPES_H_
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 namespace hybridcont {
 
 using Vector = Eigen::VectorXd;
 using RowVector = Eigen::RowVectorXd;
 using Matrix = Eigen::MatrixXd;
+// Jacobians with O(N) nonzeros (multiple shooting with many phases: block-cyclic), column-major.
+using SparseMatrix = Eigen::SparseMatrix<double>;
 
 }  // namespace hybridcont
 

@@ -52,6 +52,20 @@ class ZeroProblem {
   // Both outputs are computed from the same internal state when both are requested.
   virtual EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) = 0;
 
+  // Sparse channel. A problem whose dr has O(N) nonzeros (time-based multiple shooting: a block-cyclic
+  // pattern of 2(m+1) blocks) says so here, and the corrector then evaluates and factorizes dr as a sparse
+  // matrix: a Newton step costs O(m) instead of the O(m²) of merely storing N x (N+1) doubles. The
+  // pattern must not depend on u (explicit zeros are stored), so that its analysis can be reused.
+  virtual bool prefers_sparse_jacobian() const { return false; }
+  // r and dr as a sparse N x (N+1) matrix. The default converts the dense Evaluate.
+  virtual EvaluationStatus EvaluateSparse(const Vector& u, Vector* r, SparseMatrix* dr) {
+    if (dr == nullptr) return Evaluate(u, r, nullptr);
+    Matrix dense;
+    const EvaluationStatus status = Evaluate(u, r, &dense);
+    if (status.ok) *dr = dense.sparseView(1.0, 0.0);
+    return status;
+  }
+
   // Index of the named unknown, or -1.
   int UnknownIndex(const std::string& name) const {
     const std::vector<std::string> names = unknown_names();

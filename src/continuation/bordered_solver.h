@@ -13,6 +13,7 @@
 #include <Eigen/LU>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
+#include <vector>
 
 #include "hybridcont/types.h"
 
@@ -23,6 +24,9 @@ class BorderedSolver {
   // Factorizes [A; bᵀ]. Returns false if the matrix is not finite or numerically singular (smallest pivot
   // of the LU below kSingularPivotRatio times the largest). Storage is reused between calls of equal size.
   bool Factorize(const Matrix& A, const Vector& b);
+  // The same for a sparse A (always the sparse LU). The symbolic analysis (COLAMD ordering, elimination
+  // tree) is reused while the pattern of A stays the same: only the numeric factorization is redone.
+  bool Factorize(const SparseMatrix& A, const Vector& b);
   // x = B⁻¹ rhs for the last successful factorization; x is resized only when its size differs.
   void Solve(const Vector& rhs, Vector* x) const;
   // log|det B| and sign(det B) of the last factorization (never formed as a product: it over/underflows
@@ -45,11 +49,16 @@ class BorderedSolver {
 
  private:
   bool FactorizeSparse();
+  bool FactorizeSparseB();
+  // Pattern of the last analyzed sparse B (sizes and column starts), to reuse analyzePattern.
+  Eigen::Index analyzed_rows_ = -1, analyzed_nonzeros_ = -1;
+  std::vector<int> analyzed_outer_, analyzed_inner_;
+  std::vector<Eigen::Triplet<double>> triplets_;
 
   Matrix B_;
   Eigen::PartialPivLU<Matrix> lu_;
   bool sparse_ = false;
-  Eigen::SparseMatrix<double> sparse_B_;
+  SparseMatrix sparse_B_;
   Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> sparse_lu_;
   double sparse_log_det_ = 0.0;
   int sparse_sign_ = 1;

@@ -64,6 +64,11 @@ std::string CorrectorResult::BriefReport() const {
 struct Corrector::Workspace {
   Vector r, F, delta, kernel, unit_last, border, correction;
   Matrix dr;
+  // Sparse channel (ZeroProblem::prefers_sparse_jacobian): dr is evaluated and factorized sparse, and
+  // the dense copy is made only when jacobian() is asked for.
+  bool sparse = false;
+  bool dense_stale = false;
+  SparseMatrix dr_sparse;
   internal::BorderedSolver solver;
 };
 
@@ -84,7 +89,19 @@ Corrector::Corrector(Corrector&&) noexcept = default;
 Corrector& Corrector::operator=(Corrector&&) noexcept = default;
 
 const Vector& Corrector::residual() const { return workspace_->r; }
-const Matrix& Corrector::jacobian() const { return workspace_->dr; }
+const Matrix& Corrector::jacobian() const {
+  Workspace& w = *workspace_;
+  if (w.sparse && w.dense_stale) {
+    w.dr = Matrix(w.dr_sparse);
+    w.dense_stale = false;
+  }
+  return w.dr;
+}
+const SparseMatrix& Corrector::sparse_jacobian() const {
+  Workspace& w = *workspace_;
+  if (!w.sparse) w.dr_sparse = w.dr.sparseView(1.0, 0.0);
+  return w.dr_sparse;
+}
 
 CorrectorResult Corrector::CorrectPseudoArclength(const Vector& u_pred, const Vector& tau, Vector* u) {
   return Run(Border::kArclength, u_pred, tau, 0.0, u);
@@ -124,8 +141,11 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
 
   CorrectorResult result;
   double last_step = 0, previous_step = 0, previous_residual = 0;
+  w.sparse = problem_->prefers_sparse_jacobian();
   for (int k = 0;; ++k) {
-    const EvaluationStatus evaluation = problem_->Evaluate(u, &w.r, &w.dr);
+    const EvaluationStatus evaluation =
+        w.sparse ? problem_->EvaluateSparse(u, &w.r, &w.dr_sparse) : problem_->Evaluate(u, &w.r, &w.dr);
+    w.dense_stale = w.sparse;
     ++result.evaluations;
     if (!evaluation.ok) {
       result.status = CorrectorStatus::kEvaluationFailed;
@@ -144,7 +164,9 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
     if (k == 1 && result.predictor_residual_norm > 0) {
       result.residual_contraction = result.residual_norm / result.predictor_residual_norm;
     }
-    if (!std::isfinite(result.residual_norm) || !w.dr.allFinite()) {
+    const bool jacobian_finite = w.sparse ? Eigen::Map<const Vector>(w.dr_sparse.valuePtr(), w.dr_sparse.nonZeros()).allFinite()
+                                          : w.dr.allFinite();
+    if (!std::isfinite(result.residual_norm) || !jacobian_finite) {
       result.status = CorrectorStatus::kDiverged;
       result.message = "non-finite residual or Jacobian";
       return result;
@@ -193,7 +215,7 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
                        " iterations";
       return result;
     }
-    if (!w.solver.Factorize(w.dr, w.border)) {
+    if (!(w.sparse ? w.solver.Factorize(w.dr_sparse, w.border) : w.solver.Factorize(w.dr, w.border))) {
       result.status = CorrectorStatus::kSingular;
       result.message = "bordered matrix [dr; b^T] singular at iteration " + std::to_string(k);
       return result;

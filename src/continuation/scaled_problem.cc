@@ -26,4 +26,11 @@ EvaluationStatus ScaledProblem::Evaluate(const Vector& v, Vector* r, Matrix* dr)
   return status;
 }
 
+EvaluationStatus ScaledProblem::EvaluateSparse(const Vector& v, Vector* r, SparseMatrix* dr) {
+  u_ = FromScaled(v);
+  const EvaluationStatus status = problem_->EvaluateSparse(u_, r, dr);
+  if (status.ok && dr) *dr = *dr * scales_.asDiagonal();
+  return status;
+}
+
 }  // namespace hybridcont

@@ -43,7 +43,56 @@ EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivitie
   return status;
 }
 
+namespace {
+
+// Where the Jacobian's blocks go: Add(row, col, block) adds a block (entries of blocks that overlap sum).
+struct DenseSink {
+  Matrix* dr;
+  template <class Block>
+  void Add(int row, int col, const Block& block) {
+    dr->block(row, col, block.rows(), block.cols()) += block;
+  }
+};
+struct TripletSink {
+  std::vector<Eigen::Triplet<double>>* triplets;
+  template <class Block>
+  void Add(int row, int col, const Block& block) {
+    for (int j = 0; j < block.cols(); ++j) {
+      for (int i = 0; i < block.rows(); ++i) triplets->emplace_back(row + i, col + j, block(i, j));
+    }
+  }
+};
+
+}  // namespace
+
 EvaluationStatus TimeBasedShooting::Evaluate(const Vector& u, Vector* r, Matrix* dr) {
+  if (dr == nullptr) return Assemble<DenseSink>(u, r, nullptr);
+  const int N = layout_.num_equations();
+  dr->setZero(N, N + 1);
+  DenseSink sink{dr};
+  const EvaluationStatus status = Assemble(u, r, &sink);
+  if (status.ok && !dr->allFinite()) return EvaluationStatus::Failure("Jacobian has non-finite entries");
+  return status;
+}
+
+EvaluationStatus TimeBasedShooting::EvaluateSparse(const Vector& u, Vector* r, SparseMatrix* dr) {
+  if (dr == nullptr) return Assemble<TripletSink>(u, r, nullptr);
+  triplets_.clear();
+  TripletSink sink{&triplets_};
+  const EvaluationStatus status = Assemble(u, r, &sink);
+  if (!status.ok) return status;
+  const int N = layout_.num_equations();
+  dr->resize(N, N + 1);
+  dr->setFromTriplets(triplets_.begin(), triplets_.end());
+  if (!Eigen::Map<const Vector>(dr->valuePtr(), dr->nonZeros()).allFinite()) {
+    return EvaluationStatus::Failure("Jacobian has non-finite entries");
+  }
+  return status;
+}
+
+template <class Sink>
+EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* dr) {
+
   if (u.size() != layout_.num_unknowns()) {
     throw std::invalid_argument("TimeBasedShooting::Evaluate: u has " + std::to_string(u.size()) +
                                 " entries, expected " + std::to_string(layout_.num_unknowns()));
@@ -60,7 +109,6 @@ EvaluationStatus TimeBasedShooting::Evaluate(const Vector& u, Vector* r, Matrix*
   const int N = layout_.num_equations();
   const auto xi = u.segment(layout_.xi_index(), k);
   if (r) r->resize(N);
-  if (dr) dr->setZero(N, N + 1);
 
   Vector f_tilde;
   for (int i = 0; i <= m; ++i) {
@@ -94,14 +142,14 @@ EvaluationStatus TimeBasedShooting::Evaluate(const Vector& u, Vector* r, Matrix*
       phase.UnfoldedVectorField(flow.x, xi, &f_tilde, nullptr, nullptr);
       const int n = layout_.dim(i);
       const int ct = layout_.time_index(i);
-      dr->block(row, ct, n_out, 1).noalias() = D_ * f_tilde;
-      dr->block(row, ct + 1, n_out, n).noalias() = D_ * flow.Phi;
-      dr->block(row, layout_.xi_index(), n_out, k).noalias() = D_ * flow.Psi;
-      (*dr)(row + n_out, ct) = de_.dot(f_tilde);
-      dr->block(row + n_out, ct + 1, 1, n).noalias() = de_ * flow.Phi;
-      dr->block(row + n_out, layout_.xi_index(), 1, k).noalias() = de_ * flow.Psi;
+      dr->Add(row, ct, D_ * f_tilde);
+      dr->Add(row, ct + 1, D_ * flow.Phi);
+      dr->Add(row, layout_.xi_index(), D_ * flow.Psi);
+      dr->Add(row + n_out, ct, Eigen::Matrix<double, 1, 1>(de_.dot(f_tilde)));
+      dr->Add(row + n_out, ct + 1, de_ * flow.Phi);
+      dr->Add(row + n_out, layout_.xi_index(), de_ * flow.Psi);
       // C: -I on x̄_{i+1}
-      dr->block(row, layout_.state_offset(next), n_out, n_out).diagonal().array() -= 1.0;
+      dr->Add(row, layout_.state_offset(next), -Matrix::Identity(n_out, n_out));
     }
   }
   // First integrals at x̄_1: H_1 - H̄ (unknown level), H_j - H̄_j fixed for j >= 2.
@@ -115,9 +163,8 @@ EvaluationStatus TimeBasedShooting::Evaluate(const Vector& u, Vector* r, Matrix*
     if (!r->allFinite()) return EvaluationStatus::Failure("first integral returned a non-finite value");
   }
   if (dr) {
-    dr->block(row, layout_.state_offset(0), k, n1) = dH_;
-    (*dr)(row, layout_.H_index()) = -1.0;
-    if (!dr->allFinite()) return EvaluationStatus::Failure("Jacobian has non-finite entries");
+    dr->Add(row, layout_.state_offset(0), dH_);
+    dr->Add(row, layout_.H_index(), Eigen::Matrix<double, 1, 1>(-1.0));
   }
   return {};
 }
