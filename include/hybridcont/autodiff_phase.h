@@ -4,7 +4,8 @@
 // AutoDiffPhase<F, P> instantiates them with
 //   - double                       for values,
 //   - Jet  = AutoDiffScalar<dual>  for first derivatives (df, dH, de, D): one forward sweep over n seeds,
-//   - Jet2 = AutoDiffScalar<Jet>   for the Hessians of H (needed by A = df~/dx when xi != 0).
+//   - a second-order jet           for the Hessians of H (needed by A = df~/dx when xi != 0):
+//     HessianJet<n> (hessian_jet.h) for n <= kMaxFixedJetDim, Jet2 = AutoDiffScalar<Jet> above.
 // Derivative vectors are fixed-capacity (kMaxPhaseDim) stack storage, so no evaluation allocates on the
 // heap. Eigen's AutoDiff module is the well-kept library this builds on (STYLE.md practice 4).
 #ifndef HYBRIDCONT_AUTODIFF_PHASE_H_
@@ -19,6 +20,8 @@
 
 #include <unsupported/Eigen/AutoDiff>
 
+#include "hybridcont/hessian_jet.h"
+
 namespace hybridcont::internal {
 
 using DerivativeVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxPhaseDim, 1>;
@@ -26,12 +29,12 @@ using Jet = Eigen::AutoDiffScalar<DerivativeVector>;
 using Jet2 = Eigen::AutoDiffScalar<Eigen::Matrix<Jet, Eigen::Dynamic, 1, 0, kMaxPhaseDim, 1>>;
 
 // AD scalars for a phase of dimension N: fixed-size derivative vectors for small N (unrolled and
-// vectorized by Eigen; the Hessian of H with fixed-size nested jets is ~4x cheaper than with the
-// bounded-dynamic ones, measured on the SLIP stance phase), bounded-dynamic ones otherwise.
+// vectorized by Eigen), bounded-dynamic ones otherwise. Second order: HessianJet for small N (see its header
+// for the measured gain over nested fixed-size AutoDiffScalars), nested bounded-dynamic jets otherwise.
 template <int N>
 struct JetTypes {
   using J = Eigen::AutoDiffScalar<Eigen::Matrix<double, N, 1>>;
-  using J2 = Eigen::AutoDiffScalar<Eigen::Matrix<J, N, 1>>;
+  using J2 = HessianJet<N>;
 };
 template <>
 struct JetTypes<Eigen::Dynamic> {
@@ -67,16 +70,40 @@ StateVector<J> SeedJets(const Eigen::Ref<const Vector>& x) {
 
 template <class J2>
 StateVector<J2> SeedJets2(const Eigen::Ref<const Vector>& x) {
-  using J = typename J2::Scalar;
-  using D = typename J::DerType;
   const int n = static_cast<int>(x.size());
   StateVector<J2> xj(n);
   for (int i = 0; i < n; ++i) {
-    xj(i).value() = J(x(i), n, i);
-    xj(i).derivatives().resize(n);
-    for (int j = 0; j < n; ++j) xj(i).derivatives()(j) = J(i == j ? 1.0 : 0.0, D::Zero(n));
+    if constexpr (std::is_same_v<J2, Jet2>) {
+      xj(i).value() = Jet(x(i), n, i);
+      xj(i).derivatives().resize(n);
+      for (int j = 0; j < n; ++j) xj(i).derivatives()(j) = Jet(i == j ? 1.0 : 0.0, DerivativeVector::Zero(n));
+    } else {
+      xj(i) = J2::Variable(x(i), i);
+    }
   }
   return xj;
+}
+
+// Value, gradient (into a row) and Hessian of a second-order jet.
+template <int N, class Row>
+void UnpackSecondOrder(const HessianJet<N>& h, double* value, Row&& gradient, Matrix* hessian) {
+  *value = h.value;
+  for (int a = 0; a < N; ++a) {
+    gradient(a) = h.gradient[a];
+    for (int b = a; b < N; ++b) (*hessian)(a, b) = (*hessian)(b, a) = h.hessian[HessianJet<N>::Packed(a, b)];
+  }
+}
+// A nested jet that never met an input (a constant) has empty derivative vectors: its rows stay zero.
+template <class Row>
+void UnpackSecondOrder(const Jet2& h, double* value, Row&& gradient, Matrix* hessian) {
+  *value = h.value().value();
+  const int n = static_cast<int>(hessian->rows());
+  if (h.derivatives().size() != n) return;
+  for (int a = 0; a < n; ++a) {
+    const auto& g = h.derivatives()(a);
+    gradient(a) = g.value();
+    if (g.derivatives().size() == n) hessian->row(a) = g.derivatives().transpose();
+  }
 }
 
 // Value and Jacobian rows of a vector of jets. A jet that never met an input (a constant output) has an
@@ -187,17 +214,14 @@ class AutoDiffPhase final : public Phase {
     if (H) H->resize(k);
     if (dH) dH->resize(k, n);
     d2H->resize(k);
+    Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxPhaseDim> gradient(n);
     for (int j = 0; j < k; ++j) {
-      if (H) (*H)(j) = h(j).value().value();
-      Matrix& hess = (*d2H)[j];
-      hess.setZero(n, n);
-      if (dH) dH->row(j).setZero();
-      if (h(j).derivatives().size() != n) continue;
-      for (int a = 0; a < n; ++a) {
-        const auto& g = h(j).derivatives()(a);
-        if (dH) (*dH)(j, a) = g.value();
-        if (g.derivatives().size() == n) hess.row(a) = g.derivatives().transpose();
-      }
+      double value;
+      gradient.setZero();
+      (*d2H)[j].setZero(n, n);
+      UnpackSecondOrder(h(j), &value, gradient, &(*d2H)[j]);
+      if (H) (*H)(j) = value;
+      if (dH) dH->row(j) = gradient;
     }
   }
 

@@ -65,10 +65,20 @@ struct AugmentedRhsWorkspace {
     }
     dz.head(n) = f;
     if (!sensitivities) return;
-    Eigen::Map<Matrix>(dz.data() + n, n, n).noalias() = A * Phi(z);
-    Eigen::Map<Matrix> dPsi(dz.data() + n + n * n, n, k);
-    dPsi.noalias() = A * Psi(z);
-    dPsi += B;
+    DispatchOnDimension(n, [&](auto N) { Propagate<decltype(N)::value>(z, dz); });
+  }
+
+  // dPhi = A Phi, dPsi = A Psi + B with the phase dimension N fixed at compile time where it is small: the
+  // products unroll (the dynamic-size ones were ~18% of a SLIP r + dr evaluation).
+  template <int N>
+  void Propagate(const Vector& z, Vector& dz) const {
+    using Square = Eigen::Matrix<double, N, N>;
+    using Tall = Eigen::Matrix<double, N, Eigen::Dynamic>;
+    const Eigen::Map<const Square> A_n(A.data(), n, n);
+    Eigen::Map<Square>(dz.data() + n, n, n).noalias() = A_n * Eigen::Map<const Square>(z.data() + n, n, n);
+    Eigen::Map<Tall> dPsi(dz.data() + n + n * n, n, k);
+    dPsi.noalias() = A_n * Eigen::Map<const Tall>(z.data() + n + n * n, n, k);
+    dPsi += Eigen::Map<const Tall>(B.data(), n, k);
   }
 };
 
