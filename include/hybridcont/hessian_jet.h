@@ -37,9 +37,11 @@ struct HessianJet {
   // Index of H(i, j), i <= j, in the packed upper triangle.
   static constexpr int Packed(int i, int j) { return i * N - i * (i - 1) / 2 + (j - i); }
 
+  // Uninitialized, like double and AutoDiffScalar: Eigen's bounded-dynamic vectors of jets construct all
+  // kMaxPhaseDim entries, and zeroing them cost more than the Hessian arithmetic.
   HessianJet() = default;
   // A constant (implicit, like AutoDiffScalar: `T(0)`, `2.0 * x`, `x + 1.0`).
-  HessianJet(double v) : value(v) {}  // NOLINT(google-explicit-constructor)
+  HessianJet(double v) : value(v), gradient{}, hessian{} {}  // NOLINT(google-explicit-constructor)
   // The i-th independent variable at v.
   static HessianJet Variable(double v, int i) {
     HessianJet x(v);
@@ -56,15 +58,16 @@ struct HessianJet {
   HessianJet& operator*=(double s) { return *this = *this * s; }
   HessianJet& operator/=(double s) { return *this = *this * (1.0 / s); }
 
-  double value = 0.0;
-  std::array<double, N> gradient{};
-  std::array<double, kPackedSize> hessian{};
+  double value;
+  std::array<double, N> gradient;
+  std::array<double, kPackedSize> hessian;
 };
 
 // phi(f) from phi(f.value) = v, phi' = d1, phi'' = d2.
 template <int N>
 inline HessianJet<N> Chain(const HessianJet<N>& f, double v, double d1, double d2) {
-  HessianJet<N> r(v);
+  HessianJet<N> r;
+  r.value = v;
   for (int i = 0; i < N; ++i) r.gradient[i] = d1 * f.gradient[i];
   int q = 0;
   for (int i = 0; i < N; ++i) {
@@ -78,7 +81,8 @@ inline HessianJet<N> Chain(const HessianJet<N>& f, double v, double d1, double d
 template <int N>
 inline HessianJet<N> Chain(const HessianJet<N>& f, const HessianJet<N>& g, double v, double df, double dg,
                            double dff, double dgg, double dfg) {
-  HessianJet<N> r(v);
+  HessianJet<N> r;
+  r.value = v;
   for (int i = 0; i < N; ++i) r.gradient[i] = df * f.gradient[i] + dg * g.gradient[i];
   int q = 0;
   for (int i = 0; i < N; ++i) {
@@ -97,28 +101,32 @@ inline HessianJet<N> operator+(const HessianJet<N>& f) {
 }
 template <int N>
 inline HessianJet<N> operator-(const HessianJet<N>& f) {
-  HessianJet<N> r(-f.value);
+  HessianJet<N> r;
+  r.value = -f.value;
   for (int i = 0; i < N; ++i) r.gradient[i] = -f.gradient[i];
   for (int q = 0; q < HessianJet<N>::kPackedSize; ++q) r.hessian[q] = -f.hessian[q];
   return r;
 }
 template <int N>
 inline HessianJet<N> operator+(const HessianJet<N>& f, const HessianJet<N>& g) {
-  HessianJet<N> r(f.value + g.value);
+  HessianJet<N> r;
+  r.value = f.value + g.value;
   for (int i = 0; i < N; ++i) r.gradient[i] = f.gradient[i] + g.gradient[i];
   for (int q = 0; q < HessianJet<N>::kPackedSize; ++q) r.hessian[q] = f.hessian[q] + g.hessian[q];
   return r;
 }
 template <int N>
 inline HessianJet<N> operator-(const HessianJet<N>& f, const HessianJet<N>& g) {
-  HessianJet<N> r(f.value - g.value);
+  HessianJet<N> r;
+  r.value = f.value - g.value;
   for (int i = 0; i < N; ++i) r.gradient[i] = f.gradient[i] - g.gradient[i];
   for (int q = 0; q < HessianJet<N>::kPackedSize; ++q) r.hessian[q] = f.hessian[q] - g.hessian[q];
   return r;
 }
 template <int N>
 inline HessianJet<N> operator*(const HessianJet<N>& f, const HessianJet<N>& g) {
-  HessianJet<N> r(f.value * g.value);
+  HessianJet<N> r;
+  r.value = f.value * g.value;
   for (int i = 0; i < N; ++i) r.gradient[i] = f.value * g.gradient[i] + g.value * f.gradient[i];
   int q = 0;
   for (int i = 0; i < N; ++i) {
@@ -159,7 +167,8 @@ inline HessianJet<N> operator-(double s, const HessianJet<N>& f) {
 }
 template <int N>
 inline HessianJet<N> operator*(const HessianJet<N>& f, double s) {
-  HessianJet<N> r(f.value * s);
+  HessianJet<N> r;
+  r.value = f.value * s;
   for (int i = 0; i < N; ++i) r.gradient[i] = f.gradient[i] * s;
   for (int q = 0; q < HessianJet<N>::kPackedSize; ++q) r.hessian[q] = f.hessian[q] * s;
   return r;
