@@ -64,9 +64,9 @@ Scenario DefaultScenario(const HybridModel& model) {
     s.bounds.push_back({"H", 0.0, 2.0});
     s.sum_bounds.push_back({Durations(model), -20.0, 20.0});
     s.keyframes = {"H", 1.8};
-    // The SLIP's branches are long and gently curved: steps up to 0.25 (the library's default) halve the
-    // points (1163 -> 722 for the complete diagram) with the same SB and turning points found.
-    s.max_step = 0.25;
+    // Steps stay at 0.1: 0.25 would halve the points (1163 -> 722 for the complete diagram) with the same
+    // SB and turning points, but one step would then cross both Floquet −1 crossings of hopping in place
+    // (H = 1.24674, 1.28281), whose sign changes cancel: the PD points and the stable stretch are lost.
     s.describe = [layout](const Vector& u) {
       const double dx = u(layout.state_offset(1) + 2);  // x2_dx: forward speed in flight
       return std::string(std::abs(dx) < 1e-6 ? "hopping in place" : dx > 0 ? "forward hopping" : "backward hopping");

@@ -177,10 +177,11 @@ TEST(Cli, SlipSimpleBifurcationsAreFloquetCrossingsInBothFormulations) {
     ASSERT_EQ(r.code, 0) << r.err;
     std::ifstream summary_file(dir / "summary.json");
     const nlohmann::json summary = nlohmann::json::parse(summary_file);
-    std::vector<double> sb, bp;
+    std::vector<double> sb, bp, pd;
     for (const auto& sp : summary["special_points"]) {
       if (sp["type"] == "SB" && sp["status"] == "located") sb.push_back(sp["H"]);
       if (sp["type"] == "BP") bp.push_back(sp["H"]);
+      if (sp["type"] == "PD") pd.push_back(sp["H"]);
     }
     // the first SB above the start, located by continuation, and the first BP (multiplier +1)
     const auto near = [](const std::vector<double>& v, double x) {
@@ -190,6 +191,9 @@ TEST(Cli, SlipSimpleBifurcationsAreFloquetCrossingsInBothFormulations) {
     };
     EXPECT_LT(near(sb, 1.24674011004), 1e-9) << formulation;
     EXPECT_LT(near(bp, 1.24674011004), 1e-9) << formulation;
+    // The −1 crossing that ends the unstable stretch: 0.036 in H above the first, so the default steps
+    // must resolve both (a step across both crossings would cancel the sign changes and miss them).
+    EXPECT_LT(near(pd, 1.282809323809), 1e-9) << formulation;
   }
 }
 
