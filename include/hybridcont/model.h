@@ -87,7 +87,15 @@ class Phase {
   // when some xi_j != 0 (their term vanishes exactly otherwise) and include_hessian_term is true; a
   // caller may drop the term when it is provably below its accuracy (see PhaseFlow).
   void UnfoldedVectorField(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
-                           Vector* f_tilde, Matrix* A, Matrix* B, bool include_hessian_term = true) const;
+                           Vector* f_tilde, Matrix* A, Matrix* B, bool include_hessian_term = true) const {
+    ComputeUnfoldedVectorField(x, xi, f_tilde, A, B, include_hessian_term);
+  }
+
+ protected:
+  // UnfoldedVectorField from the four functions above. A phase may override it to compute the same in one
+  // pass (AutoDiffPhase does): it runs once per right-hand-side evaluation of the integrator.
+  virtual void ComputeUnfoldedVectorField(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
+                                          Vector* f_tilde, Matrix* A, Matrix* B, bool include_hessian_term) const;
 
  private:
   std::string name_;

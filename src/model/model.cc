@@ -13,8 +13,8 @@ Phase::Phase(std::string name, std::vector<std::string> state_names, int next_di
       num_first_integrals_(num_first_integrals),
       typical_state_(std::move(typical_state)) {}
 
-void Phase::UnfoldedVectorField(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
-                                Vector* f_tilde, Matrix* A, Matrix* B, bool include_hessian_term) const {
+void Phase::ComputeUnfoldedVectorField(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
+                                       Vector* f_tilde, Matrix* A, Matrix* B, bool include_hessian_term) const {
   const bool dissipative = (xi.array() != 0.0).any();
   const bool need_hessians = A != nullptr && dissipative && include_hessian_term;
   const bool need_gradients = B != nullptr || dissipative;
