@@ -1,15 +1,73 @@
 // The unfolded vector field (eq. `hybridDynamicsNum`), which AutoDiffPhase computes in one pass, equals its
-// definition from the phase's own functions: f~ = f + dH^T xi, A = df + sum_j xi_j d2H_j, B = dH^T.
+// definition from the phase's own functions: f~ = f + dH^T xi, A = df + sum_j xi_j d2H_j, B = dH^T; for
+// fixed-size and bounded-dynamic jets alike.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <string>
 #include <vector>
 
+#include "hybridcont/derivative_check.h"
 #include "hybridcont/models.h"
 
 namespace hybridcont {
 namespace {
+
+// A phase above kMaxFixedJetDim (bounded-dynamic jets): five coupled pendula, x = [q; p].
+struct PendulaParameters {
+  double coupling = 0.3;
+};
+struct Pendula {
+  static constexpr int kDof = 5;
+  template <class T>
+  static StateVector<T> VectorField(const StateVector<T>& x, const PendulaParameters& c) {
+    using std::sin;
+    StateVector<T> f(2 * kDof);
+    for (int i = 0; i < kDof; ++i) {
+      f(i) = x(kDof + i);
+      f(kDof + i) = -sin(x(i));
+      if (i > 0) f(kDof + i) -= c.coupling * (x(i) - x(i - 1));
+      if (i + 1 < kDof) f(kDof + i) -= c.coupling * (x(i) - x(i + 1));
+    }
+    return f;
+  }
+  template <class T>
+  static T FirstIntegral(const StateVector<T>& x, const PendulaParameters& c) {
+    using std::cos;
+    T h = T(0.0);
+    for (int i = 0; i < kDof; ++i) h += 0.5 * x(kDof + i) * x(kDof + i) - cos(x(i));
+    for (int i = 0; i + 1 < kDof; ++i) h += 0.5 * c.coupling * (x(i) - x(i + 1)) * (x(i) - x(i + 1));
+    return h;
+  }
+  template <class T>
+  static T Event(const StateVector<T>& x, const PendulaParameters&) {
+    return x(0);
+  }
+  template <class T>
+  static StateVector<T> Reset(const StateVector<T>& x, const PendulaParameters&) {
+    return x;
+  }
+};
+struct PendulaAnchor {
+  template <class T>
+  static T Anchor(const StateVector<T>& x, const PendulaParameters&) {
+    return x(Pendula::kDof);
+  }
+};
+
+HybridModel MakePendula() {
+  ModelBuilder<PendulaParameters> b("pendula", "five coupled pendula (a 10-dimensional phase)");
+  b.Parameter("c", &PendulaParameters::coupling, "coupling");
+  std::vector<std::string> names;
+  Vector typical(2 * Pendula::kDof);
+  for (int i = 0; i < 2 * Pendula::kDof; ++i) {
+    names.push_back("x" + std::to_string(i));
+    typical(i) = 0.1 * (i + 1) * (i % 2 == 0 ? 1.0 : -1.0);
+  }
+  b.AddPhase<Pendula>("swing", names, typical);
+  b.SetAnchor<PendulaAnchor>();
+  return b.Build();
+}
 
 void ExpectClose(const Matrix& got, const Matrix& want, const std::string& what) {
   ASSERT_EQ(got.rows(), want.rows()) << what;
@@ -21,6 +79,7 @@ TEST(UnfoldedVectorField, EqualsItsDefinitionInEveryBuiltinPhase) {
   std::vector<HybridModel> models;
   for (const std::string& name : BuiltinModelNames()) models.push_back(MakeBuiltinModel(name));
   models.push_back(MakeBallChain(3));
+  models.push_back(MakePendula());
   for (const HybridModel& model : models) {
     const std::string& name = model.name();
     for (int i = 0; i < model.num_phases(); ++i) {
@@ -55,6 +114,13 @@ TEST(UnfoldedVectorField, EqualsItsDefinitionInEveryBuiltinPhase) {
       }
     }
   }
+}
+
+// The bounded-dynamic path end to end: Jacobians, Hessians and the flow's Phi, Psi against differences.
+TEST(UnfoldedVectorField, BoundedDynamicPhasePassesDerivativeChecks) {
+  const HybridModel pendula = MakePendula();
+  const DerivativeCheckReport report = CheckDerivatives(pendula, DerivativeCheckOptions{});
+  EXPECT_TRUE(report.passed()) << report.Table();
 }
 
 }  // namespace

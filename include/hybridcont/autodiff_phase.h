@@ -64,7 +64,10 @@ template <class J>
 StateVector<J> SeedJets(const Eigen::Ref<const Vector>& x) {
   const int n = static_cast<int>(x.size());
   StateVector<J> xj(n);
-  for (int i = 0; i < n; ++i) xj(i) = J(x(i), n, i);
+  for (int i = 0; i < n; ++i) {
+    xj(i).value() = x(i);
+    xj(i).derivatives() = J::DerType::Unit(n, i);
+  }
   return xj;
 }
 
@@ -78,7 +81,11 @@ StateVector<J2> SeedJets2(const Eigen::Ref<const Vector>& x) {
       xj(i).derivatives().resize(n);
       for (int j = 0; j < n; ++j) xj(i).derivatives()(j) = Jet(i == j ? 1.0 : 0.0, DerivativeVector::Zero(n));
     } else {
-      xj(i) = J2::Variable(x(i), i);
+      // In place: copying in a seeded temporary stalled on store forwarding (~9% of a SLIP r + dr).
+      J2& v = xj(i);
+      v.value = x(i);
+      for (int j = 0; j < n; ++j) v.gradient[j] = i == j ? 1.0 : 0.0;
+      v.hessian.fill(0.0);
     }
   }
   return xj;
