@@ -1,8 +1,10 @@
-// The scalable ball-chain model: closed-form orbits are zeros, and Newton on large multiple-shooting
-// systems (sparse bordered LU above BorderedSolver::kSparseThreshold unknowns) converges back to them.
+// The scalable ball-chain model: closed-form orbits are zeros, Newton on large multiple-shooting systems
+// (sparse bordered LU above BorderedSolver::kSparseThreshold unknowns) converges back to them, and its
+// many segments integrated on several threads give the serial map.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include "hybridcont/corrector.h"
 #include "hybridcont/models.h"
@@ -43,6 +45,42 @@ TEST(BallChain, NewtonOnALargeSparseSystemReturnsToTheOrbit) {
   // The family is one-dimensional and H fixes it up to the phase along the orbit, which the anchor
   // fixes: the corrected point is the closed-form orbit.
   EXPECT_LT((u - exact).lpNorm<Eigen::Infinity>(), 1e-9);
+}
+
+// The segments integrated on two threads give r, dr and the work counters of the serial loop, bitwise.
+TEST(BallChain, SegmentsOnTwoThreadsGiveTheSerialMapBitwise) {
+  const int m = 200;
+  const HybridModel chain = MakeBallChain(m);
+  ASSERT_GE(m + 1, 2 * TimeBasedShooting::kMinSegmentsPerThread);  // large enough for the threads
+  Vector u = BallChainOrbit(chain, 0.5);
+  for (int i = 0; i < u.size() - 2; ++i) u(i) += 1e-3 * std::sin(1.0 + i);
+  TimeBasedShooting serial(chain, IntegratorOptions{});
+  serial.set_threads(1);
+  TimeBasedShooting threaded(chain, IntegratorOptions{});
+  threaded.set_threads(2);
+  EXPECT_EQ(threaded.threads(), 2);
+  Vector r1, r2;
+  Matrix dr1, dr2;
+  ASSERT_TRUE(serial.Evaluate(u, &r1, &dr1).ok);
+  ASSERT_TRUE(threaded.Evaluate(u, &r2, &dr2).ok);
+  EXPECT_TRUE(r1 == r2);
+  EXPECT_TRUE(dr1 == dr2);
+  u(0) += 1e-9;  // r alone: the integration without sensitivities
+  ASSERT_TRUE(serial.Evaluate(u, &r1, nullptr).ok);
+  ASSERT_TRUE(threaded.Evaluate(u, &r2, nullptr).ok);
+  EXPECT_TRUE(r1 == r2);
+  for (int k = 1; k <= 20; ++k) {  // many loops of the team: each result complete and in its place
+    u(1) += 1e-7;
+    ASSERT_TRUE(serial.Evaluate(u, &r1, nullptr).ok);
+    ASSERT_TRUE(threaded.Evaluate(u, &r2, nullptr).ok);
+    ASSERT_TRUE(r1 == r2) << "evaluation " << k;
+  }
+  EXPECT_EQ(serial.counters().rhs_evaluations, threaded.counters().rhs_evaluations);
+  EXPECT_EQ(serial.counters().steps, threaded.counters().steps);
+  EXPECT_EQ(serial.num_evaluations(), threaded.num_evaluations());
+  EXPECT_EQ(threaded.num_evaluations(), 22);
+
+  EXPECT_THROW(threaded.set_threads(0), std::invalid_argument);
 }
 
 }  // namespace
