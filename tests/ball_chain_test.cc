@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include "hybridcont/corrector.h"
@@ -47,7 +48,8 @@ TEST(BallChain, NewtonOnALargeSparseSystemReturnsToTheOrbit) {
   EXPECT_LT((u - exact).lpNorm<Eigen::Infinity>(), 1e-9);
 }
 
-// The segments integrated on two threads give r, dr and the work counters of the serial loop, bitwise.
+// The segments integrated on two threads give r, dr and the work counters of the serial loop, bitwise;
+// a clone (one thread) gives them too, and AddWorkOf sums its counters into the original's.
 TEST(BallChain, SegmentsOnTwoThreadsGiveTheSerialMapBitwise) {
   const int m = 200;
   const HybridModel chain = MakeBallChain(m);
@@ -59,7 +61,7 @@ TEST(BallChain, SegmentsOnTwoThreadsGiveTheSerialMapBitwise) {
   TimeBasedShooting threaded(chain, IntegratorOptions{});
   threaded.set_threads(2);
   EXPECT_EQ(threaded.threads(), 2);
-  Vector r1, r2;
+  Vector r1, r2, r_only;
   Matrix dr1, dr2;
   ASSERT_TRUE(serial.Evaluate(u, &r1, &dr1).ok);
   ASSERT_TRUE(threaded.Evaluate(u, &r2, &dr2).ok);
@@ -78,7 +80,18 @@ TEST(BallChain, SegmentsOnTwoThreadsGiveTheSerialMapBitwise) {
   EXPECT_EQ(serial.counters().rhs_evaluations, threaded.counters().rhs_evaluations);
   EXPECT_EQ(serial.counters().steps, threaded.counters().steps);
   EXPECT_EQ(serial.num_evaluations(), threaded.num_evaluations());
-  EXPECT_EQ(threaded.num_evaluations(), 22);
+
+  const std::unique_ptr<ZeroProblem> clone = threaded.Clone();
+  ASSERT_NE(clone, nullptr);
+  const auto& clone_map = dynamic_cast<const TimeBasedShooting&>(*clone);
+  EXPECT_EQ(clone_map.threads(), 1);
+  ASSERT_TRUE(clone->Evaluate(u, &r_only, nullptr).ok);
+  EXPECT_TRUE(r_only == r1);
+  const long before = threaded.counters().rhs_evaluations;
+  EXPECT_GT(clone_map.counters().rhs_evaluations, 0);
+  threaded.AddWorkOf(*clone);
+  EXPECT_EQ(threaded.counters().rhs_evaluations, before + clone_map.counters().rhs_evaluations);
+  EXPECT_EQ(threaded.num_evaluations(), 23);
 
   EXPECT_THROW(threaded.set_threads(0), std::invalid_argument);
 }

@@ -81,6 +81,10 @@ class TimeBasedShooting : public ZeroProblem {
   static constexpr int kMinSegmentsPerThreadWithJacobian = 4;
   static constexpr int kMinSegmentsPerThread = 12;
 
+  // Same model, integrator options and fixed levels; one thread (zero_problem.h).
+  std::unique_ptr<ZeroProblem> Clone() const override;
+  void AddWorkOf(const ZeroProblem& clone) override;
+
   // Work done by all evaluations so far.
   const FlowCounters& counters() const { return counters_; }
   long num_evaluations() const { return num_evaluations_; }

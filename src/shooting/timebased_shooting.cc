@@ -41,6 +41,19 @@ void TimeBasedShooting::set_threads(int threads) {
   team_.reset();
 }
 
+std::unique_ptr<ZeroProblem> TimeBasedShooting::Clone() const {
+  auto clone = std::make_unique<TimeBasedShooting>(*model_, options_);
+  clone->SetFixedLevels(fixed_levels_);
+  clone->set_threads(1);
+  return clone;
+}
+
+void TimeBasedShooting::AddWorkOf(const ZeroProblem& clone) {
+  const auto& other = dynamic_cast<const TimeBasedShooting&>(clone);
+  counters_ += other.counters_;
+  num_evaluations_ += other.num_evaluations_;
+}
+
 EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivities) {
   const int k = layout_.num_first_integrals();
   const auto xi = u.segment(layout_.xi_index(), k);
