@@ -112,6 +112,7 @@ Vector ModelExploration::FindPhysicalStart(std::string* why) {
   // Trace the time-based scenario's branches from its start until a point is physical.
   ExplorationOptions options = time_options_;
   options.max_depth = 0;
+  options.threads = 1;  // the predicate below writes `found`: one thread, the serial order
   Vector found;
   options.continuation.stop_predicate = [&](const Vector& u) {
     const OrbitTrace trace(model_, u, integrator_);

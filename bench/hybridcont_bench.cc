@@ -142,7 +142,8 @@ void BM_FullRun(benchmark::State& state) {
   state.counters["rhs"] = static_cast<double>(rhs);
   state.counters["rhs_over_floor"] = static_cast<double>(rhs) / floor_rhs;
 }
-BENCHMARK(BM_FullRun)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->Iterations(3);
+// Wall time: the exploration and the shooting map may run on several threads (ExplorationOptions::threads).
+BENCHMARK(BM_FullRun)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
 
 }  // namespace
 }  // namespace hybridcont::app
@@ -173,7 +174,7 @@ void BM_ScalingNewtonStep(benchmark::State& state) {
   state.counters["seconds_per_newton_step"] = benchmark::Counter(
       static_cast<double>(iterations), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_ScalingNewtonStep)->Arg(1)->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ScalingNewtonStep)->Arg(1)->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace hybridcont::app

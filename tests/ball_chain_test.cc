@@ -1,8 +1,11 @@
-// The scalable ball-chain model: closed-form orbits are zeros, and Newton on large multiple-shooting
-// systems (sparse bordered LU above BorderedSolver::kSparseThreshold unknowns) converges back to them.
+// The scalable ball-chain model: closed-form orbits are zeros, Newton on large multiple-shooting systems
+// (sparse bordered LU above BorderedSolver::kSparseThreshold unknowns) converges back to them, and its
+// many segments integrated on several threads give the serial map.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <stdexcept>
 
 #include "hybridcont/corrector.h"
 #include "hybridcont/models.h"
@@ -93,6 +96,54 @@ TEST(BallChain, SparseAndDenseCorrectorPathsAgree) {
   EXPECT_LT((u_sparse - u_dense).lpNorm<Eigen::Infinity>(), 1e-13);
   // dr at iterates equal to rounding (the two LUs order their pivots differently)
   EXPECT_LT((sparse_corrector.jacobian() - dense_corrector.jacobian()).norm(), 1e-12 * dense_corrector.jacobian().norm());
+}
+
+// The segments integrated on two threads give r, dr and the work counters of the serial loop, bitwise;
+// a clone (one thread) gives them too, and AddWorkOf sums its counters into the original's.
+TEST(BallChain, SegmentsOnTwoThreadsGiveTheSerialMapBitwise) {
+  const int m = 200;
+  const HybridModel chain = MakeBallChain(m);
+  ASSERT_GE(m + 1, 2 * TimeBasedShooting::kMinSegmentsPerThread);  // large enough for the threads
+  Vector u = BallChainOrbit(chain, 0.5);
+  for (int i = 0; i < u.size() - 2; ++i) u(i) += 1e-3 * std::sin(1.0 + i);
+  TimeBasedShooting serial(chain, IntegratorOptions{});
+  serial.set_threads(1);
+  TimeBasedShooting threaded(chain, IntegratorOptions{});
+  threaded.set_threads(2);
+  EXPECT_EQ(threaded.threads(), 2);
+  Vector r1, r2, r_only;
+  Matrix dr1, dr2;
+  ASSERT_TRUE(serial.Evaluate(u, &r1, &dr1).ok);
+  ASSERT_TRUE(threaded.Evaluate(u, &r2, &dr2).ok);
+  EXPECT_TRUE(r1 == r2);
+  EXPECT_TRUE(dr1 == dr2);
+  u(0) += 1e-9;  // r alone: the integration without sensitivities
+  ASSERT_TRUE(serial.Evaluate(u, &r1, nullptr).ok);
+  ASSERT_TRUE(threaded.Evaluate(u, &r2, nullptr).ok);
+  EXPECT_TRUE(r1 == r2);
+  for (int k = 1; k <= 20; ++k) {  // many loops of the team: each result complete and in its place
+    u(1) += 1e-7;
+    ASSERT_TRUE(serial.Evaluate(u, &r1, nullptr).ok);
+    ASSERT_TRUE(threaded.Evaluate(u, &r2, nullptr).ok);
+    ASSERT_TRUE(r1 == r2) << "evaluation " << k;
+  }
+  EXPECT_EQ(serial.counters().rhs_evaluations, threaded.counters().rhs_evaluations);
+  EXPECT_EQ(serial.counters().steps, threaded.counters().steps);
+  EXPECT_EQ(serial.num_evaluations(), threaded.num_evaluations());
+
+  const std::unique_ptr<ZeroProblem> clone = threaded.Clone();
+  ASSERT_NE(clone, nullptr);
+  const auto& clone_map = dynamic_cast<const TimeBasedShooting&>(*clone);
+  EXPECT_EQ(clone_map.threads(), 1);
+  ASSERT_TRUE(clone->Evaluate(u, &r_only, nullptr).ok);
+  EXPECT_TRUE(r_only == r1);
+  const long before = threaded.counters().rhs_evaluations;
+  EXPECT_GT(clone_map.counters().rhs_evaluations, 0);
+  threaded.AddWorkOf(*clone);
+  EXPECT_EQ(threaded.counters().rhs_evaluations, before + clone_map.counters().rhs_evaluations);
+  EXPECT_EQ(threaded.num_evaluations(), 23);
+
+  EXPECT_THROW(threaded.set_threads(0), std::invalid_argument);
 }
 
 }  // namespace

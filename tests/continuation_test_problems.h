@@ -72,6 +72,23 @@ class ParabolaAndLine : public ZeroProblem {
   }
 };
 
+// (x² + λ² − 1)(x − λ) = 0: the unit circle and the line x = λ, crossing at the SB points ±(1, 1)/√2.
+class CircleAndLine : public ZeroProblem {
+ public:
+  int num_equations() const override { return 1; }
+  std::vector<std::string> unknown_names() const override { return {"x", "lambda"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0), l = u(1);
+    const double p = x * x + l * l - 1, q = x - l;
+    if (r) *r = Vector::Constant(1, p * q);
+    if (dr) {
+      dr->resize(1, 2);
+      *dr << 2 * x * q + p, 2 * l * q - p;
+    }
+    return {};
+  }
+};
+
 // [x·y; λ(x − y)] = 0: the three coordinate axes, all through the origin, where dr = 0 (kernel of
 // dimension 3, cokernel of dimension 2).
 class ThreeAxes : public ZeroProblem {

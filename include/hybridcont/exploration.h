@@ -29,12 +29,36 @@
 //   BifurcationDiagram diagram = Explore(&pitchfork, Vector2d(0, -0.5), options);
 //   // 4 half-branches: x = 0 (λ up, λ down) and λ = x² (x > 0, x < 0); one SB point at (0, 0), located.
 //
+// Threads (ExplorationOptions::threads > 1 and ZeroProblem::Clone() available): the diagram is the serial
+// one to the last bit — same branches, points, special points, ids and order. The serial run is a
+// sequence of groups of half-branches (the start, then one group per queued SB point, steps 1 and 3);
+// each group is launched as soon as it is known, its switching direction computed at once and its
+// half-branches traced ahead by workers, each on its own clone of the problem, in the serial order.
+// The exploring thread merges the groups in that order and replays every serial decision on the
+// results: a ray known by then skips a half-branch (its trace is dropped); the closed-loop and
+// max_branches rules likewise; the known-branch check, already made while tracing against the branches
+// merged before the launch, is repeated on the kept copies of the first points against the branches
+// merged since, and ends the branch there. Special point ids are given at the merge, branch ids too
+// (a half-branch traced under another id is relabeled). Consequences:
+//  - ContinuationOptions::progress is called on the exploring thread, branch by branch in the serial
+//    order, with the serial values: a branch's points are reported when it is merged.
+//  - ContinuationOptions::stop_predicate is called on the workers, concurrently, also for points of
+//    half-branches the serial run would not trace: it must be safe to call from several threads and
+//    depend on u only (otherwise set threads = 1).
+//  - The problem's work counters include the clones' (ZeroProblem::AddWorkOf): all work done, also
+//    that of traces the merge drops (few: half-branches are handed to workers only while they can still
+//    become branches within max_branches).
+// Why a replay and not locks: the decisions depend on the order in which branches become known; any
+// other order changes the diagram (another branch would be the one found "already traced").
+//
 // The library never prints: ContinuationOptions::progress receives every accepted point (with the
 // branch id), and BriefReport()/FullReport() summarize the result.
 #ifndef HYBRIDCONT_EXPLORATION_H_
 #define HYBRIDCONT_EXPLORATION_H_
 
+#include <algorithm>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "hybridcont/branch_switching.h"
@@ -71,6 +95,10 @@ struct ExplorationOptions {
   // one at a small angle stays within the chord sag near the crossing but not within this angle;
   // 1e-3 is far above the tangents' error from integrator noise (~1e-6).
   double known_branch_angle = 1e-3;
+  // Threads tracing half-branches concurrently (see "Threads" above); 1 traces them one after the other
+  // on the calling thread, as does a problem without Clone(). The problem's clones integrate on one
+  // thread each, so a time-based map with many segments does not start threads of its own on top.
+  int threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 
   std::string Validate() const;
 };

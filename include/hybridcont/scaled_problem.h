@@ -12,6 +12,8 @@
 #ifndef HYBRIDCONT_SCALED_PROBLEM_H_
 #define HYBRIDCONT_SCALED_PROBLEM_H_
 
+#include <memory>
+
 #include "hybridcont/zero_problem.h"
 
 namespace hybridcont {
@@ -27,12 +29,18 @@ class ScaledProblem : public ZeroProblem {
   bool prefers_sparse_jacobian() const override { return problem_->prefers_sparse_jacobian(); }
   EvaluationStatus EvaluateSparse(const Vector& v, Vector* r, SparseMatrix* dr) override;
 
+  // A scaled clone of the wrapped problem (nullptr if that has none), which the clone owns.
+  std::unique_ptr<ZeroProblem> Clone() const override;
+  // Forwards the work of the clone's wrapped problem to this one's.
+  void AddWorkOf(const ZeroProblem& clone) override;
+
   Vector ToScaled(const Vector& u) const { return u.cwiseQuotient(scales_); }
   Vector FromScaled(const Vector& v) const { return v.cwiseProduct(scales_); }
   const Vector& scales() const { return scales_; }
 
  private:
   ZeroProblem* problem_;
+  std::unique_ptr<ZeroProblem> owned_;  // problem_ of a clone
   Vector scales_;
   Vector u_;
 };

@@ -28,6 +28,7 @@
 #ifndef HYBRIDCONT_STATEBASED_SHOOTING_H_
 #define HYBRIDCONT_STATEBASED_SHOOTING_H_
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,10 @@ class StateBasedShooting : public ZeroProblem {
   const PoincareResult& last_map() const { return map_result_; }
   const PoincareMap& map() const { return map_; }
   const HybridModel& model() const { return *model_; }
+
+  // Same model, Poincaré options and fixed levels (zero_problem.h).
+  std::unique_ptr<ZeroProblem> Clone() const override;
+  void AddWorkOf(const ZeroProblem& clone) override;
 
   const FlowCounters& counters() const { return counters_; }
   long num_evaluations() const { return num_evaluations_; }

@@ -19,9 +19,19 @@
 // members so that repeated evaluations allocate nothing. A numerical failure during an evaluation (the
 // integrator's step fell below its minimum, a model function returned NaN) is reported through the
 // returned status, never by an exception: the caller decides (e.g. the corrector halves its step).
+//
+// Because of that scratch space one instance evaluates on one thread at a time. A caller that wants to
+// evaluate concurrently (the exploration traces half-branches on several threads, exploration.h) asks
+// for independent copies with Clone() and, when done, hands their work counters back with AddWorkOf():
+//
+//   std::unique_ptr<ZeroProblem> copy = problem.Clone();   // nullptr: this problem stays serial
+//   std::thread worker([&] { copy->Evaluate(u, &r, &dr); });
+//   worker.join();
+//   problem.AddWorkOf(*copy);                              // totals count both threads' work
 #ifndef HYBRIDCONT_ZERO_PROBLEM_H_
 #define HYBRIDCONT_ZERO_PROBLEM_H_
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -65,6 +75,16 @@ class ZeroProblem {
     if (status.ok) *dr = dense.sparseView(1.0, 0.0);
     return status;
   }
+
+  // An independent problem with the same zero set (same model, options and fixed values): its own scratch
+  // space, caches and zeroed work counters, so that it can evaluate on one thread while this one (or
+  // another clone) evaluates on another. A clone is meant for a caller that is already concurrent: it
+  // starts no threads of its own. nullptr, the default, says the problem cannot be copied; callers then
+  // stay serial.
+  virtual std::unique_ptr<ZeroProblem> Clone() const { return nullptr; }
+  // Adds the work counters of `clone` (made by this problem's Clone()) to this problem's, so that totals
+  // cover every thread's evaluations. Default: nothing is counted.
+  virtual void AddWorkOf(const ZeroProblem& clone) { (void)clone; }
 
   // Index of the named unknown, or -1.
   int UnknownIndex(const std::string& name) const {

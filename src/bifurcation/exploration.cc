@@ -4,15 +4,205 @@
 #include "continuation/branch_geometry.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
-#include <numbers>
+#include <condition_variable>
 #include <deque>
+#include <exception>
 #include <functional>
+#include <memory>
+#include <mutex>
+#include <numbers>
+#include <span>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 namespace hybridcont {
 namespace {
+
+// A half-branch to trace, and what tracing it produced. Serially it is traced when its turn comes; in a
+// concurrent exploration a worker traces it ahead of its turn and the merge replays the serial decisions
+// on the result (exploration.h, "Threads").
+struct HalfBranch {
+  ContinuationOptions options;
+  std::function<StepStatus(ContinuationStepper*)> start;  // owns its data: it may run later, elsewhere
+  int d = +1;                                             // d of eq. IVP (Branch::direction)
+  int parent = -1;                                        // special point it leaves
+  Vector direction;                                       // the ray it leaves `parent` along
+  int id = 0;                                             // branch id it is traced under
+  std::vector<const Branch*> known;                       // branches merged before it was traced
+  bool with_worker = false;                               // handed to a worker, result not yet taken
+  // Results.
+  Branch branch;
+  // The branch as it stood at each point checked against `known` without a match (concurrent only): a
+  // branch merged later but preceding it in the serial order may still end it there (kKnownBranch).
+  std::vector<Branch> checkpoints;
+  std::vector<ProgressInfo> progress;  // concurrent only: emitted when the branch is merged
+  std::exception_ptr error;
+  std::atomic<bool> cancelled{false};  // its result will not be used: stop tracing
+  bool done = false;                   // traced (or cancelled); guarded by the pool's mutex
+};
+
+// Id of a branch among `branches` that p lies on (within the chord sag of one of its chords, parallel
+// tangent), or −1.
+int OnTracedBranch(const ContinuationPoint& p, std::span<const Branch* const> branches,
+                   const ExplorationOptions& options) {
+  for (const Branch* branch : branches) {
+    for (size_t i = 0; i + 1 < branch->points.size(); ++i) {
+      const ContinuationPoint& a = branch->points[i];
+      const ContinuationPoint& b = branch->points[i + 1];
+      const Vector chord = b.u - a.u;
+      const double length = chord.norm();
+      if (!(length > 0)) continue;
+      const double t = chord.dot(p.u - a.u) / (length * length);
+      if (t < 0 || t > 1) continue;
+      const double distance = (a.u + t * chord - p.u).norm();
+      const double allowed = options.known_branch_tolerance * (1 + p.u.norm()) +
+                             length * (internal::AngleBetween(a.tangent, b.tangent) / 4 + 1e-3);
+      // Parallel tangent: p's tangent against the known branch's tangent at the projection (the two end
+      // tangents interpolated, exact to far less than a quarter of their angle). A branch crossing the
+      // known one at a small angle θ stays within the chord sag near the crossing, but its tangent is θ
+      // off everywhere.
+      const Vector known_tangent = ((1 - t) * a.tangent + t * b.tangent).normalized();
+      const double angle = std::acos(std::min(1.0, std::abs(p.tangent.dot(known_tangent))));
+      const double allowed_angle = internal::AngleBetween(a.tangent, b.tangent) / 4 + options.known_branch_angle;
+      if (distance <= allowed && angle <= allowed_angle) return branch->id;
+    }
+  }
+  return -1;
+}
+
+std::string KnownBranchMessage(int other) { return "runs along branch " + std::to_string(other) + " (already traced)"; }
+
+// Traces `half` on `problem`, ending it with kKnownBranch where one of its first points lies on a known
+// branch. `concurrent`: buffers progress and keeps checkpoints for the merge.
+void TraceHalfBranch(ZeroProblem* problem, const ExplorationOptions& exploration, bool concurrent, HalfBranch* half) {
+  ContinuationOptions options = half->options;
+  if (concurrent && options.progress) {
+    options.progress = [half](const ProgressInfo& info) { half->progress.push_back(info); };
+  }
+  ContinuationStepper stepper(problem, options, half->id);
+  StepStatus status = half->start(&stepper);
+  while (status == StepStatus::kContinuing && !half->cancelled.load(std::memory_order_relaxed)) {
+    status = stepper.Step();
+    const auto& points = stepper.branch().points;
+    const int index = static_cast<int>(points.size()) - 1;
+    if (index >= 1 && index <= exploration.known_branch_check_points && status == StepStatus::kContinuing) {
+      if (const int other = OnTracedBranch(points.back(), half->known, exploration); other >= 0) {
+        stepper.Terminate(TerminationReason::kKnownBranch, KnownBranchMessage(other));
+        status = StepStatus::kFinished;
+      } else if (concurrent) {
+        half->checkpoints.push_back(stepper.branch());
+      }
+    }
+  }
+  half->branch = stepper.TakeBranch();
+}
+
+// Worker threads, each with a clone of the problem, tracing submitted half-branches in submission order;
+// one more clone for the evaluations of the exploring thread. When destroyed: cancels what is left,
+// joins, and adds every clone's work to the problem's counters.
+class TracingPool {
+ public:
+  // Null unless threads > 1 and the problem can be cloned.
+  static std::unique_ptr<TracingPool> Make(ZeroProblem* problem, const ExplorationOptions& options) {
+    if (options.threads <= 1) return nullptr;
+    std::vector<std::unique_ptr<ZeroProblem>> clones;
+    for (int i = 0; i <= options.threads; ++i) {
+      clones.push_back(problem->Clone());
+      if (clones.back() == nullptr) return nullptr;
+    }
+    return std::unique_ptr<TracingPool>(new TracingPool(problem, options, std::move(clones)));
+  }
+
+  ~TracingPool() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+      for (HalfBranch* half : pending_) half->done = true;
+      pending_.clear();
+      for (HalfBranch* half : running_) {
+        if (half != nullptr) half->cancelled = true;
+      }
+    }
+    work_.notify_all();
+    for (std::thread& worker : workers_) worker.join();
+    for (const auto& clone : clones_) problem_->AddWorkOf(*clone);
+  }
+
+  // For evaluations on the exploring thread (start analysis, branch switching).
+  ZeroProblem* own_problem() { return clones_.front().get(); }
+
+  void Submit(HalfBranch* half) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      pending_.push_back(half);
+    }
+    work_.notify_one();
+  }
+
+  // Blocks until `half` is traced; rethrows what its tracing threw.
+  void Wait(HalfBranch* half) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [half] { return half->done; });
+    if (half->error) std::rethrow_exception(half->error);
+  }
+
+  // `half` is not needed: dropped if pending, stopped at its next point if running.
+  void Cancel(HalfBranch* half) {
+    half->cancelled = true;
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (const auto it = std::find(pending_.begin(), pending_.end(), half); it != pending_.end()) {
+      pending_.erase(it);
+      half->done = true;
+    }
+    done_.wait(lock, [half] { return half->done; });
+  }
+
+ private:
+  TracingPool(ZeroProblem* problem, const ExplorationOptions& options, std::vector<std::unique_ptr<ZeroProblem>> clones)
+      : problem_(problem), options_(options), clones_(std::move(clones)), running_(options.threads, nullptr) {
+    for (int i = 0; i < options.threads; ++i) workers_.emplace_back([this, i] { Work(i); });
+  }
+
+  void Work(int worker) {
+    ZeroProblem* problem = clones_[worker + 1].get();
+    for (;;) {
+      HalfBranch* half;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        work_.wait(lock, [this] { return stop_ || !pending_.empty(); });
+        if (stop_) return;
+        half = pending_.front();
+        pending_.pop_front();
+        running_[worker] = half;
+      }
+      try {
+        TraceHalfBranch(problem, options_, true, half);
+      } catch (...) {
+        half->error = std::current_exception();
+      }
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        running_[worker] = nullptr;
+        half->done = true;
+      }
+      done_.notify_all();
+    }
+  }
+
+  ZeroProblem* problem_;
+  const ExplorationOptions& options_;
+  std::vector<std::unique_ptr<ZeroProblem>> clones_;  // [0] for the exploring thread, [1 + i] for worker i
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable work_;
+  std::condition_variable done_;
+  std::deque<HalfBranch*> pending_;
+  std::vector<HalfBranch*> running_;  // per worker
+  bool stop_ = false;
+};
 
 class Explorer {
  public:
@@ -23,27 +213,36 @@ class Explorer {
     if (const std::string error = options_.continuation.ValidateFor(diagram_.unknown_names); !error.empty()) {
       throw std::invalid_argument("ExplorationOptions::continuation: " + error);
     }
+    pool_ = TracingPool::Make(problem_, options_);
+    evaluator_ = pool_ ? pool_->own_problem() : problem_;
   }
 
   BifurcationDiagram Run(const Vector& u0, const Vector* tangent) {
     if (tangent != nullptr) {
-      TraceRegularStart(u0, tangent);
+      Launch(RegularStart(u0, tangent));
     } else {
       StartOptions start;
       start.switching = options_.switching;
       start.conditions = options_.start_conditions;
-      diagram_.start = AnalyzeSingularPoint(problem_, u0, start);
+      diagram_.start = AnalyzeSingularPoint(evaluator_, u0, start);
       if (diagram_.start.status == BranchSwitchStatus::kRegular) {
-        TraceRegularStart(u0, nullptr);
+        Launch(RegularStart(u0, nullptr));
       } else if (!diagram_.start.directions.empty()) {
-        TraceSingularStart(u0);
+        Launch(SingularStart(u0));
       } else {
         diagram_.status = ExplorationStatus::kStartFailed;
         diagram_.message = "singular start point without branch directions: " + diagram_.start.BriefReport();
         return std::move(diagram_);
       }
     }
-    ProcessQueue();
+    for (;;) {
+      LaunchQueued();
+      if (groups_.empty()) break;
+      Merge(groups_.front().get());
+      groups_.pop_front();
+    }
+    pool_.reset();  // every clone's work is in problem_'s counters from here on
+    diagram_.branches.assign(std::make_move_iterator(branches_.begin()), std::make_move_iterator(branches_.end()));
     if (diagram_.status == ExplorationStatus::kCompleted && !diagram_.branches.empty() &&
         std::all_of(diagram_.branches.begin(), diagram_.branches.end(),
                     [](const Branch& b) { return b.termination == TerminationReason::kStartFailed; })) {
@@ -60,22 +259,34 @@ class Explorer {
     Vector direction;
   };
 
-  void TraceRegularStart(const Vector& u0, const Vector* tangent) {
+  // The serial exploration is a sequence of groups of half-branches: the start, then one group per queued
+  // SB point. Groups are merged in this order; a concurrent exploration launches them earlier.
+  struct Group {
+    enum class Kind { kRegularStart, kSingularStart, kSwitch };
+    Kind kind = Kind::kRegularStart;
+    SwitchRecord record;  // kSwitch
+    std::vector<std::unique_ptr<HalfBranch>> halves;
+  };
+
+  std::unique_ptr<Group> RegularStart(const Vector& u0, const Vector* tangent) {
+    auto group = std::make_unique<Group>();
+    group->kind = Group::Kind::kRegularStart;
     for (const int d : {+1, -1}) {
-      if (!diagram_.branches.empty() &&
-          (diagram_.branches.back().termination == TerminationReason::kClosedLoop ||
-           diagram_.branches.back().termination == TerminationReason::kStartFailed)) {
-        break;
+      auto half = std::make_unique<HalfBranch>();
+      half->options = options_.continuation;
+      half->options.direction = d;
+      half->d = d;
+      if (tangent != nullptr) {
+        half->start = [u0, hint = Vector(d * *tangent)](ContinuationStepper* stepper) { return stepper->Start(u0, hint); };
+      } else {
+        half->start = [u0](ContinuationStepper* stepper) { return stepper->Start(u0); };
       }
-      ContinuationOptions options = options_.continuation;
-      options.direction = d;
-      Trace(options, -1, 0, d, [&](ContinuationStepper* stepper) {
-        return tangent != nullptr ? stepper->Start(u0, d * *tangent) : stepper->Start(u0);
-      });
+      group->halves.push_back(std::move(half));
     }
+    return group;
   }
 
-  void TraceSingularStart(const Vector& u0) {
+  std::unique_ptr<Group> SingularStart(const Vector& u0) {
     SpecialPoint start;
     start.type = SpecialPointType::kSingularStart;
     start.status = LocationStatus::kLocated;
@@ -83,52 +294,178 @@ class Explorer {
     start.message = diagram_.start.BriefReport();
     const int id = AddUnique(std::move(start), 0);
     NoteLines(id, diagram_.start.directions);
+    auto group = std::make_unique<Group>();
+    group->kind = Group::Kind::kSingularStart;
     for (const Vector& line : diagram_.start.directions) {
-      for (const int d : {+1, -1}) TraceFromPoint(id, d * line, d, 1);
+      for (const int d : {+1, -1}) group->halves.push_back(FromPoint(id, d * line, d));
+    }
+    return group;
+  }
+
+  // The group of a queued SB point: the transverse ABE root v gives the half-branches ±v.
+  std::unique_ptr<Group> Switch(int id) {
+    auto group = std::make_unique<Group>();
+    group->kind = Group::Kind::kSwitch;
+    group->record.special_point = id;
+    group->record.result = SwitchDirectionAt(evaluator_, diagram_.special_points[id], options_.switching);
+    const BranchSwitch& result = group->record.result;
+    if (result.status == BranchSwitchStatus::kOk || result.status == BranchSwitchStatus::kFallback) {
+      NoteLines(id, {result.direction, result.incoming_direction});
+      for (const int d : {+1, -1}) group->halves.push_back(FromPoint(id, d * result.direction, d));
+    }
+    return group;
+  }
+
+  std::unique_ptr<HalfBranch> FromPoint(int id, const Vector& direction, int d) {
+    auto half = std::make_unique<HalfBranch>();
+    half->options = options_.continuation;
+    half->d = d;
+    half->parent = id;
+    half->direction = direction;
+    half->start = [u = diagram_.special_points[id].u, direction](ContinuationStepper* stepper) {
+      return stepper->StartAtSingularPoint(u, direction);
+    };
+    return half;
+  }
+
+  // Serially a group waits for its turn. Concurrently its half-branches are handed to the workers now,
+  // each under the branch id it gets if no half-branch before it is skipped, as long as they can still
+  // become branches within max_branches (one that is not handed over is traced when its turn comes).
+  void Launch(std::unique_ptr<Group> group) {
+    if (pool_) {
+      for (const auto& half : group->halves) {
+        if (BranchBudgetSpent()) break;
+        half->id = static_cast<int>(branches_.size()) + in_flight_++;
+        half->known = MergedBranches();
+        half->with_worker = true;
+        pool_->Submit(half.get());
+      }
+    }
+    groups_.push_back(std::move(group));
+  }
+
+  bool BranchBudgetSpent() const { return static_cast<int>(branches_.size()) + in_flight_ >= options_.max_branches; }
+
+  // Groups of queued SB points, their switching directions computed now: serially the next one when
+  // nothing else is left, concurrently also ahead while half-branches can be handed to the workers.
+  void LaunchQueued() {
+    while (!queue_.empty() && diagram_.status == ExplorationStatus::kCompleted) {
+      if (!groups_.empty() && (!pool_ || BranchBudgetSpent())) return;
+      const int id = queue_.front();
+      queue_.pop_front();
+      if (depth_[id] >= options_.max_depth) continue;
+      Launch(Switch(id));
     }
   }
 
-  // Traces a half-branch leaving special point `id` along `direction`, unless that ray is known.
-  bool TraceFromPoint(int id, const Vector& direction, int d, int depth) {
-    if (RayKnown(id, direction)) return false;
-    rays_.push_back({id, direction.normalized()});
-    const Vector u = diagram_.special_points[id].u;
-    Trace(options_.continuation, id, depth, d,
-          [&](ContinuationStepper* stepper) { return stepper->StartAtSingularPoint(u, direction); });
+  // The serial exploration's decisions for a group, in its order.
+  void Merge(Group* group) {
+    switch (group->kind) {
+      case Group::Kind::kRegularStart: {
+        // d = +1, then d = −1 unless the first closed a loop or could not start
+        for (const auto& half : group->halves) {
+          if (!branches_.empty() && (branches_.back().termination == TerminationReason::kClosedLoop ||
+                                     branches_.back().termination == TerminationReason::kStartFailed)) {
+            break;
+          }
+          Trace(half.get(), -1, 0);
+        }
+        break;
+      }
+      case Group::Kind::kSingularStart:
+        for (const auto& half : group->halves) TraceFromPoint(half.get(), 1);
+        break;
+      case Group::Kind::kSwitch: {
+        if (diagram_.status != ExplorationStatus::kCompleted) break;  // the serial run stopped before it
+        SwitchRecord& record = group->record;
+        for (const auto& half : group->halves) {
+          if (diagram_.status != ExplorationStatus::kCompleted) break;
+          if (TraceFromPoint(half.get(), depth_[record.special_point] + 1)) {
+            ++record.traced;
+          } else {
+            ++record.skipped;
+          }
+        }
+        diagram_.switches.push_back(std::move(record));
+        break;
+      }
+    }
+    for (const auto& half : group->halves) {  // skipped ones: their traces are dropped
+      if (!half->with_worker) continue;
+      pool_->Cancel(half.get());
+      half->with_worker = false;
+      --in_flight_;
+    }
+  }
+
+  // Traces a half-branch leaving its special point, unless that ray is known.
+  bool TraceFromPoint(HalfBranch* half, int depth) {
+    const int id = half->parent;
+    if (RayKnown(id, half->direction)) return false;
+    rays_.push_back({id, half->direction.normalized()});
+    Trace(half, id, depth);
     return true;
   }
 
-  void Trace(const ContinuationOptions& options, int parent, int depth, int d,
-             const std::function<StepStatus(ContinuationStepper*)>& start) {
-    if (static_cast<int>(diagram_.branches.size()) >= options_.max_branches) {
+  void Trace(HalfBranch* half, int parent, int depth) {
+    if (static_cast<int>(branches_.size()) >= options_.max_branches) {
       diagram_.status = ExplorationStatus::kMaxBranches;
       diagram_.message = "max_branches = " + std::to_string(options_.max_branches) + " reached";
       return;
     }
-    const int id = static_cast<int>(diagram_.branches.size());
-    ContinuationStepper stepper(problem_, options, id);
-    StepStatus status = start(&stepper);
-    while (status == StepStatus::kContinuing) {
-      status = stepper.Step();
-      const auto& points = stepper.branch().points;
-      const int index = static_cast<int>(points.size()) - 1;
-      if (index >= 1 && index <= options_.known_branch_check_points && status == StepStatus::kContinuing) {
-        if (const int other = OnTracedBranch(points.back()); other >= 0) {
-          stepper.Terminate(TerminationReason::kKnownBranch,
-                            "runs along branch " + std::to_string(other) + " (already traced)");
-          status = StepStatus::kFinished;
-        }
-      }
-    }
-    Branch branch = stepper.TakeBranch();
+    const int id = static_cast<int>(branches_.size());
+    Branch branch = Traced(half, id);
     branch.parent_special_point = parent;
     branch.depth = depth;
-    branch.direction = d;
+    branch.direction = half->d;
     for (SpecialPoint& point : branch.special_points) Register(&point, depth);
     if (branch.termination == TerminationReason::kClosedLoop && parent >= 0) {
       rays_.push_back({parent, -branch.points.back().tangent});  // it returns to the point from this side
     }
-    diagram_.branches.push_back(std::move(branch));
+    branches_.push_back(std::move(branch));
+    for (const ProgressInfo& info : half->progress) options_.continuation.progress(info);
+    if (pool_) LaunchQueued();  // the SB points just found: their groups can start while this one merges
+  }
+
+  // The half-branch as the serial run traces it as branch `id`. Serially (or not handed to a worker):
+  // traced now. Otherwise its worker's result, ended at the first checkpoint that lies on a branch
+  // merged after it was launched, and relabeled when it was traced under another id.
+  Branch Traced(HalfBranch* half, int id) {
+    if (!half->with_worker) {
+      half->id = id;
+      half->known = MergedBranches();
+      TraceHalfBranch(evaluator_, options_, false, half);
+      return std::move(half->branch);
+    }
+    pool_->Wait(half);
+    half->with_worker = false;
+    --in_flight_;
+    Branch branch = std::move(half->branch);
+    const std::vector<const Branch*> merged = MergedBranches();
+    const std::span<const Branch* const> unseen = std::span(merged).subspan(half->known.size());
+    if (!unseen.empty()) {
+      for (Branch& checkpoint : half->checkpoints) {
+        if (const int other = OnTracedBranch(checkpoint.points.back(), unseen, options_); other >= 0) {
+          branch = std::move(checkpoint);
+          branch.termination = TerminationReason::kKnownBranch;
+          branch.message = KnownBranchMessage(other);
+          break;
+        }
+      }
+    }
+    half->progress.resize(std::min(half->progress.size(), branch.points.size()));  // one report per point
+    if (branch.id != id) {
+      branch.id = id;
+      for (SpecialPoint& point : branch.special_points) point.branch_id = id;
+      for (ProgressInfo& info : half->progress) info.branch_id = id;
+    }
+    return branch;
+  }
+
+  std::vector<const Branch*> MergedBranches() const {
+    std::vector<const Branch*> merged;
+    for (const Branch& branch : branches_) merged.push_back(&branch);
+    return merged;
   }
 
   // Gives a special point found on a branch its diagram id (a known point: duplicate_of) and records the
@@ -187,63 +524,19 @@ class Explorer {
     }
   }
 
-  // Id of a traced branch that p lies on (within the chord sag of one of its chords, parallel tangent), or −1.
-  int OnTracedBranch(const ContinuationPoint& p) const {
-    for (const Branch& branch : diagram_.branches) {
-      for (size_t i = 0; i + 1 < branch.points.size(); ++i) {
-        const ContinuationPoint& a = branch.points[i];
-        const ContinuationPoint& b = branch.points[i + 1];
-        const Vector chord = b.u - a.u;
-        const double length = chord.norm();
-        if (!(length > 0)) continue;
-        const double t = chord.dot(p.u - a.u) / (length * length);
-        if (t < 0 || t > 1) continue;
-        const double distance = (a.u + t * chord - p.u).norm();
-        const double allowed = options_.known_branch_tolerance * (1 + p.u.norm()) +
-                               length * (internal::AngleBetween(a.tangent, b.tangent) / 4 + 1e-3);
-        // Parallel tangent: p's tangent against the known branch's tangent at the projection (the two end
-        // tangents interpolated, exact to far less than a quarter of their angle). A branch crossing the
-        // known one at a small angle θ stays within the chord sag near the crossing, but its tangent is θ
-        // off everywhere.
-        const Vector known_tangent = ((1 - t) * a.tangent + t * b.tangent).normalized();
-        const double angle = std::acos(std::min(1.0, std::abs(p.tangent.dot(known_tangent))));
-        const double allowed_angle = internal::AngleBetween(a.tangent, b.tangent) / 4 + options_.known_branch_angle;
-        if (distance <= allowed && angle <= allowed_angle) return branch.id;
-      }
-    }
-    return -1;
-  }
-
-  void ProcessQueue() {
-    while (!queue_.empty() && diagram_.status == ExplorationStatus::kCompleted) {
-      const int id = queue_.front();
-      queue_.pop_front();
-      if (depth_[id] >= options_.max_depth) continue;
-      SwitchRecord record;
-      record.special_point = id;
-      record.result = SwitchDirectionAt(problem_, diagram_.special_points[id], options_.switching);
-      if (record.result.status == BranchSwitchStatus::kOk || record.result.status == BranchSwitchStatus::kFallback) {
-        NoteLines(id, {record.result.direction, record.result.incoming_direction});
-        for (const int d : {+1, -1}) {
-          if (diagram_.status != ExplorationStatus::kCompleted) break;
-          if (TraceFromPoint(id, d * record.result.direction, d, depth_[id] + 1)) {
-            ++record.traced;
-          } else {
-            ++record.skipped;
-          }
-        }
-      }
-      diagram_.switches.push_back(std::move(record));
-    }
-  }
 
   ZeroProblem* problem_;
   ExplorationOptions options_;
   BifurcationDiagram diagram_;
-  std::vector<int> depth_;  // per unique special point: depth of the branch it was found on
+  std::deque<Branch> branches_;     // merged branches, id == index; elements never move (workers read them)
+  std::vector<int> depth_;          // per unique special point: depth of the branch it was found on
   std::vector<double> line_angle_;  // per unique special point: smallest angle between its branch lines
   std::vector<Ray> rays_;
-  std::deque<int> queue_;
+  std::deque<int> queue_;                     // SB points not yet switched at
+  std::deque<std::unique_ptr<Group>> groups_;  // launched, in the serial order, not yet merged
+  int in_flight_ = 0;                         // half-branches of groups_ (concurrent)
+  std::unique_ptr<TracingPool> pool_;         // null: serial (destroyed before groups_: joins first)
+  ZeroProblem* evaluator_ = nullptr;          // evaluations on this thread: problem_, or the pool's clone
 };
 
 }  // namespace
@@ -277,6 +570,8 @@ std::string ExplorationOptions::Validate() const {
     out << "ExplorationOptions::known_branch_tolerance = " << known_branch_tolerance << " must be >= 0";
   } else if (!(known_branch_angle >= 0 && known_branch_angle < 1)) {
     out << "ExplorationOptions::known_branch_angle = " << known_branch_angle << " must lie in [0, 1)";
+  } else if (threads < 1) {
+    out << "ExplorationOptions::threads = " << threads << " must be >= 1";
   }
   return out.str();
 }

@@ -19,6 +19,18 @@ ScaledProblem::ScaledProblem(ZeroProblem* problem, Vector scales) : problem_(pro
   }
 }
 
+std::unique_ptr<ZeroProblem> ScaledProblem::Clone() const {
+  std::unique_ptr<ZeroProblem> problem = problem_->Clone();
+  if (problem == nullptr) return nullptr;
+  auto clone = std::make_unique<ScaledProblem>(problem.get(), scales_);
+  clone->owned_ = std::move(problem);
+  return clone;
+}
+
+void ScaledProblem::AddWorkOf(const ZeroProblem& clone) {
+  problem_->AddWorkOf(*dynamic_cast<const ScaledProblem&>(clone).problem_);
+}
+
 EvaluationStatus ScaledProblem::Evaluate(const Vector& v, Vector* r, Matrix* dr) {
   u_ = FromScaled(v);
   const EvaluationStatus status = problem_->Evaluate(u_, r, dr);

@@ -23,6 +23,18 @@ void StateBasedShooting::SetFixedLevels(const Vector& levels) {
   cache_valid_ = false;
 }
 
+std::unique_ptr<ZeroProblem> StateBasedShooting::Clone() const {
+  auto clone = std::make_unique<StateBasedShooting>(*model_, map_.options());
+  clone->SetFixedLevels(fixed_levels_);
+  return clone;
+}
+
+void StateBasedShooting::AddWorkOf(const ZeroProblem& clone) {
+  const auto& other = dynamic_cast<const StateBasedShooting&>(clone);
+  counters_ += other.counters_;
+  num_evaluations_ += other.num_evaluations_;
+}
+
 Vector StateBasedShooting::FromTimeBased(const Vector& u_time) const {
   if (u_time.size() != layout_.num_unknowns()) {
     throw std::invalid_argument("StateBasedShooting::FromTimeBased: u has " + std::to_string(u_time.size()) +

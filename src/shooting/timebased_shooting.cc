@@ -1,17 +1,27 @@
 #include "hybridcont/timebased_shooting.h"
 
+#include <algorithm>
+#include <exception>
 #include <stdexcept>
+#include <thread>
+
+#include "shooting/worker_team.h"
 
 namespace hybridcont {
 
 TimeBasedShooting::TimeBasedShooting(const HybridModel& model, IntegratorOptions options)
-    : model_(&model), options_(options), layout_(model),
+    : model_(&model), options_(options), threads_(std::max(1, static_cast<int>(std::thread::hardware_concurrency()))),
+      layout_(model),
       fixed_levels_(Vector::Zero(model.num_first_integrals() - 1)) {
   if (const std::string why = options.Validate(); !why.empty()) throw std::invalid_argument(why);
   const int m = model.num_phases();
   for (int i = 0; i <= m; ++i) integrators_.emplace_back(model.phase(i), options);
   flows_.resize(m + 1);
 }
+
+TimeBasedShooting::~TimeBasedShooting() = default;
+TimeBasedShooting::TimeBasedShooting(TimeBasedShooting&&) noexcept = default;
+TimeBasedShooting& TimeBasedShooting::operator=(TimeBasedShooting&&) noexcept = default;
 
 void TimeBasedShooting::SetFixedLevels(const Vector& levels) {
   if (levels.size() != fixed_levels_.size()) {
@@ -22,14 +32,61 @@ void TimeBasedShooting::SetFixedLevels(const Vector& levels) {
   cache_valid_ = false;
 }
 
+void TimeBasedShooting::set_threads(int threads) {
+  if (threads < 1) {
+    throw std::invalid_argument("TimeBasedShooting::set_threads: threads = " + std::to_string(threads) +
+                                " must be >= 1");
+  }
+  threads_ = threads;
+  team_.reset();
+}
+
+std::unique_ptr<ZeroProblem> TimeBasedShooting::Clone() const {
+  auto clone = std::make_unique<TimeBasedShooting>(*model_, options_);
+  clone->SetFixedLevels(fixed_levels_);
+  clone->set_threads(1);
+  return clone;
+}
+
+void TimeBasedShooting::AddWorkOf(const ZeroProblem& clone) {
+  const auto& other = dynamic_cast<const TimeBasedShooting&>(clone);
+  counters_ += other.counters_;
+  num_evaluations_ += other.num_evaluations_;
+}
+
 EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivities) {
   const int k = layout_.num_first_integrals();
   const auto xi = u.segment(layout_.xi_index(), k);
-  EvaluationStatus status;
-  for (int i = 0; i < layout_.num_segments(); ++i) {
+  const int segments = layout_.num_segments();
+  const auto integrate = [&](int i) {
     const double t = u(layout_.time_index(i));
     const auto x0 = u.segment(layout_.state_offset(i), layout_.dim(i));
     integrators_[i].Integrate(x0, xi, t, sensitivities, &flows_[i]);
+  };
+  // Concurrently: every segment, then the loop below reads them in order, so the status (first failing
+  // segment), the counters (segments up to it) and an exception (from the first segment that threw) are
+  // those of the serial loop, which stops there.
+  const int team =
+      std::min(threads_, segments / (sensitivities ? kMinSegmentsPerThreadWithJacobian : kMinSegmentsPerThread));
+  std::vector<std::exception_ptr> errors;
+  if (team > 1) {
+    if (team_ == nullptr) team_ = std::make_unique<internal::WorkerTeam>(threads_);
+    errors.resize(segments);
+    team_->ForEach(segments, team, [&](int i) {
+      try {
+        integrate(i);
+      } catch (...) {
+        errors[i] = std::current_exception();  // not on a helper thread: rethrown below, in order
+      }
+    });
+  }
+  EvaluationStatus status;
+  for (int i = 0; i < segments; ++i) {
+    if (team <= 1) {
+      integrate(i);
+    } else if (errors[i]) {
+      std::rethrow_exception(errors[i]);
+    }
     counters_ += flows_[i].counters;
     if (!flows_[i].ok()) {
       status = EvaluationStatus::Failure("segment " + std::to_string(i + 1) + ": " + flows_[i].message);
