@@ -31,6 +31,7 @@ struct RunArguments {
   std::optional<double> rtol;          // unset: library default
   std::optional<double> atol;
   std::optional<int> max_branches;     // unset: the model's scenario default
+  std::optional<int> threads;          // unset: ExplorationOptions default (the machine's cores)
   std::string formulation = "time";
   bool quiet = false;
   bool no_plots = false;

@@ -2,7 +2,8 @@
 //
 // Order of work, so that bad input writes nothing: parse and validate every option, build the model,
 // validate the exploration options against the problem, prepare the output folder; only then compute.
-// Points are classified (physical or why not) and streamed to branch-<id>.csv as they are accepted.
+// Points are classified (physical or why not) and streamed to branch-<id>.csv as they are accepted (with
+// --threads > 1: branch by branch as the exploration merges them, in the order of --threads 1).
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
@@ -40,6 +41,9 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
   run->add_option("--rtol", args->rtol, "integrator relative tolerance (default 1e-10)");
   run->add_option("--atol", args->atol, "integrator absolute tolerance (default 1e-10)");
   run->add_option("--max-branches", args->max_branches, "maximum number of half-branches traced");
+  run->add_option("--threads", args->threads,
+                  "threads tracing half-branches concurrently (default: the machine's cores; 1 = one after the "
+                  "other); the results do not depend on it");
   run->add_option("--formulation", args->formulation,
                   "time (default: time-based multiple shooting) or state (event-driven Poincare map)");
   run->add_flag("--quiet", args->quiet, "no progress lines");
@@ -77,6 +81,7 @@ nlohmann::json OptionsJson(const RunArguments& args, const RunSetup& setup) {
   j["targets"] = targets;
   j["max_branches"] = setup.exploration.max_branches;
   j["max_depth"] = setup.exploration.max_depth;
+  j["threads"] = setup.exploration.threads;
   nlohmann::json conditions = nlohmann::json::array();
   for (const auto& sc : setup.scenario.start_conditions) conditions.push_back(sc.description);
   j["start_conditions"] = conditions;
@@ -244,6 +249,10 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
       throw std::invalid_argument("--max-branches " + std::to_string(*args.max_branches) + ": must be >= 1");
     }
     setup.exploration.max_branches = *args.max_branches;
+  }
+  if (args.threads) {
+    if (*args.threads < 1) throw std::invalid_argument("--threads " + std::to_string(*args.threads) + ": must be >= 1");
+    setup.exploration.threads = *args.threads;
   }
   nlohmann::json options_json = OptionsJson(args, setup);
   for (const auto& [name, scale] : sc.unknown_scales) options_json["unknown_scales"][name] = scale;

@@ -4,8 +4,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -69,6 +71,7 @@ TEST(Cli, BadInputGetsAClearMessageAndNonZeroExit) {
       {{"run", "slip", "--until", "Q=2", "--out", TempDir("bad_until").string()}, "Q"},
       {{"run", "slip", "--rtol", "-1", "--out", TempDir("bad_rtol").string()}, "rtol"},
       {{"run", "slip", "--max-branches", "0", "--out", TempDir("bad_branches").string()}, "--max-branches"},
+      {{"run", "slip", "--threads", "0", "--out", TempDir("bad_threads").string()}, "--threads 0: must be >= 1"},
       {{"run", "slip", "--out", "/proc/hybridcont-cannot-write-here"}, "--out"},
       {{"frobnicate"}, ""},
   };
@@ -194,6 +197,41 @@ TEST(Cli, SlipSimpleBifurcationsAreFloquetCrossingsInBothFormulations) {
     // The −1 crossing that ends the unstable stretch: 0.036 in H above the first, so the default steps
     // must resolve both (a step across both crossings would cancel the sign changes and miss them).
     EXPECT_LT(near(pd, 1.282809323809), 1e-9) << formulation;
+  }
+}
+
+std::string ReadFile(const fs::path& file) {
+  std::ifstream in(file);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Issue 6: --threads changes nothing but the wall time. The progress lines, the report and every CSV
+// file are those of --threads 1, byte for byte (the report's wall-time line and the folder aside), in both
+// formulations.
+TEST(Cli, RunOnTwoThreadsWritesWhatTheSerialRunWrites) {
+  for (const auto& [model, formulation] : {std::pair{"bouncing-rod", "time"}, std::pair{"bouncing-ball", "state"}}) {
+    SCOPED_TRACE(std::string(model) + " " + formulation);
+    std::string out[2];
+    fs::path dirs[2];
+    for (const int threads : {1, 2}) {
+      dirs[threads - 1] = TempDir(std::string("threads_") + model + "_" + std::to_string(threads));
+      const CliResult r = RunTool({"run", model, "--formulation", formulation, "--threads", std::to_string(threads),
+                                   "--out", dirs[threads - 1].string(), "--no-plots"});
+      ASSERT_EQ(r.code, 0) << r.err;
+      std::stringstream lines(r.out);
+      for (std::string line; std::getline(lines, line);) {
+        if (line.rfind("wall time", 0) != 0 && line.rfind("results written", 0) != 0) out[threads - 1] += line + "\n";
+      }
+    }
+    EXPECT_EQ(out[0], out[1]);
+    EXPECT_NE(out[0].find("branch 1\n"), std::string::npos) << out[0];  // progress lines are there
+    int files = 0;
+    for (const auto& entry : fs::directory_iterator(dirs[0])) {
+      if (entry.path().extension() != ".csv") continue;
+      ++files;
+      EXPECT_EQ(ReadFile(entry.path()), ReadFile(dirs[1] / entry.path().filename())) << entry.path().filename();
+    }
+    EXPECT_GE(files, 3);  // branches and orbits
   }
 }
 
