@@ -123,6 +123,7 @@ class TimeBasedShooting : public ZeroProblem {
   Matrix D_, dH_;
   RowVector de_;
   std::vector<Eigen::Triplet<double>> triplets_;
+  Matrix block_scratch_;
 };
 
 }  // namespace hybridcont

@@ -103,20 +103,29 @@ EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivitie
 namespace {
 
 // Where the Jacobian's blocks go: Add(row, col, block) adds a block (entries of blocks that overlap sum).
+// AddDiagonal(row, col, n, value) adds value·I (n x n). Neither allocates once warm.
 struct DenseSink {
   Matrix* dr;
   template <class Block>
   void Add(int row, int col, const Block& block) {
-    dr->block(row, col, block.rows(), block.cols()) += block;
+    dr->block(row, col, block.rows(), block.cols()).noalias() += block;
+  }
+  void AddDiagonal(int row, int col, int n, double value) {
+    dr->block(row, col, n, n).diagonal().array() += value;
   }
 };
 struct TripletSink {
   std::vector<Eigen::Triplet<double>>* triplets;
+  Matrix* scratch;  // the block evaluated once (products are not re-evaluated per coefficient)
   template <class Block>
   void Add(int row, int col, const Block& block) {
-    for (int j = 0; j < block.cols(); ++j) {
-      for (int i = 0; i < block.rows(); ++i) triplets->emplace_back(row + i, col + j, block(i, j));
+    scratch->noalias() = block;
+    for (int j = 0; j < scratch->cols(); ++j) {
+      for (int i = 0; i < scratch->rows(); ++i) triplets->emplace_back(row + i, col + j, (*scratch)(i, j));
     }
+  }
+  void AddDiagonal(int row, int col, int n, double value) {
+    for (int i = 0; i < n; ++i) triplets->emplace_back(row + i, col + i, value);
   }
 };
 
@@ -135,7 +144,7 @@ EvaluationStatus TimeBasedShooting::Evaluate(const Vector& u, Vector* r, Matrix*
 EvaluationStatus TimeBasedShooting::EvaluateSparse(const Vector& u, Vector* r, SparseMatrix* dr) {
   if (dr == nullptr) return Assemble<TripletSink>(u, r, nullptr);
   triplets_.clear();
-  TripletSink sink{&triplets_};
+  TripletSink sink{&triplets_, &block_scratch_};
   const EvaluationStatus status = Assemble(u, r, &sink);
   if (!status.ok) return status;
   const int N = layout_.num_equations();
@@ -206,7 +215,7 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
       dr->Add(row + n_out, ct + 1, de_ * flow.Phi);
       dr->Add(row + n_out, layout_.xi_index(), de_ * flow.Psi);
       // C: -I on x̄_{i+1}
-      dr->Add(row, layout_.state_offset(next), -Matrix::Identity(n_out, n_out));
+      dr->AddDiagonal(row, layout_.state_offset(next), n_out, -1.0);
     }
   }
   // First integrals at x̄_1: H_1 - H̄ (unknown level), H_j - H̄_j fixed for j >= 2.
