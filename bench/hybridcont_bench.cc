@@ -45,7 +45,9 @@ const Representative& RepresentativePoint(const std::string& name) {
   return cache.emplace(name, rep).first->second;
 }
 
-void BM_ShootingEvaluate(benchmark::State& state) {
+// One evaluation of the time-based map at the model's representative point: r and dr, or r alone (the
+// integration without sensitivities, for comparison with the floor's r+dr).
+void ShootingEvaluation(benchmark::State& state, bool with_jacobian) {
   const std::string name = kModels[state.range(0)];
   const HybridModel model = MakeBuiltinModel(name);
   const Representative& rep = RepresentativePoint(name);
@@ -54,32 +56,17 @@ void BM_ShootingEvaluate(benchmark::State& state) {
   Matrix dr;
   for (auto _ : state) {
     u(0) += 1e-15;  // defeat the cache: a new point each time
-    shooting.Evaluate(u, &r, &dr);
-    benchmark::DoNotOptimize(dr.data());
+    shooting.Evaluate(u, &r, with_jacobian ? &dr : nullptr);
+    benchmark::DoNotOptimize(r.data());
   }
   state.SetLabel(name);
   state.counters["rhs_per_eval"] =
       static_cast<double>(shooting.counters().rhs_evaluations) / static_cast<double>(shooting.num_evaluations());
   state.counters["N"] = shooting.num_equations();
 }
+void BM_ShootingEvaluate(benchmark::State& state) { ShootingEvaluation(state, true); }
 BENCHMARK(BM_ShootingEvaluate)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
-
-// r alone (no sensitivities): what a chord-Newton iteration costs.
-void BM_ShootingResidual(benchmark::State& state) {
-  const std::string name = kModels[state.range(0)];
-  const HybridModel model = MakeBuiltinModel(name);
-  const Representative& rep = RepresentativePoint(name);
-  TimeBasedShooting shooting(model, IntegratorOptions{});
-  Vector u = rep.u, r;
-  for (auto _ : state) {
-    u(0) += 1e-15;  // defeat the cache
-    shooting.Evaluate(u, &r, nullptr);
-    benchmark::DoNotOptimize(r.data());
-  }
-  state.SetLabel(name);
-  state.counters["rhs_per_eval"] =
-      static_cast<double>(shooting.counters().rhs_evaluations) / static_cast<double>(shooting.num_evaluations());
-}
+void BM_ShootingResidual(benchmark::State& state) { ShootingEvaluation(state, false); }
 BENCHMARK(BM_ShootingResidual)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
 
 void BM_CorrectorSolve(benchmark::State& state) {
