@@ -31,6 +31,43 @@ TEST(CorrectorTest, PseudoArclengthStaysOnTheHyperplane) {
   EXPECT_LT(result.contraction, 0.1);                 // quadratic convergence from a close predictor
 }
 
+// Deuflhard's estimate after a full Newton step: from a predictor 1e-4 off the circle, e₁ = e₀²/(2x) ≈ 5e-9
+// and θ₁|Δ₁| ≈ 3e-13 is below the step tolerance, so u₁ + Δ₁ (error e₁²/(2x) ≈ 1e-17) is returned after two
+// evaluations; plain Newton needs two more (u₂ still has |Δ₂| = 1e-17 > 0 to confirm, then u₃).
+TEST(CorrectorTest, AcceptsTheNewtonStepOnItsErrorEstimate) {
+  Circle circle;
+  const double x = std::sqrt(0.96);
+  Vector u;
+  Corrector corrector(&circle);
+  CorrectorResult result = corrector.CorrectPseudoArclength(Eigen::Vector2d(x + 1e-4, 0.2), Eigen::Vector2d(0, 1), &u);
+  ASSERT_TRUE(result.converged()) << result.BriefReport();
+  EXPECT_EQ(result.evaluations, 2);
+  EXPECT_EQ(result.iterations, 2);
+  EXPECT_NEAR(u(0), x, 2e-16);
+  EXPECT_EQ(u(1), 0.2);
+  // jacobian() is the one at u₁ = u − Δ₁: dr = 2u₁ᵀ, |Δ₁| ≈ 5e-9.
+  EXPECT_NEAR(corrector.jacobian()(0, 0), 2 * x, 2e-8);
+  EXPECT_GT(std::abs(corrector.jacobian()(0, 0) - 2 * x), 1e-9);
+
+  CorrectorOptions plain;
+  plain.accept_on_error_estimate = false;
+  Corrector newton(&circle, plain);
+  Vector v;
+  result = newton.CorrectPseudoArclength(Eigen::Vector2d(x + 1e-4, 0.2), Eigen::Vector2d(0, 1), &v);
+  ASSERT_TRUE(result.converged()) << result.BriefReport();
+  EXPECT_EQ(result.evaluations, 4);
+  EXPECT_NEAR(v(0), x, 2e-16);
+
+  // |Δ₁| above max_jacobian_distance·(1 + ||u||): the step is taken, and u₂ evaluated.
+  CorrectorOptions near_jacobian;
+  near_jacobian.max_jacobian_distance = 1e-9;
+  Corrector strict(&circle, near_jacobian);
+  result = strict.CorrectPseudoArclength(Eigen::Vector2d(x + 1e-4, 0.2), Eigen::Vector2d(0, 1), &v);
+  ASSERT_TRUE(result.converged()) << result.BriefReport();
+  EXPECT_EQ(result.evaluations, 3);
+  EXPECT_NEAR(v(0), x, 2e-16);
+}
+
 TEST(CorrectorTest, MoorePenroseFindsTheNearestPoint) {
   Circle circle;
   Corrector corrector(&circle);

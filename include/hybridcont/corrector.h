@@ -34,6 +34,10 @@
 // At least one Newton step is always taken, so a converged u is never the raw predictor. From the second
 // step on, u_k is also accepted when Deuflhard's error estimate — the simplified Newton correction
 // Δ̄ = −B_{k−1}⁻¹F(u_k) — is below the step tolerance; u_k + Δ̄ is returned (NLEQ-ERR's termination).
+// And after every full Newton step Δ_k from k = 1 on, u_k + Δ_k is returned without evaluating r there
+// when its estimated error θ_k|Δ_k| (θ_k = |Δ_k|/|Δ_{k−1}|) is below the step tolerance
+// (Corrector::AcceptNewtonStep): from a Hermite predictor most continuation points then cost two r+dr
+// evaluations instead of three (SLIP exploration: 5142 -> 4209 evaluations, RHS work -19%).
 //
 // Numerical outcomes are statuses (CorrectorResult), never exceptions or prints. A wrong vector size is
 // a programming error and throws std::invalid_argument.
@@ -80,6 +84,11 @@ struct CorrectorOptions {
   // estimate, from the factorization at hand) is below step_tolerance·(1 + ||u||), returning u_k + Δ̄: one
   // r+dr evaluation fewer per point (SLIP: 3.45 -> 2.5 Newton iterations per point), same accuracy.
   bool accept_on_error_estimate = true;
+  // With accept_on_error_estimate, a full Newton step Δ_k (k >= 1) whose estimated error θ_k|Δ_k| is below
+  // step_tolerance is taken without evaluating r at its end (see Corrector::AcceptNewtonStep), when
+  // |Δ_k| <= max_jacobian_distance·(1 + ||u||): jacobian() is then the one at u_k, |Δ_k| away from the
+  // returned point, so this bounds how far the Jacobian the stepper takes tangents from may lie.
+  double max_jacobian_distance = 1e-6;
   // A step ratio ||Δ_{k+1}|| / ||Δ_k|| above this, with a residual that did not decrease either, is
   // divergence: Newton inside its basin contracts. (Steps alone may grow once: a first step overshooting
   // along a nearly singular direction of the bordered matrix is taken back by the second, while the
@@ -149,6 +158,13 @@ class Corrector {
   struct Workspace;
   enum class Border { kArclength, kMoorePenrose, kConstraint };
   CorrectorResult Run(Border border, const Vector& u_pred, const Vector& b, double value, Vector* u);
+  // Deuflhard's a-posteriori estimate after a full Newton step Δ_k (k >= 1): with the contraction
+  // θ_k = |Δ_k| / |Δ_{k−1}|, the error of u_k + Δ_k is about θ_k / (1 − θ_k) · |Δ_k| (an over-estimate by
+  // the factor θ_k under quadratic convergence). Accepted when that is below step_tolerance·(1 + ||u||),
+  // θ_k <= kMaxAcceptedContraction (the contraction is established, not a stagnating iteration) and
+  // |Δ_k| <= max_jacobian_distance·(1 + ||u||).
+  bool AcceptNewtonStep(double previous_step, double last_step, const Vector& u) const;
+  static constexpr double kMaxAcceptedContraction = 0.25;
 
   ZeroProblem* problem_;
   CorrectorOptions options_;

@@ -183,8 +183,10 @@ bool Segment::EndProbe(bool at_b, Probe* probe, std::string* message) {
     return false;
   }
   if (!at_b) log_row_scale_ = LogRowScale(dr_);
-  Vector tangent;
-  if (!InducedTangent(solver_, dr_, a_.tangent, &tangent, nullptr, &probe->sb_test, &log_row_scale_)) {
+  // The tangent induced by dr at the point itself: the stored one may come from a Jacobian up to
+  // CorrectorOptions::max_jacobian_distance away, and next to an SB point (dr nearly rank-deficient) the
+  // induced tangent is sensitive to where dr was taken. The trial points' interpolant starts from it.
+  if (!InducedTangent(solver_, dr_, a_.tangent, &probe->tangent, nullptr, &probe->sb_test, &log_row_scale_)) {
     *message = "bracketing point is singular";
     return false;
   }

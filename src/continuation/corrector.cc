@@ -47,6 +47,8 @@ std::string CorrectorOptions::Validate() const {
     out << "CorrectorOptions::max_contraction = " << max_contraction << " must be > 0";
   } else if (!(max_distance > 0)) {
     out << "CorrectorOptions::max_distance = " << max_distance << " must be > 0";
+  } else if (!(max_jacobian_distance >= 0)) {
+    out << "CorrectorOptions::max_jacobian_distance = " << max_jacobian_distance << " must be >= 0";
   }
   return out.str();
 }
@@ -123,6 +125,14 @@ CorrectorResult Corrector::CorrectFixedComponent(const Vector& u_pred, int index
 CorrectorResult Corrector::Correct(CorrectorType type, const Vector& u_pred, const Vector& tau, Vector* u) {
   return type == CorrectorType::kMoorePenrose ? CorrectMoorePenrose(u_pred, tau, u)
                                               : CorrectPseudoArclength(u_pred, tau, u);
+}
+
+bool Corrector::AcceptNewtonStep(double previous_step, double last_step, const Vector& u) const {
+  if (!(previous_step > 0)) return false;
+  const double theta = last_step / previous_step;
+  const double scale = 1.0 + u.norm();
+  return theta <= kMaxAcceptedContraction && theta / (1 - theta) * last_step <= options_.step_tolerance * scale &&
+         last_step <= options_.max_jacobian_distance * scale;
 }
 
 CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector& b, double value,
@@ -238,6 +248,13 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
       result.status = CorrectorStatus::kDiverged;
       result.message = "iterate left the ball of radius max_distance = " +
                        std::to_string(options_.max_distance) + " around the predictor";
+      return result;
+    }
+    if (options_.accept_on_error_estimate && k >= 1 && AcceptNewtonStep(previous_step, last_step, u)) {
+      // u_{k+1} = u_k + Δ_k is returned without evaluating r there: its error is estimated by θ_k·|Δ_k|
+      // (AcceptNewtonStep). jacobian() stays the one at u_k, |Δ_k| away.
+      result.distance = (u - u_pred).norm();
+      result.status = CorrectorStatus::kConverged;
       return result;
     }
   }
