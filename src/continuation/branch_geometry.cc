@@ -129,8 +129,9 @@ CorrectorResult Segment::CorrectFrom(const Vector& predictor, double max_distanc
   corrector_->set_max_distance(max_distance + kDistanceFloor * (1 + predictor.norm()));
   // Trial points next to an SB point: full Newton to a small last step. Accepting on the error estimate
   // would stop before Newton shows that it amplifies residual noise along the second kernel direction
-  // (the noise-limited test above), and locate the point inside the noise.
-  corrector_->set_accept_on_error_estimate(false);
+  // (the noise-limited test above), and locate the point inside the noise. Elsewhere (turning points,
+  // stops) the curve is regular and the estimate is as good as on branch points.
+  if (with_sb_test_) corrector_->set_accept_on_error_estimate(false);
   const CorrectorResult result = corrector_->CorrectPseudoArclength(predictor, a_.tangent, &probe->u);
   corrector_->set_max_distance(saved.max_distance);
   corrector_->set_accept_on_error_estimate(saved.accept_on_error_estimate);
