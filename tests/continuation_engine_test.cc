@@ -103,6 +103,25 @@ TEST(CorrectorTest, FixedComponentAndStatuses) {
   EXPECT_THROW(corrector.CorrectPseudoArclength(Vector::Zero(3), Vector::Zero(3), &u), std::invalid_argument);
 }
 
+// On the unit circle the tangent predictor's residual is exactly h², so with evaluations failing above
+// |r| = 0.01 the corrector fails for every h > 0.1, while the angle criterion alone (α̃ = 0.15) asks for
+// h = 0.15 after each success. Without a memory of the failed step every second step was rejected
+// (h = 0.15 fails, 0.075 succeeds, 0.15 is proposed again); with it, about one step in four.
+TEST(ContinuationTest, StepControlRemembersWhereTheCorrectorFailed) {
+  Circle circle;
+  testing::FailsFarFromCurve failing(&circle, 0.01);
+  ContinuationOptions options;
+  options.predictor = PredictorType::kTangent;
+  options.turning_point_components = {};
+  const Branch branch = TraceBranch(&failing, Eigen::Vector2d(1, 0), options);
+  ASSERT_EQ(branch.termination, TerminationReason::kClosedLoop) << branch.FullReport();
+  for (const ContinuationPoint& point : branch.points) EXPECT_NEAR(point.u.norm(), 1.0, 1e-14);
+  for (size_t i = 1; i < branch.points.size(); ++i) EXPECT_LE(branch.points[i].step, 0.1);
+  // Measured: 87 points with 21 rejected steps; without the memory 127 points with 63.
+  EXPECT_LE(branch.rejected_steps, static_cast<int>(branch.points.size()) / 4) << branch.BriefReport();
+  EXPECT_LT(branch.points.size(), 100u) << branch.BriefReport();
+}
+
 TEST(ContinuationOptionsTest, ValidateNamesFieldValueAndConstraint) {
   ContinuationOptions options;
   EXPECT_EQ(options.Validate(), "");
@@ -388,7 +407,7 @@ TEST(ContinuationTest, StepControlIsNotPinnedByAnOvershootingFirstNewtonStep) {
   while (status == StepStatus::kContinuing) status = stepper.Step();
   const Branch& branch = stepper.branch();
   ASSERT_EQ(branch.termination, TerminationReason::kBoundReached) << branch.FullReport();
-  EXPECT_EQ(branch.points.back().u(2), 1.0);
+  EXPECT_EQ(branch.points.back().u(2), 1.0) << branch.message << " " << (branch.points.back().u(2) - 1.0);
   for (const ContinuationPoint& point : branch.points) {
     // x is resolved to residual_tolerance / δ only (r₂ = δx at e = 0).
     EXPECT_LE(std::abs(point.u(0)), options.corrector.residual_tolerance / OvershootingCurve::kDelta);

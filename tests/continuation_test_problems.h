@@ -127,6 +127,25 @@ class FailsAbove : public ZeroProblem {
   double limit_;
 };
 
+// Wraps a problem and fails every evaluation whose residual norm exceeds `limit` (an integrator that
+// gives up on orbits far from periodic): the corrector fails for predictors too far off the curve.
+class FailsFarFromCurve : public ZeroProblem {
+ public:
+  FailsFarFromCurve(ZeroProblem* inner, double limit) : inner_(inner), limit_(limit) {}
+  int num_equations() const override { return inner_->num_equations(); }
+  std::vector<std::string> unknown_names() const override { return inner_->unknown_names(); }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    Vector residual;
+    inner_->Evaluate(u, &residual, nullptr);
+    if (residual.norm() > limit_) return EvaluationStatus::Failure("residual above its limit");
+    return inner_->Evaluate(u, r, dr);
+  }
+
+ private:
+  ZeroProblem* inner_;
+  double limit_;
+};
+
 }  // namespace hybridcont::testing
 
 #endif  // HYBRIDCONT_TESTS_CONTINUATION_TEST_PROBLEMS_H_

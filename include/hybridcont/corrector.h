@@ -163,8 +163,11 @@ class Corrector {
   // the factor θ_k under quadratic convergence). Accepted when that is below step_tolerance·(1 + ||u||),
   // θ_k <= kMaxAcceptedContraction (the contraction is established, not a stagnating iteration) and
   // |Δ_k| <= max_jacobian_distance·(1 + ||u||).
-  bool AcceptNewtonStep(double previous_step, double last_step, const Vector& u) const;
+  // From k = 2 on also θ_{k−1} <= kMaxAcceptedContraction (before_previous_step = |Δ_{k−2}|, 0 for k = 1).
+  bool AcceptNewtonStep(double before_previous_step, double previous_step, double last_step,
+                        const Vector& u) const;
   static constexpr double kMaxAcceptedContraction = 0.25;
+  void ProjectOnConstraint(Border border, double value, Vector* u) const;
 
   ZeroProblem* problem_;
   CorrectorOptions options_;

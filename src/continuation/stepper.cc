@@ -163,6 +163,7 @@ class ContinuationStepper::Impl {
                               " along this direction: not a simple curve (at h = " + std::to_string(h_) + ")");
           }
         }
+        failed_step_ = std::min(failed_step_, h_);
         Reject(0.5);
         continue;
       }
@@ -182,8 +183,14 @@ class ContinuationStepper::Impl {
         Reject(std::max(0.5 / (f / 2), 0.25));  // h / f, but never below h / 4
         continue;
       }
-      // No growth right after a rejection: the step that just failed would be proposed again.
-      const double growth_limit = branch_.rejected_steps > rejected_before ? h_ : options_.max_step;
+      // No growth right after a rejection: the step that just failed would be proposed again. And no
+      // growth back to a step at which the corrector failed recently (failed_step_, released by
+      // kFailedStepRelease per accepted step): the deceleration factor measures the step just taken, not
+      // the basin of the one twice as long. Without this memory the bouncing rod's symmetric family
+      // alternated failure at 2h and success at h for 30 steps (136 rejected steps in 354 points).
+      double growth_limit = branch_.rejected_steps > rejected_before ? h_ : options_.max_step;
+      growth_limit = std::max(h_, std::min(growth_limit, kFailedStepMargin * failed_step_));
+      failed_step_ *= kFailedStepRelease;
       next_h = std::clamp(std::min(h_ / std::max(f, 0.5), growth_limit), options_.min_step, options_.max_step);
       b.step = h_;
       b.newton_iterations = result.iterations;
@@ -349,6 +356,17 @@ class ContinuationStepper::Impl {
       // The probe's test uses τ_a as last row: det([dr; τᵀ]) = det([dr; τ_aᵀ]) / (τ·τ_a).
       event.sb_test = root.estimate.sb_test / a.tangent.dot(event.tangent);
       if (!root.located) message->append(" (stop only bracketed: " + root.message + ")");
+      // The located trial point satisfies cᵀu = value to the root finder's tolerance; one constraint
+      // correction from there (a step of that size) puts it exactly on the stop.
+      ContinuationPoint exact;
+      corrector_.set_max_distance(10 * options_.location_tolerance * (1 + event.u.norm()));
+      if (root.located && corrector_.CorrectWithConstraint(event.u, first->c, first->value, &exact.u).converged() &&
+          internal::InducedTangent(&solver_, corrector_.jacobian(), a.tangent, &exact.tangent, &exact.sb_test,
+                                   nullptr)) {
+        event.u = std::move(exact.u);
+        event.tangent = std::move(exact.tangent);
+        event.sb_test = exact.sb_test;
+      }
     }
     event.step = b->step;
     event.newton_iterations = b->newton_iterations + result.iterations;
@@ -463,6 +481,11 @@ class ContinuationStepper::Impl {
   std::vector<LinearStop> stops_;
   Branch branch_;
   double h_;
+  // Smallest step at which the corrector failed, growing by kFailedStepRelease per accepted point
+  // (infinite before any failure); steps grow to at most kFailedStepMargin times it.
+  double failed_step_ = std::numeric_limits<double>::infinity();
+  static constexpr double kFailedStepMargin = 0.75;
+  static constexpr double kFailedStepRelease = 1.1;
   bool start_singular_ = false;
 };
 
