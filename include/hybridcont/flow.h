@@ -82,6 +82,9 @@ struct PhaseFlowResult {
   Matrix Phi;           // dphi/dx0, n x n (only with sensitivities)
   Matrix Psi;           // dphi/dxi, n x k (only with sensitivities)
   FlowCounters counters;
+  // The ξ·∇²H term was left out of the sensitivities only because of set_jacobian_tolerance: Phi and Psi
+  // are then exact only to that relative tolerance.
+  bool jacobian_relaxed = false;
   bool ok() const { return status == FlowStatus::kSuccess; }
 };
 
@@ -105,11 +108,15 @@ class PhaseFlow {
 
   const Phase& phase() const { return *phase_; }
   const IntegratorOptions& options() const { return options_; }
+  // Relative size below which the ξ·∇²H term of A = df~/dx may be left out of the sensitivities
+  // (ZeroProblem::set_jacobian_tolerance); 0, the default, keeps it unless it is below 1e-3 rtol.
+  void set_jacobian_tolerance(double tolerance) { jacobian_tolerance_ = tolerance; }
 
  private:
   struct Steppers;
   const Phase* phase_;
   IntegratorOptions options_;
+  double jacobian_tolerance_ = 0.0;
   std::unique_ptr<Steppers> steppers_;
 };
 

@@ -33,6 +33,8 @@ class ScaledProblem : public ZeroProblem {
   std::unique_ptr<ZeroProblem> Clone() const override;
   // Forwards the work of the clone's wrapped problem to this one's.
   void AddWorkOf(const ZeroProblem& clone) override;
+  // Forwarded: the column scaling leaves every entry's relative error as it is.
+  void set_jacobian_tolerance(double tolerance) override { problem_->set_jacobian_tolerance(tolerance); }
 
   Vector ToScaled(const Vector& u) const { return u.cwiseQuotient(scales_); }
   Vector FromScaled(const Vector& v) const { return v.cwiseProduct(scales_); }

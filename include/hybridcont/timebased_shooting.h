@@ -79,6 +79,10 @@ class TimeBasedShooting : public ZeroProblem {
   // std::invalid_argument for < 1.
   void set_threads(int threads);
   int threads() const { return threads_; }
+  // ZeroProblem::set_jacobian_tolerance: the ξ·∇²H term of the segments' sensitivities is left out where
+  // its relative size is below it. A cached evaluation serves a later request only if it was at least
+  // as exact.
+  void set_jacobian_tolerance(double tolerance) override { jacobian_tolerance_ = tolerance; }
   // Segments per thread from which a thread pays. Ball-chain on 2 idle cores, 2 threads against 1: r and
   // dr (a segment ~8 us) x1.19 at 8 segments, x1.34 at 16, x1.67 from 64; r alone (~2 us) x0.72 at 16
   // segments, x1.09 at 24, x1.65 from 128.
@@ -114,6 +118,8 @@ class TimeBasedShooting : public ZeroProblem {
   // cache of the last integrated point
   Vector cached_u_;
   bool cached_sensitivities_ = false;
+  double jacobian_tolerance_ = 0.0;
+  double cached_jacobian_tolerance_ = 0.0;
   bool cache_valid_ = false;
   EvaluationStatus cached_status_;
   FlowCounters counters_;

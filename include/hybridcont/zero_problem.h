@@ -86,6 +86,15 @@ class ZeroProblem {
   // cover every thread's evaluations. Default: nothing is counted.
   virtual void AddWorkOf(const ZeroProblem& clone) { (void)clone; }
 
+  // How exact the next evaluations' dr must be: terms of dr whose relative size is below `tolerance` may
+  // be left out (0, the default: dr exact to the problem's own accuracy). The corrector raises it for the
+  // Jacobian at the predictor, which only steers the first Newton step: a relative error ε there adds
+  // ε·|u_0 − u*| to the error of u_1, next to Newton's own C·|u_0 − u*|², and the Jacobians that tangents,
+  // test functions and monodromies are taken from are evaluated exactly. The time-based map then leaves
+  // out the ξ·∇²H term of df~/dx where it is below the tolerance (its Hessians were ~20% of a SLIP
+  // exploration). Default: ignored.
+  virtual void set_jacobian_tolerance(double tolerance) { (void)tolerance; }
+
   // Index of the named unknown, or -1.
   int UnknownIndex(const std::string& name) const {
     const std::vector<std::string> names = unknown_names();

@@ -47,6 +47,9 @@ std::string CorrectorOptions::Validate() const {
     out << "CorrectorOptions::max_contraction = " << max_contraction << " must be > 0";
   } else if (!(max_distance > 0)) {
     out << "CorrectorOptions::max_distance = " << max_distance << " must be > 0";
+  } else if (!(predictor_jacobian_tolerance >= 0 && predictor_jacobian_tolerance < 1)) {
+    out << "CorrectorOptions::predictor_jacobian_tolerance = " << predictor_jacobian_tolerance
+        << " must be in [0, 1)";
   } else if (!(max_jacobian_distance >= 0)) {
     out << "CorrectorOptions::max_jacobian_distance = " << max_jacobian_distance << " must be >= 0";
   }
@@ -166,8 +169,10 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
   double last_step = 0, previous_step = 0, before_previous_step = 0, previous_residual = 0;
   w.sparse = problem_->prefers_sparse_jacobian();
   for (int k = 0;; ++k) {
+    if (k == 0) problem_->set_jacobian_tolerance(options_.predictor_jacobian_tolerance);
     const EvaluationStatus evaluation =
         w.sparse ? problem_->EvaluateSparse(u, &w.r, &w.dr_sparse) : problem_->Evaluate(u, &w.r, &w.dr);
+    if (k == 0) problem_->set_jacobian_tolerance(0.0);
     w.dense_stale = w.sparse;
     ++result.evaluations;
     if (!evaluation.ok) {

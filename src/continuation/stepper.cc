@@ -157,7 +157,9 @@ class ContinuationStepper::Impl {
             result.iterations == 0) {
           // [dr; pᵀ] singular at the very predictor: along a curve of singular points (e.g. the rod's
           // at-rest ξ-line) halving h cannot help. Said once, instead of ~20 rejected steps.
-          if (const int k = KernelDimension(corrector_.jacobian()); k >= 2) {
+          // dr at the predictor, exact (the corrector's was taken with predictor_jacobian_tolerance).
+          Matrix dr;
+          if (const int k = problem_->Evaluate(predictor, nullptr, &dr).ok ? KernelDimension(dr) : 0; k >= 2) {
             return Finish(TerminationReason::kStartFailed,
                           "dr has a kernel of dimension " + std::to_string(k) +
                               " along this direction: not a simple curve (at h = " + std::to_string(h_) + ")");

@@ -93,6 +93,7 @@ FlowStatus PhaseFlow::Integrate(const Eigen::Ref<const Vector>& x0, const Eigen:
   const int n = w.n;
   const int k = w.k;
   result->counters = FlowCounters();
+  result->jacobian_relaxed = false;
   result->message.clear();
   result->status = FlowStatus::kSuccess;
 
@@ -123,7 +124,8 @@ FlowStatus PhaseFlow::Integrate(const Eigen::Ref<const Vector>& x0, const Eigen:
   // the Newton noise (~1e-13) and the term is orders of magnitude below the integrator's own error; the
   // nested-jet Hessians it needs were ~40% of a SLIP exploration. It is dropped only when, at x0,
   // |xi| |d2H| <= 1e-3 rtol max(|df|, 1): the Jacobian stays exact to the integration tolerance, and any
-  // sizable xi (the at-rest branches, the derivative checks) keeps the exact term.
+  // sizable xi (the at-rest branches, the derivative checks) keeps the exact term. A caller that needs dr
+  // only to the relative tolerance set_jacobian_tolerance (the corrector, at the predictor) raises the bar.
   if (with_sensitivities && (w.xi.array() != 0.0).any()) {
     Vector H;
     Matrix df, dH;
@@ -132,7 +134,9 @@ FlowStatus PhaseFlow::Integrate(const Eigen::Ref<const Vector>& x0, const Eigen:
     phase_->FirstIntegrals(z.head(n), &H, &dH, &d2H);
     double hessian_norm = 0.0;
     for (int j = 0; j < k; ++j) hessian_norm += std::abs(w.xi(j)) * d2H[j].cwiseAbs().maxCoeff();
-    w.hessian_term = hessian_norm > 1e-3 * options_.rtol * std::max(df.cwiseAbs().maxCoeff(), 1.0);
+    const double scale = std::max(df.cwiseAbs().maxCoeff(), 1.0);
+    w.hessian_term = hessian_norm > std::max(1e-3 * options_.rtol, jacobian_tolerance_) * scale;
+    result->jacobian_relaxed = !w.hessian_term && hessian_norm > 1e-3 * options_.rtol * scale;
   }
   const internal::AugmentedRhs system{&w};
   const double direction = t > 0.0 ? 1.0 : -1.0;

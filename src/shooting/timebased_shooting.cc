@@ -61,6 +61,7 @@ EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivitie
   const auto integrate = [&](int i) {
     const double t = u(layout_.time_index(i));
     const auto x0 = u.segment(layout_.state_offset(i), layout_.dim(i));
+    integrators_[i].set_jacobian_tolerance(jacobian_tolerance_);
     integrators_[i].Integrate(x0, xi, t, sensitivities, &flows_[i]);
   };
   // Concurrently: every segment, then the loop below reads them in order, so the status (first failing
@@ -81,6 +82,7 @@ EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivitie
     });
   }
   EvaluationStatus status;
+  bool relaxed = false;
   for (int i = 0; i < segments; ++i) {
     if (team <= 1) {
       integrate(i);
@@ -88,6 +90,7 @@ EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivitie
       std::rethrow_exception(errors[i]);
     }
     counters_ += flows_[i].counters;
+    relaxed = relaxed || flows_[i].jacobian_relaxed;
     if (!flows_[i].ok()) {
       status = EvaluationStatus::Failure("segment " + std::to_string(i + 1) + ": " + flows_[i].message);
       break;
@@ -95,6 +98,8 @@ EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivitie
   }
   cached_u_ = u;
   cached_sensitivities_ = sensitivities;
+  // Exact unless some segment actually left a term out (zero durations, ξ = 0: nothing to leave out).
+  cached_jacobian_tolerance_ = relaxed ? jacobian_tolerance_ : 0.0;
   cache_valid_ = true;
   cached_status_ = status;
   return status;
@@ -164,7 +169,8 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
                                 " entries, expected " + std::to_string(layout_.num_unknowns()));
   }
   const bool need_sensitivities = dr != nullptr;
-  if (!cache_valid_ || (need_sensitivities && !cached_sensitivities_) || cached_u_ != u) {
+  if (!cache_valid_ || cached_u_ != u ||
+      (need_sensitivities && (!cached_sensitivities_ || cached_jacobian_tolerance_ > jacobian_tolerance_))) {
     ++num_evaluations_;
     Integrate(u, need_sensitivities);
   }
