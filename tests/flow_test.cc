@@ -121,6 +121,41 @@ TEST(PhaseFlow, NonFiniteModelValueIsReportedWithPhaseAndTime) {
   EXPECT_NE(res.message.find("t = 0"), std::string::npos) << res.message;
 }
 
+// f(x) = sqrt(x) on [0, ∞): finite at x = 0, its derivative is not. Only A = df/dx carries the Inf, and
+// the sensitivities must report it (the right-hand side tests the sum of dz, which A·Phi reaches).
+class SqrtPhase final : public Phase {
+ public:
+  SqrtPhase() : Phase("sqrt", {"x"}, 1, 1, Vector::Ones(1)) {}
+  void VectorField(const Eigen::Ref<const Vector>& x, Vector* f, Matrix* df) const override {
+    *f = x.cwiseAbs().cwiseSqrt();
+    if (df) *df = Matrix::Constant(1, 1, 0.5 / std::sqrt(std::abs(x(0))));
+  }
+  void FirstIntegrals(const Eigen::Ref<const Vector>&, Vector* H, Matrix* dH, std::vector<Matrix>* d2H) const override {
+    if (H) *H = Vector::Zero(1);
+    if (dH) *dH = Matrix::Zero(1, 1);
+    if (d2H) d2H->assign(1, Matrix::Zero(1, 1));
+  }
+  double Event(const Eigen::Ref<const Vector>& x, RowVector* de) const override {
+    if (de) *de = RowVector::Ones(1);
+    return x(0);
+  }
+  void Reset(const Eigen::Ref<const Vector>& x, Vector* x_next, Matrix* D) const override {
+    *x_next = x;
+    if (D) *D = Matrix::Identity(1, 1);
+  }
+};
+
+TEST(PhaseFlow, NonFiniteJacobianAloneIsReported) {
+  SqrtPhase phase;
+  PhaseFlow flow(phase, IntegratorOptions{});
+  PhaseFlowResult res;
+  // Without sensitivities the flow from x = 0 is fine (x(t) = t²/4 is one solution; RKF stays at 0).
+  EXPECT_EQ(flow.Integrate(Vector::Zero(1), Vector::Zero(1), 0.5, false, &res), FlowStatus::kSuccess);
+  EXPECT_EQ(flow.Integrate(Vector::Zero(1), Vector::Zero(1), 0.5, true, &res), FlowStatus::kNonFinite);
+  EXPECT_NE(res.message.find("phase 'sqrt'"), std::string::npos) << res.message;
+  EXPECT_NE(res.message.find("t = 0"), std::string::npos) << res.message;
+}
+
 TEST(IntegratorOptions, ValidateNamesFieldAndValue) {
   IntegratorOptions o;
   o.rtol = -1.0;

@@ -8,6 +8,8 @@
 #ifndef HYBRIDCONT_SRC_INTEGRATION_AUGMENTED_RHS_H_
 #define HYBRIDCONT_SRC_INTEGRATION_AUGMENTED_RHS_H_
 
+#include <cmath>
+
 #include "hybridcont/model.h"
 
 namespace hybridcont::internal {
@@ -57,15 +59,16 @@ struct AugmentedRhsWorkspace {
     dz.resize(z.size());
     phase->UnfoldedVectorField(z.head(n), xi, &f, sensitivities ? &A : nullptr, sensitivities ? &B : nullptr,
                                hessian_term);
-    if (!f.allFinite() || (sensitivities && (!A.allFinite() || !B.allFinite()))) {
+    dz.head(n) = f;
+    if (sensitivities) DispatchOnDimension(n, [&](auto N) { Propagate<decltype(N)::value>(z, dz); });
+    // One vectorized sum instead of element-wise tests of f, A and B (those were ~7% of a SLIP exploration):
+    // a NaN or Inf in f, A or B reaches dz (A Phi, A Psi + B; 0 * Inf is NaN) and then its sum. A sum that
+    // overflows from finite entries (|dz| ~ 1e308) also counts as non-finite: the integration has blown up.
+    if (!std::isfinite(dz.sum())) {
       if (!nonfinite) nonfinite_time = t;
       nonfinite = true;
       dz.setZero();
-      return;
     }
-    dz.head(n) = f;
-    if (!sensitivities) return;
-    DispatchOnDimension(n, [&](auto N) { Propagate<decltype(N)::value>(z, dz); });
   }
 
   // dPhi = A Phi, dPsi = A Psi + B with the phase dimension N fixed at compile time where it is small: the
