@@ -190,7 +190,11 @@ std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::ma
       const auto it = tests->find(b.id);
       if (it == tests->end()) continue;
       const std::vector<double>& values = it->second;
-      for (std::size_t i = 0; i + 1 < values.size() && i + 1 < b.points.size(); ++i) {
+      // As for the SB points (continuation.h): the first interval of a branch that leaves a bifurcation
+      // point is not searched, its start point is that point, where the test functions are zero up to noise
+      // (SLIP: the branches leaving the SB at H = 1.24674 reported it again as a BP, by the sign of noise).
+      const std::size_t first = b.parent_special_point >= 0 ? 1 : 0;
+      for (std::size_t i = first; i + 1 < values.size() && i + 1 < b.points.size(); ++i) {
         if (!(values[i] * values[i + 1] < 0.0)) continue;  // NaN (non-physical) compares false
         const auto test = [&, type = std::string(type)](const Vector& u) {
           const FloquetResult f = ComputeFloquet(map, u);
