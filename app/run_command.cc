@@ -180,6 +180,7 @@ void AnalyzePhysicalOrbit(const HybridModel& model, TimeBasedShooting& floquet_m
 // BP (a further multiplier crosses +1) and PD (one crosses -1) points: sign changes of the Floquet test
 // functions between consecutive physical points of a branch, located on the branch (test_function_root.h).
 // Returns report lines; appends the points to special_points.
+constexpr double kStartNoise = 1e-3;
 std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::map<int, std::vector<double>>& bp,
                                 const std::map<int, std::vector<double>>& pd, TimeBasedShooting& map,
                                 const ShootingLayout& layout, nlohmann::json* special_points) {
@@ -190,12 +191,13 @@ std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::ma
       const auto it = tests->find(b.id);
       if (it == tests->end()) continue;
       const std::vector<double>& values = it->second;
-      // As for the SB points (continuation.h): the first interval of a branch that leaves a bifurcation
-      // point is not searched, its start point is that point, where the test functions are zero up to noise
-      // (SLIP: the branches leaving the SB at H = 1.24674 reported it again as a BP, by the sign of noise).
-      const std::size_t first = b.parent_special_point >= 0 ? 1 : 0;
-      for (std::size_t i = first; i + 1 < values.size() && i + 1 < b.points.size(); ++i) {
+      for (std::size_t i = 0; i + 1 < values.size() && i + 1 < b.points.size(); ++i) {
         if (!(values[i] * values[i + 1] < 0.0)) continue;  // NaN (non-physical) compares false
+        // A branch that leaves a bifurcation point starts on it: where a test function vanishes there
+        // (to kStartNoise of its value at the next point), its sign at the start is noise and the
+        // "crossing" is that point itself, reported on the parent branch (SLIP: the branches leaving the
+        // SB at H = 1.24674 reported it again as BPs). A test that is not small there is searched as usual.
+        if (i == 0 && b.parent_special_point >= 0 && std::abs(values[0]) <= kStartNoise * std::abs(values[1])) continue;
         const auto test = [&, type = std::string(type)](const Vector& u) {
           const FloquetResult f = ComputeFloquet(map, u);
           return f.ok() ? (type == "BP" ? f.bp_test : f.pd_test) : std::nan("");

@@ -1,6 +1,8 @@
 // Corrector, stepper, stops and located special points on algebraic curves with exact answers.
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -68,6 +70,71 @@ TEST(CorrectorTest, AcceptsTheNewtonStepOnItsErrorEstimate) {
   EXPECT_NEAR(v(0), x, 2e-16);
 }
 
+// r = x + 1e5x² + 1e7x³ (λ free, pinned by the border): Newton from x₀ = −5e-3 lands exactly on the root
+// (r(x) = x r'(x) there), so from 3e-8 beside it the first step lands 6e-8 from the root by chance:
+// θ₁ = 1.2e-5 and θ₁|Δ₁| = 7e-13 promise convergence, yet u₁ + Δ₁ is 3.6e-10 off (the contraction is a
+// lower bound of the curvature, ω = 2e5 here). max_jacobian_distance = 1e-8 refuses that step.
+class CurvedScalar : public ZeroProblem {
+ public:
+  int num_equations() const override { return 1; }
+  std::vector<std::string> unknown_names() const override { return {"x", "lambda"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0);
+    if (r) *r = Vector::Constant(1, x + 1e5 * x * x + 1e7 * x * x * x);
+    if (dr) *dr = Eigen::RowVector2d(1 + 2e5 * x + 3e7 * x * x, 0);
+    return {};
+  }
+  void set_jacobian_tolerance(double tolerance) override { tolerance_ = tolerance; }
+  double jacobian_tolerance() const override { return tolerance_; }
+  double tolerance_ = 0;
+};
+
+TEST(CorrectorTest, AcceptedNewtonStepIsBoundedWhereTheContractionMisleads) {
+  CurvedScalar problem;
+  Corrector corrector(&problem);
+  Vector u;
+  const CorrectorResult result = corrector.CorrectFixedComponent(Eigen::Vector2d(-5e-3 + 3e-8, 0), 1, 0.0, &u);
+  ASSERT_TRUE(result.converged()) << result.BriefReport();
+  // Within the step tolerance, as promised (here 1.3e-14: the step of 3.7e-10 from u₂ was accepted).
+  EXPECT_LT(std::abs(u(0)), CorrectorOptions().step_tolerance) << result.BriefReport();
+  EXPECT_EQ(u(1), 0.0);
+  // The counterexample itself: allowed a step of 6e-8, the estimate accepts a point 3.6e-10 off.
+  CorrectorOptions loose;
+  loose.max_jacobian_distance = 1e-6;
+  Corrector trusting(&problem, loose);
+  ASSERT_TRUE(trusting.CorrectFixedComponent(Eigen::Vector2d(-5e-3 + 3e-8, 0), 1, 0.0, &u).converged());
+  EXPECT_GT(std::abs(u(0)), 3e-10);
+}
+
+// The predictor's evaluation runs with predictor_jacobian_tolerance, the others with the problem's own,
+// which is restored afterwards — also when an evaluation throws.
+class RecordsJacobianTolerance : public CurvedScalar {
+ public:
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    seen.push_back(tolerance_);
+    if (static_cast<int>(seen.size()) - 1 == throw_at) throw std::runtime_error("model failure");
+    return CurvedScalar::Evaluate(u, r, dr);
+  }
+  std::vector<double> seen;
+  int throw_at = -1;
+};
+
+TEST(CorrectorTest, PredictorJacobianToleranceIsScopedToThePredictor) {
+  RecordsJacobianTolerance problem;
+  problem.set_jacobian_tolerance(1e-4);  // the user's own
+  Corrector corrector(&problem);
+  Vector u;
+  ASSERT_TRUE(corrector.CorrectFixedComponent(Eigen::Vector2d(1e-3, 0), 1, 0.0, &u).converged());
+  ASSERT_GE(problem.seen.size(), 2u);
+  EXPECT_EQ(problem.seen[0], 1e-2);
+  for (size_t i = 1; i < problem.seen.size(); ++i) EXPECT_EQ(problem.seen[i], 1e-4);
+  EXPECT_EQ(problem.jacobian_tolerance(), 1e-4);
+  problem.seen.clear();
+  problem.throw_at = 0;
+  EXPECT_THROW(corrector.CorrectFixedComponent(Eigen::Vector2d(1e-3, 0), 1, 0.0, &u), std::runtime_error);
+  EXPECT_EQ(problem.jacobian_tolerance(), 1e-4);
+}
+
 TEST(CorrectorTest, MoorePenroseFindsTheNearestPoint) {
   Circle circle;
   Corrector corrector(&circle);
@@ -120,6 +187,27 @@ TEST(ContinuationTest, StepControlRemembersWhereTheCorrectorFailed) {
   // Measured: 87 points with 21 rejected steps; without the memory 127 points with 63.
   EXPECT_LE(branch.rejected_steps, static_cast<int>(branch.points.size()) / 4) << branch.BriefReport();
   EXPECT_LT(branch.points.size(), 100u) << branch.BriefReport();
+}
+
+// The memory is local: failures only in the upper half (y > 0, steps above 0.01 fail) must not hold the
+// steps down in the lower half, where the angle criterion alone sets h ≈ 0.15. Released by 1.1 per point
+// only, the cap would take ~30 points to grow from 0.0075 to 0.15; it is forgotten after 4 failed steps.
+TEST(ContinuationTest, StepMemoryIsForgottenFurtherAlongTheBranch) {
+  Circle circle;
+  testing::FailsFarFromCurve failing(&circle, 1e-4, 1, 0.0);
+  ContinuationOptions options;
+  options.predictor = PredictorType::kTangent;
+  options.turning_point_components = {};
+  const Branch branch = TraceBranch(&failing, Eigen::Vector2d(1, 0), options);
+  ASSERT_EQ(branch.termination, TerminationReason::kClosedLoop) << branch.FullReport();
+  const auto lower_points = [](const Branch& b) {
+    int lower = 0;
+    for (const ContinuationPoint& point : b.points) lower += point.u(1) < 0 ? 1 : 0;
+    return lower;
+  };
+  const Branch free_branch = TraceBranch(&circle, Eigen::Vector2d(1, 0), options);
+  // Measured: 29 against 21 without failures (43 if the memory were only released by 1.1 per point).
+  EXPECT_LE(lower_points(branch), lower_points(free_branch) + 10) << branch.BriefReport();
 }
 
 TEST(ContinuationOptionsTest, ValidateNamesFieldValueAndConstraint) {

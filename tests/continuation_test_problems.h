@@ -131,19 +131,23 @@ class FailsAbove : public ZeroProblem {
 // gives up on orbits far from periodic): the corrector fails for predictors too far off the curve.
 class FailsFarFromCurve : public ZeroProblem {
  public:
-  FailsFarFromCurve(ZeroProblem* inner, double limit) : inner_(inner), limit_(limit) {}
+  // Only where component `index` is above `from` (the whole space by default).
+  FailsFarFromCurve(ZeroProblem* inner, double limit, int index = 0, double from = -1e300)
+      : inner_(inner), limit_(limit), index_(index), from_(from) {}
   int num_equations() const override { return inner_->num_equations(); }
   std::vector<std::string> unknown_names() const override { return inner_->unknown_names(); }
   EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
     Vector residual;
     inner_->Evaluate(u, &residual, nullptr);
-    if (residual.norm() > limit_) return EvaluationStatus::Failure("residual above its limit");
+    if (u(index_) > from_ && residual.norm() > limit_) return EvaluationStatus::Failure("residual above its limit");
     return inner_->Evaluate(u, r, dr);
   }
 
  private:
   ZeroProblem* inner_;
   double limit_;
+  int index_;
+  double from_;
 };
 
 }  // namespace hybridcont::testing

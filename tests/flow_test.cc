@@ -5,6 +5,7 @@
 
 #include "hybridcont/flow.h"
 #include "hybridcont/models.h"
+#include "integration/augmented_rhs.h"
 
 namespace hybridcont {
 namespace {
@@ -144,6 +145,29 @@ class SqrtPhase final : public Phase {
     if (D) *D = Matrix::Identity(1, 1);
   }
 };
+
+// The right-hand side itself flags a Jacobian-only Inf and returns dz = 0, so that the stepper's
+// arithmetic (its error estimate, its next step size) stays finite: an Inf reaching only the stages
+// that Fehlberg's 7th-order solution weights by zero would otherwise leave z finite and the step size NaN.
+TEST(AugmentedRhs, FlagsANonFiniteJacobianAndReturnsZero) {
+  SqrtPhase phase;
+  internal::AugmentedRhsWorkspace w;
+  const int size = w.Start(phase, Vector::Zero(1), true);
+  Vector z, dz;
+  w.InitialState(Vector::Zero(1), &z);
+  ASSERT_EQ(z.size(), size);
+  w.Evaluate(z, dz, 0.25);
+  EXPECT_TRUE(w.nonfinite);
+  EXPECT_EQ(w.nonfinite_time, 0.25);
+  EXPECT_TRUE(dz.isZero(0.0)) << dz.transpose();
+  internal::AugmentedRhsWorkspace fine;
+  fine.Start(phase, Vector::Zero(1), true);
+  fine.InitialState(Vector::Ones(1), &z);
+  fine.Evaluate(z, dz, 0.0);
+  EXPECT_FALSE(fine.nonfinite);
+  EXPECT_DOUBLE_EQ(dz(0), 1.0);   // f = sqrt(1)
+  EXPECT_DOUBLE_EQ(dz(1), 0.5);   // dPhi = A Phi = 0.5 · 1
+}
 
 TEST(PhaseFlow, NonFiniteJacobianAloneIsReported) {
   SqrtPhase phase;

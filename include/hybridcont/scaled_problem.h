@@ -35,6 +35,7 @@ class ScaledProblem : public ZeroProblem {
   void AddWorkOf(const ZeroProblem& clone) override;
   // Forwarded: the column scaling leaves every entry's relative error as it is.
   void set_jacobian_tolerance(double tolerance) override { problem_->set_jacobian_tolerance(tolerance); }
+  double jacobian_tolerance() const override { return problem_->jacobian_tolerance(); }
 
   Vector ToScaled(const Vector& u) const { return u.cwiseQuotient(scales_); }
   Vector FromScaled(const Vector& v) const { return v.cwiseProduct(scales_); }

@@ -83,6 +83,7 @@ class TimeBasedShooting : public ZeroProblem {
   // its relative size is below it. A cached evaluation serves a later request only if it was at least
   // as exact.
   void set_jacobian_tolerance(double tolerance) override { jacobian_tolerance_ = tolerance; }
+  double jacobian_tolerance() const override { return jacobian_tolerance_; }
   // Segments per thread from which a thread pays. Ball-chain on 2 idle cores, 2 threads against 1: r and
   // dr (a segment ~8 us) x1.19 at 8 segments, x1.34 at 16, x1.67 from 64; r alone (~2 us) x0.72 at 16
   // segments, x1.09 at 24, x1.65 from 128.

@@ -94,6 +94,8 @@ class ZeroProblem {
   // out the ξ·∇²H term of df~/dx where it is below the tolerance (its Hessians were ~20% of a SLIP
   // exploration). Default: ignored.
   virtual void set_jacobian_tolerance(double tolerance) { (void)tolerance; }
+  // The tolerance in effect (0 for problems that ignore it).
+  virtual double jacobian_tolerance() const { return 0.0; }
 
   // Index of the named unknown, or -1.
   int UnknownIndex(const std::string& name) const {

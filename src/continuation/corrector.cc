@@ -1,5 +1,6 @@
 #include "hybridcont/corrector.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -63,6 +64,29 @@ std::string CorrectorResult::BriefReport() const {
   if (!message.empty()) out << " (" << message << ")";
   return out.str();
 }
+
+namespace {
+
+// Sets a problem's Jacobian tolerance for one evaluation (a negative value leaves it alone) and restores
+// the previous value when it goes out of scope.
+class JacobianToleranceScope {
+ public:
+  JacobianToleranceScope(ZeroProblem* problem, double tolerance)
+      : problem_(tolerance >= 0 ? problem : nullptr), previous_(problem->jacobian_tolerance()) {
+    if (problem_ != nullptr) problem_->set_jacobian_tolerance(std::max(tolerance, previous_));
+  }
+  ~JacobianToleranceScope() {
+    if (problem_ != nullptr) problem_->set_jacobian_tolerance(previous_);
+  }
+  JacobianToleranceScope(const JacobianToleranceScope&) = delete;
+  JacobianToleranceScope& operator=(const JacobianToleranceScope&) = delete;
+
+ private:
+  ZeroProblem* problem_;
+  double previous_;
+};
+
+}  // namespace
 
 // Scratch space sized once per problem (STYLE.md practice 6): the Newton loop allocates nothing after the
 // first call.
@@ -169,10 +193,12 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
   double last_step = 0, previous_step = 0, before_previous_step = 0, previous_residual = 0;
   w.sparse = problem_->prefers_sparse_jacobian();
   for (int k = 0;; ++k) {
-    if (k == 0) problem_->set_jacobian_tolerance(options_.predictor_jacobian_tolerance);
-    const EvaluationStatus evaluation =
-        w.sparse ? problem_->EvaluateSparse(u, &w.r, &w.dr_sparse) : problem_->Evaluate(u, &w.r, &w.dr);
-    if (k == 0) problem_->set_jacobian_tolerance(0.0);
+    const EvaluationStatus evaluation = [&] {
+      // The predictor's dr only steers the first step (CorrectorOptions::predictor_jacobian_tolerance);
+      // the problem's own tolerance is restored however Evaluate returns, an exception included.
+      const JacobianToleranceScope scope(problem_, k == 0 ? options_.predictor_jacobian_tolerance : -1.0);
+      return w.sparse ? problem_->EvaluateSparse(u, &w.r, &w.dr_sparse) : problem_->Evaluate(u, &w.r, &w.dr);
+    }();
     w.dense_stale = w.sparse;
     ++result.evaluations;
     if (!evaluation.ok) {

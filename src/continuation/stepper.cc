@@ -166,6 +166,8 @@ class ContinuationStepper::Impl {
           }
         }
         failed_step_ = std::min(failed_step_, h_);
+        failed_size_ = failed_step_;
+        failed_at_ = a.arclength;
         Reject(0.5);
         continue;
       }
@@ -187,10 +189,13 @@ class ContinuationStepper::Impl {
       }
       // No growth right after a rejection: the step that just failed would be proposed again. And no
       // growth back to a step at which the corrector failed recently (failed_step_, released by
-      // kFailedStepRelease per accepted step): the deceleration factor measures the step just taken, not
-      // the basin of the one twice as long. Without this memory the bouncing rod's symmetric family
-      // alternated failure at 2h and success at h for 30 steps (136 rejected steps in 354 points).
+      // kFailedStepRelease per accepted step and forgotten kFailedStepMemory failed steps further along
+      // the branch, where the difficulty need not persist): the deceleration factor measures the step
+      // just taken, not the basin of the one twice as long. Without this memory the bouncing rod's
+      // symmetric family alternated failure at 2h and success at h for 30 steps (136 rejected steps in
+      // 354 points).
       double growth_limit = branch_.rejected_steps > rejected_before ? h_ : options_.max_step;
+      if (a.arclength - failed_at_ > kFailedStepMemory * failed_size_) failed_step_ = kNoFailure;
       growth_limit = std::max(h_, std::min(growth_limit, kFailedStepMargin * failed_step_));
       failed_step_ *= kFailedStepRelease;
       next_h = std::clamp(std::min(h_ / std::max(f, 0.5), growth_limit), options_.min_step, options_.max_step);
@@ -485,9 +490,13 @@ class ContinuationStepper::Impl {
   double h_;
   // Smallest step at which the corrector failed, growing by kFailedStepRelease per accepted point
   // (infinite before any failure); steps grow to at most kFailedStepMargin times it.
-  double failed_step_ = std::numeric_limits<double>::infinity();
+  static constexpr double kNoFailure = std::numeric_limits<double>::infinity();
+  double failed_step_ = kNoFailure;
+  double failed_size_ = 0;  // failed_step_ when it was last set (before any release)
+  double failed_at_ = 0;    // arclength of the point the last failed step started from
   static constexpr double kFailedStepMargin = 0.75;
   static constexpr double kFailedStepRelease = 1.1;
+  static constexpr double kFailedStepMemory = 4;
   bool start_singular_ = false;
 };
 

@@ -59,12 +59,17 @@ struct AugmentedRhsWorkspace {
     dz.resize(z.size());
     phase->UnfoldedVectorField(z.head(n), xi, &f, sensitivities ? &A : nullptr, sensitivities ? &B : nullptr,
                                hessian_term);
-    dz.head(n) = f;
-    if (sensitivities) DispatchOnDimension(n, [&](auto N) { Propagate<decltype(N)::value>(z, dz); });
-    // One vectorized sum instead of element-wise tests of f, A and B (those were ~7% of a SLIP exploration):
-    // a NaN or Inf in f, A or B reaches dz (A Phi, A Psi + B; 0 * Inf is NaN) and then its sum. A sum that
-    // overflows from finite entries (|dz| ~ 1e308) also counts as non-finite: the integration has blown up.
-    if (!std::isfinite(dz.sum())) {
+    // Vectorized sums instead of element-wise tests of f, A and B (those were ~7% of a SLIP exploration):
+    // a NaN or Inf in f, A or B reaches its sum or dz (A Phi, A Psi + B; 0 * Inf is NaN) and then dz's sum.
+    // A sum that overflows from finite entries (~1e308) also counts as non-finite: the integration has
+    // blown up. f first, so that A and B are not read when f already failed (a model may not fill them).
+    bool finite = std::isfinite(f.sum());
+    if (finite) {
+      dz.head(n) = f;
+      if (sensitivities) DispatchOnDimension(n, [&](auto N) { Propagate<decltype(N)::value>(z, dz); });
+      finite = std::isfinite(dz.sum());
+    }
+    if (!finite) {
       if (!nonfinite) nonfinite_time = t;
       nonfinite = true;
       dz.setZero();
