@@ -210,22 +210,6 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
     return out;
   }
   double g_lo = test(lo_probe), g_hi = test(hi_probe);
-  if (g_lo != 0 && g_hi != 0 && std::signbit(g_lo) == std::signbit(g_hi)) {
-    // The end probes recompute the SB test from dr at the points themselves, while the sign change was
-    // seen in the values stored with the points (from dr up to CorrectorOptions::max_jacobian_distance
-    // away): the crossing lies within that distance of an end, or is not there. Not a root to locate.
-    out.message = "no sign change between the bracketing points when the test is re-evaluated there (" +
-                  FormatShort(g_lo) + ", " + FormatShort(g_hi) + ")";
-    out.lo = lo;
-    out.hi = hi;
-    const bool use_hi = std::abs(g_hi) < std::abs(g_lo);
-    out.estimate = use_hi ? hi_probe : lo_probe;
-    out.sigma = use_hi ? hi : lo;
-    out.test = use_hi ? g_hi : g_lo;
-    out.u_lo = lo_probe.u;
-    out.u_hi = hi_probe.u;
-    return out;
-  }
   // Illinois factors: the value of an end retained twice is halved.
   double f_lo = g_lo, f_hi = g_hi;
   int side = 0;
@@ -245,6 +229,14 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
     out.u_hi = hi_probe.u;
     return out;
   };
+  if (g_lo != 0 && g_hi != 0 && std::signbit(g_lo) == std::signbit(g_hi)) {
+    // The end probes recompute the SB test from dr at the points themselves, while the sign change was
+    // seen in the values stored with the points (from dr up to CorrectorOptions::max_jacobian_distance
+    // away): the crossing lies within that distance of an end, or is not there. Not a root to locate.
+    out.message = "no sign change between the bracketing points when the test is re-evaluated there (" +
+                  FormatShort(g_lo) + ", " + FormatShort(g_hi) + ")";
+    return finish(false);
+  }
   for (int it = 1; it <= max_iterations; ++it) {
     const double width = hi - lo;
     if (width <= tolerance) return finish(true);
