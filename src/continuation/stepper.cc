@@ -308,12 +308,34 @@ class ContinuationStepper::Impl {
     const double d = (a.u - p.u).norm();
     if (!(d > 0) || h > 2 * d || p.tangent.dot(a.tangent) <= 0) return;
     const double t = 1 + h / d;  // t = 0 at u_p, 1 at u_a
-    const double t2 = t * t, t3 = t2 * t;
-    const double h00 = 2 * t3 - 3 * t2 + 1, h10 = t3 - 2 * t2 + t, h01 = -2 * t3 + 3 * t2, h11 = t3 - t2;
+    *predictor = HermitePoint(p, a, t);
+    const double t2 = t * t;
     const double d00 = 6 * t2 - 6 * t, d10 = 3 * t2 - 4 * t + 1, d01 = -6 * t2 + 6 * t, d11 = 3 * t2 - 2 * t;
-    *predictor = h00 * p.u + h01 * a.u + (h10 * d) * p.tangent + (h11 * d) * a.tangent;
     const Vector slope = (d00 / d) * p.u + (d01 / d) * a.u + d10 * p.tangent + d11 * a.tangent;
     if (slope.norm() > 0) *normal = slope.normalized();
+  }
+
+  // The cubic Hermite interpolant of (u_a, τ_a) at t = 0 and (u_b, τ_b) at t = 1, the chord length
+  // standing for the arclength between them.
+  static Vector HermitePoint(const ContinuationPoint& a, const ContinuationPoint& b, double t) {
+    const double d = (b.u - a.u).norm();
+    const double t2 = t * t, t3 = t2 * t;
+    const double h00 = 2 * t3 - 3 * t2 + 1, h10 = t3 - 2 * t2 + t, h01 = -2 * t3 + 3 * t2, h11 = t3 - t2;
+    return h00 * a.u + h01 * b.u + (h10 * d) * a.tangent + (h11 * d) * b.tangent;
+  }
+
+  // Where the Hermite interpolant between a and b meets the stop (cᵀu = value), by bisection on the
+  // scalar cubic (it meets it: the stop's sign differs at a and b). Predicts the point on the stop with
+  // error O(|b − a|⁴) where the chord's is O(|b − a|²): on the bouncing rod's curved families the chord
+  // predictor's residual was 5–24 and every stop fell back to the root finder.
+  static Vector HermiteOnStop(const ContinuationPoint& a, const ContinuationPoint& b, const LinearStop& stop) {
+    double lo = 0, hi = 1;
+    const bool rising = stop.f(a.u) < stop.f(b.u);
+    for (int i = 0; i < 60; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      ((stop.f(HermitePoint(a, b, mid)) < 0) == rising ? lo : hi) = mid;
+    }
+    return HermitePoint(a, b, 0.5 * (lo + hi));
   }
 
   // Shrinks h; the last try before giving up is made with exactly min_step.
@@ -344,7 +366,9 @@ class ContinuationStepper::Impl {
       return false;
     }
     ContinuationPoint event;
-    const Vector predictor = a.u + first_theta * (b->u - a.u);
+    // From the Hermite interpolant when the tangents agree in orientation, else from the chord.
+    const Vector predictor = a.tangent.dot(b->tangent) > 0 ? HermiteOnStop(a, *b, *first)
+                                                           : Vector(a.u + first_theta * (b->u - a.u));
     corrector_.set_max_distance((b->u - a.u).norm() + options_.min_step);
     const CorrectorResult result = corrector_.CorrectWithConstraint(predictor, first->c, first->value, &event.u);
     branch_.newton_iterations += result.iterations;
