@@ -37,7 +37,7 @@
 // And after every full Newton step Δ_k from k = 1 on, u_k + Δ_k is returned without evaluating r there
 // when its estimated error θ_k|Δ_k| (θ_k = |Δ_k|/|Δ_{k−1}|) is below the step tolerance
 // (Corrector::AcceptNewtonStep): from a Hermite predictor most continuation points then cost two r+dr
-// evaluations instead of three (SLIP exploration: 5142 -> 4209 evaluations, RHS work -19%).
+// evaluations instead of three (SLIP exploration: 5142 -> 4290 evaluations, RHS work -19%).
 //
 // Numerical outcomes are statuses (CorrectorResult), never exceptions or prints. A wrong vector size is
 // a programming error and throws std::invalid_argument.
