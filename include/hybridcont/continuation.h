@@ -13,7 +13,9 @@
 //               clamped to [min_step, max_step]. A failed corrector also halves h; below min_step the
 //               branch ends with kStepTooSmall and keeps its points. κ is the smaller of the step and the
 //               residual contraction (corrector.h; 0 when the predictor's residual is already at the
-//               corrector's tolerance), and h does not grow on the step after a rejection.
+//               corrector's tolerance), and h does not grow on the step after a rejection, nor beyond
+//               0.75× the smallest step at which the corrector failed recently (released by 1.1× per
+//               accepted point, forgotten four failed steps further along the branch).
 //
 // The tangent is the solution of the bordered system [dr(uⁱ⁺¹); τⁱᵀ] v = e_{N+1}, normalized: its last
 // equation τⁱᵀv = 1 is the continuous orientation, so the curve passes straight through simple
