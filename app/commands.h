@@ -35,6 +35,7 @@ struct RunArguments {
   std::string formulation = "time";
   bool quiet = false;
   bool no_plots = false;
+  bool no_symmetry = false;            // trace every half-branch instead of mapping images
 };
 void AddRunOptions(CLI::App* run, RunArguments* args);
 int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err);

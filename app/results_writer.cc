@@ -98,6 +98,10 @@ void ResultsWriter::EndBranch(const Branch& b) {
                                   {"message", b.message},
                                   {"newton_iterations", b.newton_iterations},
                                   {"rejected_steps", b.rejected_steps}});
+  if (b.image_of >= 0) {  // mapped, not traced (exploration.h, "Symmetries")
+    summary_["branches"].back()["image_of"] = b.image_of;
+    summary_["branches"].back()["symmetry"] = b.symmetry;
+  }
   WriteSummary();
 }
 

@@ -46,6 +46,8 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
                   "other); the results do not depend on it");
   run->add_option("--formulation", args->formulation,
                   "time (default: time-based multiple shooting) or state (event-driven Poincare map)");
+  run->add_flag("--no-symmetry", args->no_symmetry,
+               "trace every half-branch, also those that are images of traced ones under the model's symmetries");
   run->add_flag("--quiet", args->quiet, "no progress lines");
   run->add_flag("--no-plots", args->no_plots, "do not draw figures");
 }
@@ -82,6 +84,7 @@ nlohmann::json OptionsJson(const RunArguments& args, const RunSetup& setup) {
   j["max_branches"] = setup.exploration.max_branches;
   j["max_depth"] = setup.exploration.max_depth;
   j["threads"] = setup.exploration.threads;
+  j["use_symmetries"] = setup.exploration.use_symmetries;
   nlohmann::json conditions = nlohmann::json::array();
   for (const auto& sc : setup.scenario.start_conditions) conditions.push_back(sc.description);
   j["start_conditions"] = conditions;
@@ -260,6 +263,7 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     if (*args.threads < 1) throw std::invalid_argument("--threads " + std::to_string(*args.threads) + ": must be >= 1");
     setup.exploration.threads = *args.threads;
   }
+  if (args.no_symmetry) setup.exploration.use_symmetries = false;
   nlohmann::json options_json = OptionsJson(args, setup);
   for (const auto& [name, scale] : sc.unknown_scales) options_json["unknown_scales"][name] = scale;
   std::unique_ptr<ModelExploration> exploration;

@@ -38,6 +38,19 @@ class Pitchfork : public ZeroProblem {
   }
 };
 
+// The pitchfork with its symmetry x -> −x declared (exploration: the x < 0 half-branch is mapped).
+class SymmetricPitchfork : public Pitchfork {
+ public:
+  std::vector<Symmetry> symmetries() const override { return {{"x-flip", Eigen::Vector2d(-1, 1)}}; }
+};
+
+// The pitchfork with a false declaration, (x, λ) -> (−x, −λ): it maps the SB point's ray along +x onto
+// the one along −x, but r(−x, −λ) = −(x³ + λx) does not vanish on λ = x².
+class FalselySymmetricPitchfork : public Pitchfork {
+ public:
+  std::vector<Symmetry> symmetries() const override { return {{"both-flip", Eigen::Vector2d(-1, -1)}}; }
+};
+
 // x(λ − x) = 0: the lines x = 0 and x = λ, crossing at the SB point (0, 0).
 class Transcritical : public ZeroProblem {
  public:

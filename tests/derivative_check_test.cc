@@ -12,8 +12,10 @@ class BuiltinModelDerivatives : public ::testing::TestWithParam<std::string> {};
 TEST_P(BuiltinModelDerivatives, AgreeWithFiniteDifferences) {
   const HybridModel model = MakeBuiltinModel(GetParam());
   const DerivativeCheckReport report = CheckDerivatives(model, DerivativeCheckOptions{});
-  // Every derivative kind is covered: per phase 7 (f, e, Delta, dH, d2H, Phi, Psi), anchor, shooting map.
-  EXPECT_EQ(static_cast<int>(report.entries.size()), 7 * model.num_phases() + 2);
+  // Every derivative kind is covered: per phase 7 (f, e, Delta, dH, d2H, Phi, Psi), anchor, shooting map,
+  // and the symmetry group of the shooting map (the SLIP: mirror, time reversal and their product).
+  const int symmetries = GetParam() == "slip" ? 3 : 1;
+  EXPECT_EQ(static_cast<int>(report.entries.size()), 7 * model.num_phases() + 2 + symmetries);
   for (const auto& e : report.entries) {
     EXPECT_TRUE(e.passed()) << e.what << ": " << e.worst_error << " > " << e.tolerance << " " << e.note;
   }
@@ -87,6 +89,48 @@ class HandWrittenWrong final : public Phase {
   }
   using Vector2d = Eigen::Vector2d;
 };
+
+// A mirror declared without the forward speed's sign: the check names it.
+TEST(DerivativeCheck, CatchesAWrongSymmetryDeclaration) {
+  HybridModel slip = MakeSlip();
+  Vector stance(4), flight(5);
+  stance << -1, 1, -1, 1;
+  flight << 1, -1, 1, 1, -1;  // dx should flip
+  slip.AddSymmetry({"bad-mirror", {stance, flight}, false});
+  const DerivativeCheckReport report = CheckDerivatives(slip, DerivativeCheckOptions{});
+  bool found = false;
+  for (const auto& e : report.entries) {
+    if (e.what.find("'bad-mirror'") == std::string::npos) continue;
+    found = true;
+    EXPECT_GT(e.worst_error, 1e-2) << e.what;  // O(1), not noise
+    EXPECT_FALSE(e.passed());
+  }
+  EXPECT_TRUE(found) << report.Table();
+  EXPECT_FALSE(report.passed());
+}
+
+TEST(DerivativeCheck, SymmetryDeclarationsAreValidated) {
+  HybridModel slip = MakeSlip();
+  const auto message = [&](ModelSymmetry s) {
+    try {
+      slip.AddSymmetry(std::move(s));
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  Vector four = Vector::Ones(4), five = Vector::Ones(5), two = Vector::Ones(2);
+  EXPECT_EQ(message({"a", {four}, true}), "model 'slip', symmetry 'a': 1 sign vectors for 2 phases");
+  EXPECT_EQ(message({"a", {four, two}, true}), "model 'slip', symmetry 'a', phase 'flight': 2 signs for 5 states");
+  Vector half = four;
+  half(2) = 0.5;
+  EXPECT_EQ(message({"a", {half, five}, true}),
+            "model 'slip', symmetry 'a', phase 'stance': sign of state 'dalpha' is 0.500000, must be +1 or -1");
+  EXPECT_EQ(message({"a", {four, five}, false}), "model 'slip', symmetry 'a': is the identity");
+  EXPECT_EQ(message({"mirror", {four, five}, true}), "model 'slip', symmetry 'mirror': declared twice");
+  EXPECT_EQ(message({"", {four, five}, true}), "model 'slip': a symmetry needs a name");
+  EXPECT_EQ(slip.symmetries().size(), 2u);
+}
 
 TEST(DerivativeCheck, CatchesAWrongHandWrittenJacobian) {
   ModelBuilder<WrongParameters> b("wrong", "oscillator with a wrong Jacobian");

@@ -39,7 +39,7 @@ auto Fields(const ContinuationPoint& p) {
 }
 auto Fields(const Branch& b) {
   return std::tie(b.id, b.direction, b.parent_special_point, b.depth, b.termination, b.message,
-                  b.newton_iterations, b.rejected_steps, b.located_iterations);
+                  b.newton_iterations, b.rejected_steps, b.located_iterations, b.image_of, b.symmetry);
 }
 auto Fields(const SwitchRecord& r) { return std::tie(r.special_point, r.traced, r.skipped, r.result.status); }
 
@@ -52,6 +52,7 @@ void ExpectSamePoint(const SpecialPoint& a, const SpecialPoint& b, const std::st
 void ExpectSameDiagram(const BifurcationDiagram& a, const BifurcationDiagram& b) {
   EXPECT_EQ(a.status, b.status);
   EXPECT_EQ(a.message, b.message);
+  EXPECT_EQ(a.warnings, b.warnings);
   ASSERT_EQ(a.branches.size(), b.branches.size()) << a.FullReport() << b.FullReport();
   for (size_t i = 0; i < a.branches.size(); ++i) {
     const Branch& x = a.branches[i];
@@ -133,6 +134,10 @@ TEST(ExplorationThreads, AlgebraicDiagramsAreTheSerialOnes) {
   ExpectSameOnThreads<testing::Pitchfork>(Eigen::Vector2d(0, -0.5), options);      // regular start, SB
   ExpectSameOnThreads<testing::Pitchfork>(Eigen::Vector2d(0, 0), options);         // singular start
   ExpectSameOnThreads<testing::Transcritical>(Eigen::Vector2d(0, 0.4), options);
+  // Symmetries: the image is mapped at its merge, the same on every thread count.
+  ExpectSameOnThreads<testing::SymmetricPitchfork>(Eigen::Vector2d(0, -0.5), options);
+  ExpectSameOnThreads<testing::SymmetricPitchfork>(Eigen::Vector2d(0, 0), options);
+  ExpectSameOnThreads<testing::FalselySymmetricPitchfork>(Eigen::Vector2d(0, -0.5), options);
 
   // Two SB points on the line: at the second one both line rays are known, its half-branches skipped.
   ExplorationOptions parabola;

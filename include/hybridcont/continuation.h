@@ -210,6 +210,10 @@ struct Branch {
   int newton_iterations = 0;          // total over accepted and rejected steps
   int rejected_steps = 0;
   int located_iterations = 0;         // root-finder iterations spent locating special points
+  // Exploration: the branch is the image of branch `image_of` under the problem's symmetry `symmetry`
+  // (zero_problem.h), mapped instead of traced (no Newton iterations of its own); −1 if traced.
+  int image_of = -1;
+  std::string symmetry;
 
   std::string BriefReport() const;
   std::string FullReport(const std::vector<std::string>& unknown_names = {}) const;

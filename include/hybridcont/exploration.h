@@ -22,6 +22,23 @@
 //      branch are compared with all traced branches (distance to a chord within the chord sag, tangent
 //      within known_branch_angle of the interpolated one); a match ends the new branch with kKnownBranch.
 //
+// Symmetries (ZeroProblem::symmetries(), e.g. the SLIP's mirror and time reversal): a half-branch
+// leaving point p along v is not traced when a merged branch starts at q along w with S q = p and
+// S w ∥ v (same_point_tolerance, same_direction_cosine) for a symmetry S: it is that branch mapped
+// point by point (u -> S u, τ -> S τ, special points likewise; Branch::image_of, Branch::symmetry), and
+// an SB point that is the image of one already switched at gets the mapped switching directions. What
+// the serial trace would decide is decided on the image too: its first points are checked against the
+// merged branches (kKnownBranch), its special points are registered and queued. Guards: a symmetry is
+// used only when it maps every stop onto itself (bounds and sum bounds symmetric where it flips signs,
+// targets at 0 there; none with a stop_predicate, which cannot be checked); the first mapped point is
+// evaluated, and a residual above 1e-6·(1 + ||u||) or a tangent off by more than known_branch_angle drops
+// the symmetry for the rest of the run (BifurcationDiagram::warnings) and the half-branch is traced. The
+// sign of the SB test function along an image is taken from that evaluation (det([dr; τᵀ]) may change
+// sign under S). Sources whose own end depended on the order of tracing (kKnownBranch) are not mapped.
+// Mapped branches are exact images (the time-based map is equivariant to the last bit on the built-in
+// models: durations, states and ξ change sign in exact arithmetic), so the diagram is the traced one
+// up to the tracing's own noise; the SLIP's complete diagram costs about half.
+//
 // Tiny example (pitchfork x³ − λx from a regular point of the trivial branch):
 //
 //   ExplorationOptions options;
@@ -99,6 +116,8 @@ struct ExplorationOptions {
   // on the calling thread, as does a problem without Clone(). The problem's clones integrate on one
   // thread each, so a time-based map with many segments does not start threads of its own on top.
   int threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  // Map half-branches through the problem's symmetries instead of tracing them ("Symmetries" above).
+  bool use_symmetries = true;
 
   std::string Validate() const;
 };
@@ -125,6 +144,7 @@ struct BifurcationDiagram {
   BranchDirections start;                     // analysis of the start point
   ExplorationStatus status = ExplorationStatus::kCompleted;
   std::string message;
+  std::vector<std::string> warnings;          // e.g. a declared symmetry that failed its check
 
   std::string BriefReport() const;
   std::string FullReport() const;

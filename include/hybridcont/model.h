@@ -29,6 +29,11 @@
 //   b.SetAnchor<Apex>();
 //   HybridModel ball = b.Build();
 //
+// A model may declare symmetries (ModelBuilder::Symmetry): involutions that map orbits onto orbits, each a
+// sign change of every phase's state, possibly with time reversal (durations and ξ change sign). The
+// exploration then maps a half-branch that is the image of a traced one instead of tracing it
+// (exploration.h, "Symmetries"); `hybridcont check` verifies each declaration on sample points.
+//
 // A phase functor may define `FirstIntegrals` (returning a StateVector<T> of k values) instead of
 // `FirstIntegral` when the system has k > 1 hybrid first integrals (the paper's remark on N_H > 1).
 // A user who wants analytic derivatives implements the `Phase` interface directly instead.
@@ -127,6 +132,19 @@ class ParameterBlock {
   virtual void Set(int index, double value) = 0;
 };
 
+// An involution x_i -> S_i x_i (S_i = diag(state_signs[i]), entries ±1) of every phase that maps orbits of
+// the model onto orbits. Without time reversal it must commute with the flows (f_i(S x) = S f_i(x)) and
+// with the resets, leave events, anchor and first integrals invariant up to sign. With time reversal
+// (mechanical reversibility: velocities flip) f_i(S x) = −S f_i(x) instead, so x(t) -> S x(−t); then
+// durations and ξ change sign in the shooting maps (the dissipative unfolding f + ξ∇H reverses with ξ).
+// Example, the SLIP: mirror x -> −x flips (α, α̇) in stance and (α, ẋ, α̇) in flight; time reversal
+// flips the velocities (α̇, l̇) and (ẋ, ẏ, α̇).
+struct ModelSymmetry {
+  std::string name;
+  std::vector<Vector> state_signs;  // one per phase, of the phase's dimension
+  bool reverses_time = false;
+};
+
 // A hybrid model: phases, anchor and parameters. Move-only (phases refer to the parameter block it owns).
 class HybridModel {
  public:
@@ -150,6 +168,12 @@ class HybridModel {
   // Sets a parameter; throws std::invalid_argument if the name is unknown or the value is not finite.
   void SetParameter(const std::string& name, double value);
 
+  // Declared symmetries (generators; see ModelSymmetry).
+  const std::vector<ModelSymmetry>& symmetries() const { return symmetries_; }
+  // Adds one; throws std::invalid_argument naming the symmetry, phase and entry when the sign vectors do
+  // not match the phases (count, dimension, entries ±1) or the name is empty or taken.
+  void AddSymmetry(ModelSymmetry symmetry);
+
  private:
   int ParameterIndex(const std::string& name) const;
 
@@ -158,6 +182,7 @@ class HybridModel {
   std::unique_ptr<ParameterBlock> parameters_;
   std::vector<std::unique_ptr<Phase>> phases_;
   std::unique_ptr<Anchor> anchor_;
+  std::vector<ModelSymmetry> symmetries_;
 };
 
 }  // namespace hybridcont
@@ -205,6 +230,12 @@ class ModelBuilder {
     return *this;
   }
 
+  // Declares a symmetry (ModelSymmetry): one sign vector per phase, in the order the phases were added.
+  ModelBuilder& Symmetry(std::string name, std::vector<Vector> state_signs, bool reverses_time) {
+    symmetries_.push_back({std::move(name), std::move(state_signs), reverses_time});
+    return *this;
+  }
+
   // Validates dimensions (reset maps into the next phase, first integrals in every phase) and builds.
   // Throws std::invalid_argument naming the offending phase.
   HybridModel Build() {
@@ -235,7 +266,9 @@ class ModelBuilder {
       }
     }
     internal::ValidatePhaseSizes(name_, phases);
-    return HybridModel(name_, description_, std::move(parameters_), std::move(phases), anchor_factory_(params));
+    HybridModel model(name_, description_, std::move(parameters_), std::move(phases), anchor_factory_(params));
+    for (ModelSymmetry& symmetry : symmetries_) model.AddSymmetry(std::move(symmetry));
+    return model;
   }
 
  private:
@@ -251,6 +284,7 @@ class ModelBuilder {
   std::vector<PendingPhase> pending_;
   std::map<int, std::unique_ptr<Phase>> ready_;
   std::function<std::unique_ptr<Anchor>(const P*)> anchor_factory_;
+  std::vector<ModelSymmetry> symmetries_;
 };
 
 }  // namespace hybridcont

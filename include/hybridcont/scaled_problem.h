@@ -30,6 +30,8 @@ class ScaledProblem : public ZeroProblem {
   EvaluationStatus EvaluateSparse(const Vector& v, Vector* r, SparseMatrix* dr) override;
 
   // A scaled clone of the wrapped problem (nullptr if that has none), which the clone owns.
+  // Diagonal scaling commutes with sign changes: the same signs act on v.
+  std::vector<Symmetry> symmetries() const override { return problem_->symmetries(); }
   std::unique_ptr<ZeroProblem> Clone() const override;
   // Forwards the work of the clone's wrapped problem to this one's.
   void AddWorkOf(const ZeroProblem& clone) override;

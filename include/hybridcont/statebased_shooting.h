@@ -46,6 +46,10 @@ class StateBasedShooting : public ZeroProblem {
 
   int num_equations() const override { return n1_ + k_; }
   std::vector<std::string> unknown_names() const override { return names_; }
+  // The model's symmetries without time reversal (and their products): phase 1's signs on x0. A time
+  // reversal runs the phases backwards, which the event-driven map, integrating forward through downward
+  // crossings, does not.
+  std::vector<Symmetry> symmetries() const override;
   EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override;
 
   // Layout of u.

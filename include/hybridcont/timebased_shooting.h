@@ -91,6 +91,9 @@ class TimeBasedShooting : public ZeroProblem {
   static constexpr int kMinSegmentsPerThread = 12;
 
   // Same model, integrator options and fixed levels; one thread (zero_problem.h).
+  // The model's symmetries (ModelSymmetry) and their products, on u: states by the phases' signs;
+  // durations and ξ change sign under time reversal; H̄ is invariant.
+  std::vector<Symmetry> symmetries() const override;
   std::unique_ptr<ZeroProblem> Clone() const override;
   void AddWorkOf(const ZeroProblem& clone) override;
 

@@ -12,7 +12,9 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <limits>
 #include <numbers>
+#include <optional>
 #include <span>
 #include <sstream>
 #include <stdexcept>
@@ -30,6 +32,8 @@ struct HalfBranch {
   int d = +1;                                             // d of eq. IVP (Branch::direction)
   int parent = -1;                                        // special point it leaves
   Vector direction;                                       // the ray it leaves `parent` along
+  Vector ray_point;                                       // where it starts, once known (symmetries)
+  bool reserved = false;  // an id is reserved for it, not handed to a worker: expected to be an image
   int id = 0;                                             // branch id it is traced under
   std::vector<const Branch*> known;                       // branches merged before it was traced
   bool with_worker = false;                               // handed to a worker, result not yet taken
@@ -215,6 +219,14 @@ class Explorer {
     }
     pool_ = TracingPool::Make(problem_, options_);
     evaluator_ = pool_ ? pool_->own_problem() : problem_;
+    if (options_.use_symmetries && !options_.continuation.stop_predicate) {
+      for (Symmetry& g : problem_->symmetries()) {
+        if (g.signs.size() == problem_->num_unknowns() && MapsStopsOntoThemselves(g)) symmetries_.push_back(std::move(g));
+      }
+    }
+    for (const std::string& name : options_.continuation.progress_components) {
+      progress_indices_.push_back(problem_->UnknownIndex(name));
+    }
   }
 
   BifurcationDiagram Run(const Vector& u0, const Vector* tangent) {
@@ -307,7 +319,11 @@ class Explorer {
     auto group = std::make_unique<Group>();
     group->kind = Group::Kind::kSwitch;
     group->record.special_point = id;
-    group->record.result = SwitchDirectionAt(evaluator_, diagram_.special_points[id], options_.switching);
+    if (std::optional<BranchSwitch> image = ImageSwitch(id)) {
+      group->record.result = std::move(*image);
+    } else {
+      group->record.result = SwitchDirectionAt(evaluator_, diagram_.special_points[id], options_.switching);
+    }
     const BranchSwitch& result = group->record.result;
     if (result.status == BranchSwitchStatus::kOk || result.status == BranchSwitchStatus::kFallback) {
       NoteLines(id, {result.direction, result.incoming_direction});
@@ -322,6 +338,7 @@ class Explorer {
     half->d = d;
     half->parent = id;
     half->direction = direction;
+    half->ray_point = diagram_.special_points[id].u;
     half->start = [u = diagram_.special_points[id].u, direction](ContinuationStepper* stepper) {
       return stepper->StartAtSingularPoint(u, direction);
     };
@@ -333,12 +350,17 @@ class Explorer {
   // become branches within max_branches (one that is not handed over is traced when its turn comes).
   void Launch(std::unique_ptr<Group> group) {
     if (pool_) {
-      for (const auto& half : group->halves) {
+      for (size_t i = 0; i < group->halves.size(); ++i) {
+        HalfBranch* half = group->halves[i].get();
         if (BranchBudgetSpent()) break;
         half->id = static_cast<int>(branches_.size()) + in_flight_++;
+        if (ExpectedImage(*half, std::span(group->halves).first(i))) {
+          half->reserved = true;  // mapped at its merge (or traced there if its source does not come)
+          continue;
+        }
         half->known = MergedBranches();
         half->with_worker = true;
-        pool_->Submit(half.get());
+        pool_->Submit(half);
       }
     }
     groups_.push_back(std::move(group));
@@ -368,6 +390,12 @@ class Explorer {
                                      branches_.back().termination == TerminationReason::kStartFailed)) {
             break;
           }
+          if (half->d == -1 && !branches_.empty() && !branches_.back().points.empty()) {
+            // Start(u0) corrects u0 to the same point for both directions: the second half leaves the
+            // first one's start point against its tangent.
+            half->ray_point = branches_.back().points.front().u;
+            half->direction = -branches_.back().points.front().tangent;
+          }
           Trace(half.get(), -1, 0);
         }
         break;
@@ -391,6 +419,10 @@ class Explorer {
       }
     }
     for (const auto& half : group->halves) {  // skipped ones: their traces are dropped
+      if (half->reserved) {
+        half->reserved = false;
+        --in_flight_;
+      }
       if (!half->with_worker) continue;
       pool_->Cancel(half.get());
       half->with_worker = false;
@@ -431,6 +463,20 @@ class Explorer {
   // traced now. Otherwise its worker's result, ended at the first checkpoint that lies on a branch
   // merged after it was launched, and relabeled when it was traced under another id.
   Branch Traced(HalfBranch* half, int id) {
+    if (half->reserved) {
+      half->reserved = false;
+      --in_flight_;
+    }
+    if (std::optional<Branch> image = Image(*half, id)) {
+      if (half->with_worker) {  // traced ahead for nothing
+        pool_->Cancel(half);
+        half->with_worker = false;
+        --in_flight_;
+      }
+      half->progress.clear();
+      if (options_.continuation.progress) ReportImage(*image, &half->progress);
+      return std::move(*image);
+    }
     if (!half->with_worker) {
       half->id = id;
       half->known = MergedBranches();
@@ -524,6 +570,195 @@ class Explorer {
     }
   }
 
+  // --- Symmetries (exploration.h, "Symmetries") ---
+
+  // Every bound, sum bound and target of the continuation is mapped onto itself by g.
+  bool MapsStopsOntoThemselves(const Symmetry& g) const {
+    const ContinuationOptions& c = options_.continuation;
+    const auto sign = [&](const std::string& name) { return g.signs(problem_->UnknownIndex(name)); };
+    for (const ComponentBound& b : c.bounds) {
+      if (sign(b.component) < 0 && b.lower != -b.upper) return false;
+    }
+    for (const ComponentTarget& t : c.targets) {
+      if (sign(t.component) < 0 && t.value != 0) return false;
+    }
+    for (const SumBound& b : c.sum_bounds) {
+      const double s = sign(b.components.front());
+      for (const std::string& name : b.components) {
+        if (sign(name) != s) return false;
+      }
+      if (s < 0 && b.lower != -b.upper) return false;
+    }
+    return true;
+  }
+
+  // Whether the ray (p, v) is the image of the ray (q, w) under g.
+  bool MapsRay(const Symmetry& g, const Vector& q, const Vector& w, const Vector& p, const Vector& v) const {
+    if ((g.Apply(q) - p).lpNorm<Eigen::Infinity>() > options_.same_point_tolerance * (1 + p.norm())) return false;
+    return g.Apply(w).normalized().dot(v.normalized()) >= options_.same_direction_cosine;
+  }
+
+  static bool Mappable(const Branch& source) {
+    return source.points.size() >= 2 && source.termination != TerminationReason::kKnownBranch &&
+           source.termination != TerminationReason::kStartFailed &&
+           source.termination != TerminationReason::kNotFinished;
+  }
+
+  // At launch: `half` will probably be mapped at its merge, as the image of a merged branch or of a
+  // half-branch launched before it (`earlier`: those of its own group). Only saves a worker's time;
+  // the decision is Image()'s, at the merge.
+  bool ExpectedImage(const HalfBranch& half, std::span<const std::unique_ptr<HalfBranch>> earlier) const {
+    if (symmetries_.empty() || half.ray_point.size() == 0) return false;
+    const auto image_of = [&](const Vector& q, const Vector& w) {
+      return std::any_of(symmetries_.begin(), symmetries_.end(),
+                         [&](const Symmetry& g) { return MapsRay(g, q, w, half.ray_point, half.direction); });
+    };
+    for (const Branch& branch : branches_) {
+      if (Mappable(branch) && image_of(branch.points.front().u, branch.points.front().tangent)) return true;
+    }
+    const auto launched = [&](const std::unique_ptr<HalfBranch>& other) {
+      return other->ray_point.size() > 0 && image_of(other->ray_point, other->direction);
+    };
+    for (const auto& group : groups_) {
+      if (std::any_of(group->halves.begin(), group->halves.end(), launched)) return true;
+    }
+    return std::any_of(earlier.begin(), earlier.end(), launched);
+  }
+
+  // The half-branch as the image of a merged branch, or nothing (then it is traced).
+  std::optional<Branch> Image(const HalfBranch& half, int id) {
+    if (symmetries_.empty() || half.ray_point.size() == 0) return std::nullopt;
+    for (const Branch& source : branches_) {
+      if (!Mappable(source)) continue;
+      for (size_t k = 0; k < symmetries_.size(); ++k) {
+        const Symmetry& g = symmetries_[k];
+        if (!MapsRay(g, source.points.front().u, source.points.front().tangent, half.ray_point, half.direction)) {
+          continue;
+        }
+        std::optional<Branch> image = MapBranch(source, g, id);
+        if (image) return image;
+        symmetries_.erase(symmetries_.begin() + static_cast<long>(k));  // failed its check: not used again
+        return std::nullopt;
+      }
+    }
+    return std::nullopt;
+  }
+
+  // source mapped by g as branch `id`; nothing if the first mapped point fails its check.
+  std::optional<Branch> MapBranch(const Branch& source, const Symmetry& g, int id) {
+    Branch image;
+    image.id = id;
+    image.termination = source.termination;
+    image.message = source.message;
+    image.image_of = source.id;
+    image.symmetry = g.name;
+    for (const ContinuationPoint& p : source.points) {
+      ContinuationPoint q = p;
+      q.u = g.Apply(p.u);
+      q.tangent = g.Apply(p.tangent);
+      image.points.push_back(std::move(q));
+    }
+    // The check: r and the induced tangent at the first point after the start (the start may be singular).
+    const ContinuationPoint& first = image.points[1];
+    Vector r;
+    Matrix dr;
+    const EvaluationStatus status = evaluator_->Evaluate(first.u, &r, &dr);
+    Vector tangent;
+    double sb_own = 0, sb_reference = 0;
+    internal::BorderedSolver solver;
+    const bool regular = status.ok && internal::InducedTangent(&solver, dr, first.tangent, &tangent, &sb_own, &sb_reference);
+    const double residual = status.ok ? r.lpNorm<Eigen::Infinity>() : std::numeric_limits<double>::infinity();
+    if (!regular || !(residual <= 1e-6 * (1 + first.u.norm())) ||
+        internal::AngleBetween(tangent, first.tangent) > options_.known_branch_angle) {
+      std::ostringstream out;
+      out << "symmetry '" << g.name << "' does not map branch " << source.id << " onto solutions (|r| = " << residual
+          << (regular ? ", tangent off by " + std::to_string(internal::AngleBetween(tangent, first.tangent)) + " rad"
+                      : ", singular")
+          << " at its point 1): not used";
+      diagram_.warnings.push_back(out.str());
+      return std::nullopt;
+    }
+    // det([dr; τᵀ]) at S u with S τ is ± the source's: the sign is the same along the whole branch.
+    const double sb_sign = (sb_own < 0) == (source.points[1].sb_test < 0) ? 1.0 : -1.0;
+    for (ContinuationPoint& p : image.points) p.sb_test *= sb_sign;
+    for (const SpecialPoint& sp : source.special_points) {
+      SpecialPoint q = sp;
+      q.branch_id = id;
+      q.id = -1;
+      q.duplicate_of = -1;
+      q.u = g.Apply(sp.u);
+      q.tangent = g.Apply(sp.tangent);
+      q.tangent_before = g.Apply(sp.tangent_before);
+      q.tangent_after = g.Apply(sp.tangent_after);
+      q.test_value *= sp.type == SpecialPointType::kTurningPoint ? g.signs(sp.component_index) : sb_sign;
+      image.special_points.push_back(std::move(q));
+    }
+    // The serial trace's known-branch check on the first points (not on the last: the trace had ended).
+    const std::vector<const Branch*> merged = MergedBranches();
+    for (int j = 1; j <= options_.known_branch_check_points && j + 1 < static_cast<int>(image.points.size()); ++j) {
+      if (const int other = OnTracedBranch(image.points[j], merged, options_); other >= 0) {
+        image.points.resize(j + 1);
+        std::erase_if(image.special_points, [j](const SpecialPoint& sp) { return sp.index >= j; });
+        image.termination = TerminationReason::kKnownBranch;
+        image.message = KnownBranchMessage(other);
+        break;
+      }
+    }
+    for (size_t i = 0; i < image.special_points.size(); ++i) image.special_points[i].id = static_cast<int>(i);
+    return image;
+  }
+
+  // The progress reports the stepper would have made for the image's points.
+  void ReportImage(const Branch& image, std::vector<ProgressInfo>* reports) const {
+    for (size_t i = 0; i < image.points.size(); ++i) {
+      const ContinuationPoint& p = image.points[i];
+      ProgressInfo info;
+      info.branch_id = image.id;
+      info.point_index = static_cast<int>(i);
+      if (progress_indices_.empty()) {
+        info.values.assign(p.u.data(), p.u.data() + p.u.size());
+      } else {
+        for (const int k : progress_indices_) info.values.push_back(p.u(k));
+      }
+      info.step = p.step;
+      info.next_step = i + 1 < image.points.size() ? image.points[i + 1].step : p.step;
+      info.newton_iterations = p.newton_iterations;
+      reports->push_back(std::move(info));
+    }
+  }
+
+  // The switching directions at SB point `id` mapped from an SB point already switched at, whose image
+  // it is; nothing if there is none. Of the two mapped branch lines, the one transverse to the branch
+  // the point was found on is the switching direction.
+  std::optional<BranchSwitch> ImageSwitch(int id) const {
+    if (symmetries_.empty()) return std::nullopt;
+    const SpecialPoint& p = diagram_.special_points[id];
+    std::vector<const SwitchRecord*> records;
+    for (const SwitchRecord& record : diagram_.switches) records.push_back(&record);
+    for (const auto& group : groups_) {
+      if (group->kind == Group::Kind::kSwitch) records.push_back(&group->record);
+    }
+    for (const SwitchRecord* record : records) {
+      const BranchSwitch& known = record->result;
+      if ((known.status != BranchSwitchStatus::kOk && known.status != BranchSwitchStatus::kFallback) ||
+          known.direction.size() == 0 || known.incoming_direction.size() == 0 || record->special_point == id) {
+        continue;
+      }
+      const SpecialPoint& q = diagram_.special_points[record->special_point];
+      for (const Symmetry& g : symmetries_) {
+        if ((g.Apply(q.u) - p.u).lpNorm<Eigen::Infinity>() > options_.same_point_tolerance * (1 + p.u.norm())) continue;
+        BranchSwitch image = known;
+        Vector a = g.Apply(known.direction), b = g.Apply(known.incoming_direction);
+        if (p.tangent.size() == a.size() && std::abs(a.dot(p.tangent)) > std::abs(b.dot(p.tangent))) std::swap(a, b);
+        image.direction = std::move(a);
+        image.incoming_direction = std::move(b);
+        image.message += (image.message.empty() ? "" : "; ") + std::string("image of the switch at #") +
+                         std::to_string(q.id) + " under " + g.name;
+        return image;
+      }
+    }
+    return std::nullopt;
+  }
 
   ZeroProblem* problem_;
   ExplorationOptions options_;
@@ -537,6 +772,8 @@ class Explorer {
   int in_flight_ = 0;                         // half-branches of groups_ (concurrent)
   std::unique_ptr<TracingPool> pool_;         // null: serial (destroyed before groups_: joins first)
   ZeroProblem* evaluator_ = nullptr;          // evaluations on this thread: problem_, or the pool's clone
+  std::vector<Symmetry> symmetries_;          // those used (exploration.h, "Symmetries")
+  std::vector<int> progress_indices_;         // ContinuationOptions::progress_components
 };
 
 }  // namespace
@@ -596,6 +833,7 @@ std::string BifurcationDiagram::FullReport() const {
   std::ostringstream out;
   out << BriefReport() << "\n";
   if (!message.empty()) out << "  " << message << "\n";
+  for (const std::string& warning : warnings) out << "  warning: " << warning << "\n";
   if (start.kernel_dimension > 1) out << "Start: " << start.BriefReport() << "\n";
   out << "Branches:\n";
   for (const Branch& branch : branches) out << "  " << branch.FullReport(unknown_names);

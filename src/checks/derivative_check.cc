@@ -1,5 +1,6 @@
 #include "hybridcont/derivative_check.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <iomanip>
@@ -31,10 +32,13 @@ bool DerivativeCheckReport::passed() const {
 std::string DerivativeCheckReport::Table() const {
   std::ostringstream os;
   os << "derivative check of model '" << model << "' (relative error vs central finite differences)\n";
-  os << std::left << std::setw(44) << "derivative" << std::right << std::setw(12) << "worst error" << std::setw(12)
+  size_t width = 44;
+  for (const auto& e : entries) width = std::max(width, e.what.size() + 2);
+  const int w = static_cast<int>(width);
+  os << std::left << std::setw(w) << "derivative" << std::right << std::setw(12) << "worst error" << std::setw(12)
      << "threshold" << "  verdict\n";
   for (const auto& e : entries) {
-    os << std::left << std::setw(44) << e.what << std::right << std::scientific << std::setprecision(2)
+    os << std::left << std::setw(w) << e.what << std::right << std::scientific << std::setprecision(2)
        << std::setw(12) << e.worst_error << std::setw(12) << e.tolerance << "  " << (e.passed() ? "ok" : "FAIL");
     if (!e.note.empty()) os << " (" << e.note << ")";
     os << "\n";
@@ -227,6 +231,27 @@ class Checker {
         return shooting.Evaluate(v, out, nullptr).ok;
       }, u, o_.flow_step, &ok);
       Record("shooting map: dr/du", o_.flow_tolerance, dr, fd, ok);
+      CheckSymmetries(&shooting, u, r, dr);
+    }
+  }
+
+  // A declared symmetry S maps r to ±r componentwise (r(S u) = T r(u), T a sign matrix) and dr to
+  // dr(S u) S = T dr(u): compared as |r(S u)| against |r(u)| and |dr(S u) S| against |dr(u)|, relative
+  // to the largest entry. Exact in exact arithmetic; a wrong sign in a declaration gives O(1) errors.
+  void CheckSymmetries(TimeBasedShooting* shooting, const Vector& u, const Vector& r, const Matrix& dr) {
+    for (const Symmetry& g : shooting->symmetries()) {
+      const std::string what = "symmetry '" + g.name + "': |r(Su)|, |dr(Su) S| vs |r(u)|, |dr(u)|";
+      Vector r_image;
+      Matrix dr_image;
+      const EvaluationStatus s = shooting->Evaluate(g.Apply(u), &r_image, &dr_image);
+      if (!s.ok) {
+        Record(what, o_.flow_tolerance, Matrix(), Matrix(), false, s.message);
+        continue;
+      }
+      Matrix exact(r.size(), dr.cols() + 1), image(r.size(), dr.cols() + 1);
+      exact << dr.cwiseAbs(), r.cwiseAbs();
+      image << (dr_image * g.signs.asDiagonal()).cwiseAbs(), r_image.cwiseAbs();
+      Record(what, o_.flow_tolerance, exact, image, true);
     }
   }
 

@@ -121,6 +121,7 @@ std::string Branch::BriefReport() const {
   out << "Branch " << id << ": " << points.size() << " points, " << special_points.size()
       << " special points, " << ToString(termination) << ", " << newton_iterations << " Newton iterations, "
       << rejected_steps << " rejected steps";
+  if (image_of >= 0) out << ", image of branch " << image_of << " under " << symmetry;
   return out.str();
 }
 

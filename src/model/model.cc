@@ -42,6 +42,36 @@ HybridModel::HybridModel(std::string name, std::string description, std::unique_
       phases_(std::move(phases)),
       anchor_(std::move(anchor)) {}
 
+void HybridModel::AddSymmetry(ModelSymmetry symmetry) {
+  const std::string where = "model '" + name_ + "', symmetry '" + symmetry.name + "'";
+  if (symmetry.name.empty()) throw std::invalid_argument("model '" + name_ + "': a symmetry needs a name");
+  for (const ModelSymmetry& known : symmetries_) {
+    if (known.name == symmetry.name) throw std::invalid_argument(where + ": declared twice");
+  }
+  if (symmetry.state_signs.size() != phases_.size()) {
+    throw std::invalid_argument(where + ": " + std::to_string(symmetry.state_signs.size()) +
+                                " sign vectors for " + std::to_string(phases_.size()) + " phases");
+  }
+  bool identity = !symmetry.reverses_time;
+  for (size_t i = 0; i < phases_.size(); ++i) {
+    const Vector& signs = symmetry.state_signs[i];
+    const std::string phase = where + ", phase '" + phases_[i]->name() + "'";
+    if (signs.size() != phases_[i]->dim()) {
+      throw std::invalid_argument(phase + ": " + std::to_string(signs.size()) + " signs for " +
+                                  std::to_string(phases_[i]->dim()) + " states");
+    }
+    for (int k = 0; k < signs.size(); ++k) {
+      if (signs(k) != 1.0 && signs(k) != -1.0) {
+        throw std::invalid_argument(phase + ": sign of state '" + phases_[i]->state_names()[k] + "' is " +
+                                    std::to_string(signs(k)) + ", must be +1 or -1");
+      }
+      identity = identity && signs(k) == 1.0;
+    }
+  }
+  if (identity) throw std::invalid_argument(where + ": is the identity");
+  symmetries_.push_back(std::move(symmetry));
+}
+
 int HybridModel::ParameterIndex(const std::string& name) const {
   const auto& infos = parameters_->infos();
   for (int i = 0; i < static_cast<int>(infos.size()); ++i) {

@@ -17,6 +17,7 @@ HybridModel MakeBallChain(int num_phases) {
   typical << 0.5, 0.3;
   for (int i = 0; i < num_phases; ++i) b.AddPhase<internal::BallFlight>("flight-" + std::to_string(i + 1), {"y", "dy"}, typical);
   b.SetAnchor<internal::BallApex>();
+  b.Symmetry("time-reversal", std::vector<Vector>(num_phases, Vector(Eigen::Vector2d(1, -1))), true);
   return b.Build();
 }
 

@@ -10,6 +10,7 @@ HybridModel MakeBouncingBall() {
   typical << 0.5, 0.3;
   b.AddPhase<internal::BallFlight>("flight", {"y", "dy"}, typical);
   b.SetAnchor<internal::BallApex>();
+  b.Symmetry("time-reversal", {Vector(Eigen::Vector2d(1, -1))}, true);
   return b.Build();
 }
 

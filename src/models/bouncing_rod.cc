@@ -65,6 +65,11 @@ HybridModel MakeBouncingRod() {
   b.AddPhase<RodFlight<-1>>("left-impact", states, typical);
   b.AddPhase<RodFlight<+1>>("right-impact", states, typical);
   b.SetAnchor<Apex>();
+  // Time reversal (velocities flip; the impact law is linear in them). The mirror alpha -> -alpha swaps
+  // the two impact phases, which a sign change per phase cannot express.
+  Vector reverse(4);
+  reverse << 1, 1, -1, -1;
+  b.Symmetry("time-reversal", {reverse, reverse}, true);
   return b.Build();
 }
 

@@ -58,6 +58,7 @@ HybridModel MakeRockingBlock() {
   typical << 0.1, 0.2;
   b.AddPhase<Rocking>("rocking", {"alpha", "dalpha"}, typical);
   b.SetAnchor<TurningPoint>();
+  b.Symmetry("time-reversal", {Vector(Eigen::Vector2d(1, -1))}, true);  // the impact law is linear in dalpha
   return b.Build();
 }
 

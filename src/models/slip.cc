@@ -102,6 +102,14 @@ HybridModel MakeSlip() {
   b.AddPhase<Stance>("stance", {"alpha", "l", "dalpha", "dl"}, stance);
   b.AddPhase<Flight>("flight", {"y", "alpha", "dx", "dy", "dalpha"}, flight);
   b.SetAnchor<Nadir>();
+  // x -> -x (forward/backward hopping) and time reversal (velocities flip).
+  Vector mirror_stance(4), mirror_flight(5), reverse_stance(4), reverse_flight(5);
+  mirror_stance << -1, 1, -1, 1;
+  mirror_flight << 1, -1, -1, 1, -1;
+  reverse_stance << 1, 1, -1, -1;
+  reverse_flight << 1, 1, -1, -1, -1;
+  b.Symmetry("mirror", {mirror_stance, mirror_flight}, false);
+  b.Symmetry("time-reversal", {reverse_stance, reverse_flight}, true);
   return b.Build();
 }
 

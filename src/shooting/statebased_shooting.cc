@@ -23,6 +23,17 @@ void StateBasedShooting::SetFixedLevels(const Vector& levels) {
   cache_valid_ = false;
 }
 
+std::vector<Symmetry> StateBasedShooting::symmetries() const {
+  std::vector<Symmetry> generators;
+  for (const ModelSymmetry& s : model_->symmetries()) {
+    if (s.reverses_time) continue;
+    Vector signs = Vector::Ones(num_unknowns());
+    signs.head(n1_) = s.state_signs[0];
+    generators.push_back({s.name, std::move(signs)});
+  }
+  return SymmetryGroup(generators);
+}
+
 std::unique_ptr<ZeroProblem> StateBasedShooting::Clone() const {
   auto clone = std::make_unique<StateBasedShooting>(*model_, map_.options());
   clone->SetFixedLevels(fixed_levels_);

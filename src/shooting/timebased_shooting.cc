@@ -41,6 +41,21 @@ void TimeBasedShooting::set_threads(int threads) {
   team_.reset();
 }
 
+std::vector<Symmetry> TimeBasedShooting::symmetries() const {
+  std::vector<Symmetry> generators;
+  for (const ModelSymmetry& s : model_->symmetries()) {
+    const double time = s.reverses_time ? -1.0 : 1.0;
+    Vector signs = Vector::Ones(layout_.num_unknowns());
+    for (int i = 0; i < layout_.num_segments(); ++i) {
+      signs(layout_.time_index(i)) = time;
+      signs.segment(layout_.state_offset(i), layout_.dim(i)) = s.state_signs[i % model_->num_phases()];
+    }
+    for (int j = 0; j < layout_.num_first_integrals(); ++j) signs(layout_.xi_index(j)) = time;
+    generators.push_back({s.name, std::move(signs)});
+  }
+  return SymmetryGroup(generators);
+}
+
 std::unique_ptr<ZeroProblem> TimeBasedShooting::Clone() const {
   auto clone = std::make_unique<TimeBasedShooting>(*model_, options_);
   clone->SetFixedLevels(fixed_levels_);
