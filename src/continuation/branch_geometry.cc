@@ -1,4 +1,5 @@
 #include "continuation/branch_geometry.h"
+#include "continuation/jacobian_tolerance_scope.h"
 
 #include <Eigen/QR>
 #include <algorithm>
@@ -132,6 +133,8 @@ CorrectorResult Segment::CorrectFrom(const Vector& predictor, double max_distanc
   // (the noise-limited test above), and locate the point inside the noise. Elsewhere (turning points,
   // stops) the curve is regular and the estimate is as good as on branch points.
   if (with_sb_test_) corrector_->set_accept_on_error_estimate(false);
+  // and the exact Jacobian: the SB test function is taken from it
+  const JacobianToleranceScope exact(problem_, with_sb_test_ ? 0.0 : -1.0, JacobianToleranceScope::Mode::kExactly);
   const CorrectorResult result = corrector_->CorrectPseudoArclength(predictor, a_.tangent, &probe->u);
   corrector_->set_max_distance(saved.max_distance);
   corrector_->set_accept_on_error_estimate(saved.accept_on_error_estimate);
@@ -179,6 +182,7 @@ bool Segment::EndProbe(bool at_b, Probe* probe, std::string* message) {
   probe->tangent = p.tangent;
   probe->sb_test = 0;
   if (!with_sb_test_) return true;
+  const JacobianToleranceScope exact(problem_, 0.0, JacobianToleranceScope::Mode::kExactly);
   if (const EvaluationStatus status = problem_->Evaluate(p.u, nullptr, &dr_); !status.ok) {
     *message = "evaluation at a bracketing point failed: " + status.message;
     return false;

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "continuation/bordered_solver.h"
+#include "continuation/jacobian_tolerance_scope.h"
 
 namespace hybridcont {
 
@@ -65,28 +66,7 @@ std::string CorrectorResult::BriefReport() const {
   return out.str();
 }
 
-namespace {
-
-// Sets a problem's Jacobian tolerance for one evaluation (a negative value leaves it alone) and restores
-// the previous value when it goes out of scope.
-class JacobianToleranceScope {
- public:
-  JacobianToleranceScope(ZeroProblem* problem, double tolerance)
-      : problem_(tolerance >= 0 ? problem : nullptr), previous_(problem->jacobian_tolerance()) {
-    if (problem_ != nullptr) problem_->set_jacobian_tolerance(std::max(tolerance, previous_));
-  }
-  ~JacobianToleranceScope() {
-    if (problem_ != nullptr) problem_->set_jacobian_tolerance(previous_);
-  }
-  JacobianToleranceScope(const JacobianToleranceScope&) = delete;
-  JacobianToleranceScope& operator=(const JacobianToleranceScope&) = delete;
-
- private:
-  ZeroProblem* problem_;
-  double previous_;
-};
-
-}  // namespace
+using internal::JacobianToleranceScope;
 
 // Scratch space sized once per problem (STYLE.md practice 6): the Newton loop allocates nothing after the
 // first call.
