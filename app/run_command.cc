@@ -299,8 +299,10 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     PointRecord record;
     record.index = info.point_index;
     record.u = u;
-    const OrbitTrace trace(model, u, setup.integrator);
-    record.classification = ClassifyOrbit(model, u, trace, ClassificationOptions{});
+    if (!ClassifyByUnknowns(model, u, ClassificationOptions{}, &record.classification)) {  // no trace needed
+      const OrbitTrace trace(model, u, setup.integrator);
+      record.classification = ClassifyOrbit(model, u, trace, ClassificationOptions{});
+    }
     record.newton_iterations = info.newton_iterations;
     record.step = info.step;
     // Floquet data first: its r + dr evaluation leaves r in the map's cache, so the residual below costs

@@ -59,6 +59,12 @@ struct Classification {
 Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const OrbitTrace& trace,
                              const ClassificationOptions& options);
 
+// ClassifyOrbit's checks on u alone (|ξ|, negative and zero durations), which need no trace: true, with
+// *result set, when they decide; then ClassifyOrbit would return the same. Lets a caller skip the
+// integration of the trace for most non-physical points (the SLIP: three of four points of its diagram).
+bool ClassifyByUnknowns(const HybridModel& model, const Vector& u, const ClassificationOptions& options,
+                        Classification* result);
+
 }  // namespace hybridcont
 
 #endif  // HYBRIDCONT_CLASSIFICATION_H_

@@ -71,8 +71,8 @@ double FirstViolation(const HybridModel& model, const OrbitTrace& trace, int i, 
 
 }  // namespace
 
-Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const OrbitTrace& trace,
-                             const ClassificationOptions& options) {
+bool ClassifyByUnknowns(const HybridModel& model, const Vector& u, const ClassificationOptions& options,
+                        Classification* result) {
   const ShootingLayout layout(model);
   const int m = model.num_phases();
   std::ostringstream os;
@@ -89,16 +89,25 @@ Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const Or
   }
   if (xi > options.xi_tolerance) {
     os << "|xi| = " << xi;
-    return NonPhysical(all_zero ? OrbitClass::kAtRest : OrbitClass::kDissipative, os.str());
-  }
-  if (any_negative) {
+    *result = NonPhysical(all_zero ? OrbitClass::kAtRest : OrbitClass::kDissipative, os.str());
+  } else if (any_negative) {
     os << "t" << negative_segment + 1 << " = " << u(layout.time_index(negative_segment)) << " < 0";
-    return NonPhysical(OrbitClass::kReversedTime, os.str());
-  }
-  if (any_zero) {
+    *result = NonPhysical(OrbitClass::kReversedTime, os.str());
+  } else if (any_zero) {
     os << "t" << zero_segment + 1 << " = " << u(layout.time_index(zero_segment));
-    return NonPhysical(OrbitClass::kZeroDuration, os.str());
+    *result = NonPhysical(OrbitClass::kZeroDuration, os.str());
+  } else {
+    return false;
   }
+  return true;
+}
+
+Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const OrbitTrace& trace,
+                             const ClassificationOptions& options) {
+  if (Classification decided; ClassifyByUnknowns(model, u, options, &decided)) return decided;
+  const ShootingLayout layout(model);
+  const int m = model.num_phases();
+  std::ostringstream os;
   if (!trace.ok()) return NonPhysical(OrbitClass::kIntegrationFailed, trace.message());
   // Transversal downward crossing at the end of every segment.
   for (int i = 0; i <= m; ++i) {
