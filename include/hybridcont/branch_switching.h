@@ -118,7 +118,7 @@ std::vector<Vector> BranchDirectionsAt(ZeroProblem& problem, const Vector& u0, c
 struct BranchSwitch {
   BranchSwitchStatus status = BranchSwitchStatus::kNoRoots;
   std::string message;
-  Vector direction;              // unit, the ABE root transverse to the incoming branch
+  Vector direction;              // unit, the ABE root transverse to the incoming branch (CanonicalLine sign)
   Vector incoming_direction;     // unit, the ABE root nearest the incoming tangent
   // Angle (radians) between the incoming tangent and its ABE root: a self-check of the whole reduction
   // (small when the SB point and the second derivatives are accurate).
@@ -131,6 +131,10 @@ struct BranchSwitch {
   std::string BriefReport() const;
 };
 BranchSwitch SwitchDirectionAt(ZeroProblem* problem, const SpecialPoint& sb, const BranchSwitchOptions& options);
+
+// Sign convention for lines (BranchDirections::directions, BranchSwitch::direction): unit, the
+// largest-magnitude component positive. The half-branch along +direction is traced first.
+Vector CanonicalLine(Vector v);
 
 // The two half-branches leaving an SB point along ±direction (the stepper's StartAtSingularPoint: a
 // predictor along the direction, then the corrector), traced with `options`. Branch ids 0 and 1.

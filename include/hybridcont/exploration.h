@@ -24,15 +24,19 @@
 //
 // Symmetries (ZeroProblem::symmetries(), e.g. the SLIP's mirror and time reversal): a half-branch
 // leaving point p along v is not traced when a merged branch starts at q along w with S q = p and
-// S w ∥ v (same_point_tolerance, same_direction_cosine) for a symmetry S: it is that branch mapped
-// point by point (u -> S u, τ -> S τ, special points likewise; Branch::image_of, Branch::symmetry), and
-// an SB point that is the image of one already switched at gets the mapped switching directions. What
+// S w ∥ v (same_point_tolerance; directions within known_branch_angle) for a symmetry S: it is that
+// branch mapped point by point (u -> S u, τ -> S τ, special points likewise; Branch::image_of,
+// Branch::symmetry). Switching directions are computed at every SB point, images too: a mapped one could
+// only be checked by the second derivatives the computation needs anyway (N = 1: dr vanishes at an SB
+// point), and their canonical sign (CanonicalLine) makes the images' half-branches come in the order of
+// the traced diagram's. What
 // the serial trace would decide is decided on the image too: its first points are checked against the
 // merged branches (kKnownBranch), its special points are registered and queued. Guards: a symmetry is
 // used only when it maps every stop onto itself (bounds and sum bounds symmetric where it flips signs,
 // targets at 0 there; none with a stop_predicate, which cannot be checked); the first mapped point is
 // evaluated, and a residual above 1e-6·(1 + ||u||) or a tangent off by more than known_branch_angle drops
-// the symmetry for the rest of the run (BifurcationDiagram::warnings) and the half-branch is traced. The
+// the symmetry for the rest of the run (BifurcationDiagram::warnings) and the half-branch is traced (the
+// last mapped point is checked as well). An image's termination message names the mapped stop. The
 // sign of the SB test function along an image is taken from that evaluation (det([dr; τᵀ]) may change
 // sign under S). Sources whose own end depended on the order of tracing (kKnownBranch) are not mapped.
 // Mapped branches are exact images (the time-based map is equivariant to the last bit on the built-in

@@ -133,10 +133,13 @@ class ParameterBlock {
 };
 
 // An involution x_i -> S_i x_i (S_i = diag(state_signs[i]), entries ±1) of every phase that maps orbits of
-// the model onto orbits. Without time reversal it must commute with the flows (f_i(S x) = S f_i(x)) and
-// with the resets, leave events, anchor and first integrals invariant up to sign. With time reversal
-// (mechanical reversibility: velocities flip) f_i(S x) = −S f_i(x) instead, so x(t) -> S x(−t); then
-// durations and ξ change sign in the shooting maps (the dissipative unfolding f + ξ∇H reverses with ξ).
+// the model onto orbits. In both cases it must commute with the resets (Δ_i(S_i x) = S_{i+1} Δ_i(x)),
+// leave the first integrals invariant (H(S x) = H(x)) and the events and the anchor invariant up to sign
+// (e(S x) = ±e(x); the state-based map, which follows downward crossings, needs +). Without time
+// reversal it commutes with the flows (f_i(S x) = S f_i(x)). With time reversal (mechanical
+// reversibility: velocities flip) f_i(S x) = −S f_i(x) instead, so x(t) -> S x(−t); then durations and
+// ξ change sign in the time-based map (the dissipative unfolding f + ξ∇H reverses with ξ). `hybridcont
+// check` tests the time-based map's equivariance.
 // Example, the SLIP: mirror x -> −x flips (α, α̇) in stance and (α, ẋ, α̇) in flight; time reversal
 // flips the velocities (α̇, l̇) and (ẋ, ẏ, α̇).
 struct ModelSymmetry {

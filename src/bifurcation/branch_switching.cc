@@ -53,15 +53,14 @@ Roots QuadraticRoots(const Matrix& A, double degeneracy_tolerance, std::vector<E
   return Roots::kTwo;
 }
 
-// Sign convention for lines: largest-magnitude component positive.
+}  // namespace
+
 Vector CanonicalLine(Vector v) {
   v.normalize();
   Eigen::Index i;
   v.cwiseAbs().maxCoeff(&i);
   return v(i) < 0 ? Vector(-v) : v;
 }
-
-}  // namespace
 
 std::string ToString(BranchSwitchStatus status) {
   switch (status) {
@@ -268,7 +267,7 @@ BranchSwitch SwitchDirectionAt(ZeroProblem* problem, const SpecialPoint& sb, con
     out.message = "degenerate algebraic bifurcation equation (discriminant b^2 - ac = " +
                   std::to_string(out.b * out.b - out.a * out.c) +
                   "): using the kernel direction orthogonal to the incoming tangent";
-    out.direction = basis.col(1);
+    out.direction = CanonicalLine(basis.col(1));
     out.incoming_direction = basis.col(0);
     return out;
   }
@@ -276,7 +275,7 @@ BranchSwitch SwitchDirectionAt(ZeroProblem* problem, const SpecialPoint& sb, con
   const bool first_transverse = std::abs(roots[0](0)) < std::abs(roots[1](0));
   const Eigen::Vector2d transverse = first_transverse ? roots[0] : roots[1];
   const Eigen::Vector2d along = first_transverse ? roots[1] : roots[0];
-  out.direction = (basis * transverse).normalized();
+  out.direction = CanonicalLine(basis * transverse);
   out.incoming_direction = (basis * along).normalized();
   if (out.incoming_direction.dot(incoming) < 0) out.incoming_direction = -out.incoming_direction;
   out.incoming_root_angle = std::acos(std::clamp(std::abs(along(0)), 0.0, 1.0));

@@ -2,6 +2,7 @@
 #include "hybridcont/exploration.h"
 
 #include "continuation/branch_geometry.h"
+#include "continuation/linear_stop.h"
 
 #include <algorithm>
 #include <atomic>
@@ -224,6 +225,7 @@ class Explorer {
         if (g.signs.size() == problem_->num_unknowns() && MapsStopsOntoThemselves(g)) symmetries_.push_back(std::move(g));
       }
     }
+    stops_ = internal::LinearStops(options_.continuation, *problem_);
     for (const std::string& name : options_.continuation.progress_components) {
       progress_indices_.push_back(problem_->UnknownIndex(name));
     }
@@ -319,11 +321,7 @@ class Explorer {
     auto group = std::make_unique<Group>();
     group->kind = Group::Kind::kSwitch;
     group->record.special_point = id;
-    if (std::optional<BranchSwitch> image = ImageSwitch(id)) {
-      group->record.result = std::move(*image);
-    } else {
-      group->record.result = SwitchDirectionAt(evaluator_, diagram_.special_points[id], options_.switching);
-    }
+    group->record.result = SwitchDirectionAt(evaluator_, diagram_.special_points[id], options_.switching);
     const BranchSwitch& result = group->record.result;
     if (result.status == BranchSwitchStatus::kOk || result.status == BranchSwitchStatus::kFallback) {
       NoteLines(id, {result.direction, result.incoming_direction});
@@ -592,10 +590,13 @@ class Explorer {
     return true;
   }
 
-  // Whether the ray (p, v) is the image of the ray (q, w) under g.
+  // Whether the ray (p, v) is the image of the ray (q, w) under g: the points within same_point_tolerance,
+  // the directions within known_branch_angle (a true image is exact to rounding or to the switching
+  // directions' accuracy, ~1e-6; same_direction_cosine, ~8°, would take a branch crossing at a small
+  // angle for the image of the other).
   bool MapsRay(const Symmetry& g, const Vector& q, const Vector& w, const Vector& p, const Vector& v) const {
     if ((g.Apply(q) - p).lpNorm<Eigen::Infinity>() > options_.same_point_tolerance * (1 + p.norm())) return false;
-    return g.Apply(w).normalized().dot(v.normalized()) >= options_.same_direction_cosine;
+    return internal::AngleBetween(g.Apply(w).normalized(), v.normalized()) <= options_.known_branch_angle;
   }
 
   static bool Mappable(const Branch& source) {
@@ -649,7 +650,7 @@ class Explorer {
     Branch image;
     image.id = id;
     image.termination = source.termination;
-    image.message = source.message;
+    image.message = ImageStopMessage(source.message, g);
     image.image_of = source.id;
     image.symmetry = g.name;
     for (const ContinuationPoint& p : source.points) {
@@ -658,28 +659,34 @@ class Explorer {
       q.tangent = g.Apply(p.tangent);
       image.points.push_back(std::move(q));
     }
-    // The check: r and the induced tangent at the first point after the start (the start may be singular).
-    const ContinuationPoint& first = image.points[1];
-    Vector r;
-    Matrix dr;
-    const EvaluationStatus status = evaluator_->Evaluate(first.u, &r, &dr);
-    Vector tangent;
-    double sb_own = 0, sb_reference = 0;
-    internal::BorderedSolver solver;
-    const bool regular = status.ok && internal::InducedTangent(&solver, dr, first.tangent, &tangent, &sb_own, &sb_reference);
-    const double residual = status.ok ? r.lpNorm<Eigen::Infinity>() : std::numeric_limits<double>::infinity();
-    if (!regular || !(residual <= 1e-6 * (1 + first.u.norm())) ||
-        internal::AngleBetween(tangent, first.tangent) > options_.known_branch_angle) {
-      std::ostringstream out;
-      out << "symmetry '" << g.name << "' does not map branch " << source.id << " onto solutions (|r| = " << residual
-          << (regular ? ", tangent off by " + std::to_string(internal::AngleBetween(tangent, first.tangent)) + " rad"
-                      : ", singular")
-          << " at its point 1): not used";
-      diagram_.warnings.push_back(out.str());
-      return std::nullopt;
+    // The check: r and the induced tangent at the first point after the start (the start may be singular)
+    // and at the last one.
+    double sb_sign = 1.0;
+    for (const size_t i : {size_t{1}, image.points.size() - 1}) {
+      const ContinuationPoint& point = image.points[i];
+      Vector r;
+      Matrix dr;
+      const EvaluationStatus status = evaluator_->Evaluate(point.u, &r, &dr);
+      Vector tangent;
+      double sb_own = 0, sb_reference = 0;
+      internal::BorderedSolver solver;
+      const bool regular =
+          status.ok && internal::InducedTangent(&solver, dr, point.tangent, &tangent, &sb_own, &sb_reference);
+      const double residual = status.ok ? r.lpNorm<Eigen::Infinity>() : std::numeric_limits<double>::infinity();
+      if (!regular || !(residual <= 1e-6 * (1 + point.u.norm())) ||
+          internal::AngleBetween(tangent, point.tangent) > options_.known_branch_angle) {
+        std::ostringstream out;
+        out << "symmetry '" << g.name << "' does not map branch " << source.id << " onto solutions (|r| = "
+            << residual
+            << (regular ? ", tangent off by " + std::to_string(internal::AngleBetween(tangent, point.tangent)) + " rad"
+                        : ", singular")
+            << " at its point " << i << "): not used";
+        diagram_.warnings.push_back(out.str());
+        return std::nullopt;
+      }
+      // det([dr; τᵀ]) at S u with S τ is ± the source's: the sign is the same along the whole branch.
+      if (i == 1) sb_sign = (sb_own < 0) == (source.points[1].sb_test < 0) ? 1.0 : -1.0;
     }
-    // det([dr; τᵀ]) at S u with S τ is ± the source's: the sign is the same along the whole branch.
-    const double sb_sign = (sb_own < 0) == (source.points[1].sb_test < 0) ? 1.0 : -1.0;
     for (ContinuationPoint& p : image.points) p.sb_test *= sb_sign;
     for (const SpecialPoint& sp : source.special_points) {
       SpecialPoint q = sp;
@@ -708,6 +715,25 @@ class Explorer {
     return image;
   }
 
+  // The termination message of an image: the stop the source reached, mapped by g (a lower bound on a
+  // flipped component becomes the upper one, e.g. "reached lambda >= -2" -> "reached lambda <= 2").
+  std::string ImageStopMessage(const std::string& message, const Symmetry& g) const {
+    for (const internal::LinearStop& stop : stops_) {
+      const std::string reached = "reached " + stop.label;
+      if (message.rfind(reached, 0) != 0) continue;
+      const Vector c = g.Apply(stop.c);  // the image stops at cᵀ(S u) = value, i.e. (S c)ᵀu = value
+      for (const internal::LinearStop& other : stops_) {
+        const bool same = other.c == c && other.value == stop.value && other.kind == stop.kind;
+        const bool flipped = other.c == -c && other.value == -stop.value &&
+                             (stop.kind == internal::LinearStop::Kind::kTarget
+                                  ? other.kind == stop.kind
+                                  : other.kind != stop.kind && other.kind != internal::LinearStop::Kind::kTarget);
+        if (same || flipped) return "reached " + other.label + message.substr(reached.size());
+      }
+    }
+    return message;
+  }
+
   // The progress reports the stepper would have made for the image's points.
   void ReportImage(const Branch& image, std::vector<ProgressInfo>* reports) const {
     for (size_t i = 0; i < image.points.size(); ++i) {
@@ -727,39 +753,6 @@ class Explorer {
     }
   }
 
-  // The switching directions at SB point `id` mapped from an SB point already switched at, whose image
-  // it is; nothing if there is none. Of the two mapped branch lines, the one transverse to the branch
-  // the point was found on is the switching direction.
-  std::optional<BranchSwitch> ImageSwitch(int id) const {
-    if (symmetries_.empty()) return std::nullopt;
-    const SpecialPoint& p = diagram_.special_points[id];
-    std::vector<const SwitchRecord*> records;
-    for (const SwitchRecord& record : diagram_.switches) records.push_back(&record);
-    for (const auto& group : groups_) {
-      if (group->kind == Group::Kind::kSwitch) records.push_back(&group->record);
-    }
-    for (const SwitchRecord* record : records) {
-      const BranchSwitch& known = record->result;
-      if ((known.status != BranchSwitchStatus::kOk && known.status != BranchSwitchStatus::kFallback) ||
-          known.direction.size() == 0 || known.incoming_direction.size() == 0 || record->special_point == id) {
-        continue;
-      }
-      const SpecialPoint& q = diagram_.special_points[record->special_point];
-      for (const Symmetry& g : symmetries_) {
-        if ((g.Apply(q.u) - p.u).lpNorm<Eigen::Infinity>() > options_.same_point_tolerance * (1 + p.u.norm())) continue;
-        BranchSwitch image = known;
-        Vector a = g.Apply(known.direction), b = g.Apply(known.incoming_direction);
-        if (p.tangent.size() == a.size() && std::abs(a.dot(p.tangent)) > std::abs(b.dot(p.tangent))) std::swap(a, b);
-        image.direction = std::move(a);
-        image.incoming_direction = std::move(b);
-        image.message += (image.message.empty() ? "" : "; ") + std::string("image of the switch at #") +
-                         std::to_string(q.id) + " under " + g.name;
-        return image;
-      }
-    }
-    return std::nullopt;
-  }
-
   ZeroProblem* problem_;
   ExplorationOptions options_;
   BifurcationDiagram diagram_;
@@ -773,6 +766,7 @@ class Explorer {
   std::unique_ptr<TracingPool> pool_;         // null: serial (destroyed before groups_: joins first)
   ZeroProblem* evaluator_ = nullptr;          // evaluations on this thread: problem_, or the pool's clone
   std::vector<Symmetry> symmetries_;          // those used (exploration.h, "Symmetries")
+  std::vector<internal::LinearStop> stops_;   // ContinuationOptions' linear stops, for image messages
   std::vector<int> progress_indices_;         // ContinuationOptions::progress_components
 };
 

@@ -9,37 +9,11 @@
 
 #include "continuation/bordered_solver.h"
 #include "continuation/branch_geometry.h"
+#include "continuation/linear_stop.h"
 #include "hybridcont/continuation.h"
 
 namespace hybridcont {
-namespace {
-
-// A stop that is a level set of a linear functional cᵀu (targets, bounds, sum bounds).
-struct LinearStop {
-  enum class Kind { kTarget, kLower, kUpper };
-  Vector c;
-  double value = 0;
-  Kind kind = Kind::kTarget;
-  std::string label;
-
-  double f(const Vector& u) const { return c.dot(u) - value; }
-  bool Crossed(double f_a, double f_b) const {
-    switch (kind) {
-      case Kind::kTarget: return f_a != 0 && (f_b == 0 || std::signbit(f_a) != std::signbit(f_b));
-      case Kind::kLower: return f_a >= 0 && f_b < 0;
-      case Kind::kUpper: return f_a <= 0 && f_b > 0;
-    }
-    return false;
-  }
-  bool Violated(double f_u) const {
-    return (kind == Kind::kLower && f_u < 0) || (kind == Kind::kUpper && f_u > 0);
-  }
-  TerminationReason reason() const {
-    return kind == Kind::kTarget ? TerminationReason::kTargetReached : TerminationReason::kBoundReached;
-  }
-};
-
-}  // namespace
+using internal::LinearStop;
 
 class ContinuationStepper::Impl {
  public:
@@ -50,31 +24,11 @@ class ContinuationStepper::Impl {
     if (!error.empty()) throw std::invalid_argument(error);
     branch_.id = branch_id;
     branch_.direction = options_.direction;
-    const int n = problem_->num_unknowns();
     std::vector<std::string> turning = options_.turning_point_components;
     if (turning.empty() && problem_->UnknownIndex("H") >= 0) turning.push_back("H");
     for (const std::string& name : turning) turning_.push_back(problem_->UnknownIndex(name));
     for (const std::string& name : options_.progress_components) progress_.push_back(problem_->UnknownIndex(name));
-    for (const ComponentTarget& target : options_.targets) {
-      stops_.push_back({Vector::Unit(n, problem_->UnknownIndex(target.component)), target.value,
-                        LinearStop::Kind::kTarget, target.component + " = " + std::to_string(target.value)});
-    }
-    auto add_bounds = [this](const Vector& c, double lower, double upper, const std::string& label) {
-      if (std::isfinite(lower)) stops_.push_back({c, lower, LinearStop::Kind::kLower, label + " >= " + std::to_string(lower)});
-      if (std::isfinite(upper)) stops_.push_back({c, upper, LinearStop::Kind::kUpper, label + " <= " + std::to_string(upper)});
-    };
-    for (const ComponentBound& bound : options_.bounds) {
-      add_bounds(Vector::Unit(n, problem_->UnknownIndex(bound.component)), bound.lower, bound.upper, bound.component);
-    }
-    for (const SumBound& bound : options_.sum_bounds) {
-      Vector c = Vector::Zero(n);
-      std::string label;
-      for (const std::string& name : bound.components) {
-        c(problem_->UnknownIndex(name)) += 1.0;
-        label += (label.empty() ? "" : "+") + name;
-      }
-      add_bounds(c, bound.lower, bound.upper, label);
-    }
+    stops_ = internal::LinearStops(options_, *problem_);
   }
 
   StepStatus Start(const Vector& u0, const Vector* hint) {

@@ -1,0 +1,69 @@
+// Internal: the stops that are level sets of a linear functional cᵀu (ContinuationOptions' targets,
+// bounds and sum bounds), shared by the stepper (which locates them) and the exploration (which names
+// the stop an image of a branch ends on).
+#ifndef HYBRIDCONT_SRC_CONTINUATION_LINEAR_STOP_H_
+#define HYBRIDCONT_SRC_CONTINUATION_LINEAR_STOP_H_
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "hybridcont/continuation.h"
+#include "hybridcont/zero_problem.h"
+
+namespace hybridcont::internal {
+
+struct LinearStop {
+  enum class Kind { kTarget, kLower, kUpper };
+  Vector c;
+  double value = 0;
+  Kind kind = Kind::kTarget;
+  std::string label;  // e.g. "H <= 2.000000", "t1+t2+t3 >= -20.000000", "H = 1.500000"
+
+  double f(const Vector& u) const { return c.dot(u) - value; }
+  bool Crossed(double f_a, double f_b) const {
+    switch (kind) {
+      case Kind::kTarget: return f_a != 0 && (f_b == 0 || std::signbit(f_a) != std::signbit(f_b));
+      case Kind::kLower: return f_a >= 0 && f_b < 0;
+      case Kind::kUpper: return f_a <= 0 && f_b > 0;
+    }
+    return false;
+  }
+  bool Violated(double f_u) const {
+    return (kind == Kind::kLower && f_u < 0) || (kind == Kind::kUpper && f_u > 0);
+  }
+  TerminationReason reason() const {
+    return kind == Kind::kTarget ? TerminationReason::kTargetReached : TerminationReason::kBoundReached;
+  }
+};
+
+// Targets, then bounds, then sum bounds (finite sides only), in the order of the options.
+inline std::vector<LinearStop> LinearStops(const ContinuationOptions& options, const ZeroProblem& problem) {
+  const int n = problem.num_unknowns();
+  std::vector<LinearStop> stops;
+  for (const ComponentTarget& target : options.targets) {
+    stops.push_back({Vector::Unit(n, problem.UnknownIndex(target.component)), target.value,
+                     LinearStop::Kind::kTarget, target.component + " = " + std::to_string(target.value)});
+  }
+  auto add_bounds = [&stops](const Vector& c, double lower, double upper, const std::string& label) {
+    if (std::isfinite(lower)) stops.push_back({c, lower, LinearStop::Kind::kLower, label + " >= " + std::to_string(lower)});
+    if (std::isfinite(upper)) stops.push_back({c, upper, LinearStop::Kind::kUpper, label + " <= " + std::to_string(upper)});
+  };
+  for (const ComponentBound& bound : options.bounds) {
+    add_bounds(Vector::Unit(n, problem.UnknownIndex(bound.component)), bound.lower, bound.upper, bound.component);
+  }
+  for (const SumBound& bound : options.sum_bounds) {
+    Vector c = Vector::Zero(n);
+    std::string label;
+    for (const std::string& name : bound.components) {
+      c(problem.UnknownIndex(name)) += 1.0;
+      label += (label.empty() ? "" : "+") + name;
+    }
+    add_bounds(c, bound.lower, bound.upper, label);
+  }
+  return stops;
+}
+
+}  // namespace hybridcont::internal
+
+#endif  // HYBRIDCONT_SRC_CONTINUATION_LINEAR_STOP_H_
