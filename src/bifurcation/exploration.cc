@@ -154,21 +154,32 @@ class TracingPool {
     if (half->error) std::rethrow_exception(half->error);
   }
 
-  // `half` is not needed: dropped if pending, stopped at its next point if running.
+  // `half` is not needed: dropped if pending, stopped at its next point if running; returns when it is.
   void Cancel(HalfBranch* half) {
-    half->cancelled = true;
     std::unique_lock<std::mutex> lock(mutex_);
-    if (const auto it = std::find(pending_.begin(), pending_.end(), half); it != pending_.end()) {
-      pending_.erase(it);
-      half->done = true;
-    }
+    Drop(half);
     done_.wait(lock, [half] { return half->done; });
+  }
+
+  // The same without waiting for a running worker to stop (Cancel later returns at once, or soon).
+  void RequestCancel(HalfBranch* half) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Drop(half);
   }
 
  private:
   TracingPool(ZeroProblem* problem, const ExplorationOptions& options, std::vector<std::unique_ptr<ZeroProblem>> clones)
       : problem_(problem), options_(options), clones_(std::move(clones)), running_(options.threads, nullptr) {
     for (int i = 0; i < options.threads; ++i) workers_.emplace_back([this, i] { Work(i); });
+  }
+
+  // Under mutex_.
+  void Drop(HalfBranch* half) {
+    half->cancelled = true;
+    if (const auto it = std::find(pending_.begin(), pending_.end(), half); it != pending_.end()) {
+      pending_.erase(it);
+      half->done = true;
+    }
   }
 
   void Work(int worker) {
@@ -454,7 +465,10 @@ class Explorer {
     }
     branches_.push_back(std::move(branch));
     for (const ProgressInfo& info : half->progress) options_.continuation.progress(info);
-    if (pool_) LaunchQueued();  // the SB points just found: their groups can start while this one merges
+    if (pool_) {
+      CancelKnownRays();
+      LaunchQueued();  // the SB points just found: their groups can start while this one merges
+    }
   }
 
   // The half-branch as the serial run traces it as branch `id`. Serially (or not handed to a worker):
@@ -504,6 +518,18 @@ class Explorer {
       for (ProgressInfo& info : half->progress) info.branch_id = id;
     }
     return branch;
+  }
+
+  // Concurrent: a half-branch in flight whose ray is known by now will be skipped at its merge (rays
+  // only accumulate): its worker stops at its next point instead of tracing it to the end (SLIP: ~80
+  // points a run). Not waited for here; the merge collects it as any skipped half-branch.
+  void CancelKnownRays() {
+    for (const auto& group : groups_) {
+      for (const auto& half : group->halves) {
+        if (!half->with_worker || half->cancelled || half->parent < 0) continue;
+        if (RayKnown(half->parent, half->direction)) pool_->RequestCancel(half.get());
+      }
+    }
   }
 
   std::vector<const Branch*> MergedBranches() const {
