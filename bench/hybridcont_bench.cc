@@ -2,7 +2,8 @@
 // exploration of the model's default scenario. Counters: points, Newton iterations per point, rejected
 // steps, right-hand-side (RHS) evaluations and their ratio to the floor — one integration of every phase
 // with sensitivities per accepted point (the RHS count of one r+dr evaluation at each accepted point,
-// summed over the diagram).
+// summed over the diagram; rhs_over_traced_floor: over the traced points only, without the images that
+// symmetries map for free). newton_per_point is per traced point.
 //
 //   build/bench/hybridcont_bench --benchmark_filter=FullRun
 #include <benchmark/benchmark.h>
@@ -94,17 +95,18 @@ void BM_FullRun(benchmark::State& state) {
   const std::string name = kModels[state.range(0)];
   const HybridModel model = MakeBuiltinModel(name);
   const Scenario scenario = DefaultScenario(model);
-  long points = 0, newton = 0, rejected = 0, rhs = 0, branches = 0;
-  double floor_rhs = 0;
+  long points = 0, traced_points = 0, newton = 0, rejected = 0, rhs = 0, branches = 0;
+  double floor_rhs = 0, traced_floor_rhs = 0;
   BifurcationDiagram diagram;
   ExplorationOptions options = ScenarioExplorationOptions(scenario);
   options.threads = static_cast<int>(state.range(1));
   for (auto _ : state) {
     ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
     const BifurcationDiagram d = exploration.Run();
-    points = newton = rejected = 0;
+    points = traced_points = newton = rejected = 0;
     for (const Branch& b : d.branches) {
       points += static_cast<long>(b.points.size());
+      if (b.image_of < 0) traced_points += static_cast<long>(b.points.size());
       newton += b.newton_iterations;
       rejected += b.rejected_steps;
     }
@@ -114,22 +116,28 @@ void BM_FullRun(benchmark::State& state) {
   }
   {
     // The floor (issue 6): one integration of every phase with sensitivities per accepted point — the
-    // RHS count of one r+dr evaluation at each accepted point itself, summed.
+    // RHS count of one r+dr evaluation at each accepted point itself, summed. Over all points of the
+    // diagram, and over the traced ones only (the points of branches mapped through a symmetry cost
+    // nothing: rhs_over_traced_floor is the work per point the continuation itself did).
     TimeBasedShooting probe(model, IntegratorOptions{});
     Vector r;
     Matrix dr;
     for (const Branch& b : diagram.branches) {
+      const long before = probe.counters().rhs_evaluations;
       for (const ContinuationPoint& p : b.points) probe.Evaluate(p.u, &r, &dr);
+      if (b.image_of < 0) traced_floor_rhs += static_cast<double>(probe.counters().rhs_evaluations - before);
     }
     floor_rhs = static_cast<double>(probe.counters().rhs_evaluations);
   }
   state.SetLabel(name);
   state.counters["branches"] = static_cast<double>(branches);
   state.counters["points"] = static_cast<double>(points);
-  state.counters["newton_per_point"] = static_cast<double>(newton) / static_cast<double>(points);
+  state.counters["traced_points"] = static_cast<double>(traced_points);
+  state.counters["newton_per_point"] = static_cast<double>(newton) / static_cast<double>(traced_points);
   state.counters["rejected"] = static_cast<double>(rejected);
   state.counters["rhs"] = static_cast<double>(rhs);
   state.counters["rhs_over_floor"] = static_cast<double>(rhs) / floor_rhs;
+  state.counters["rhs_over_traced_floor"] = static_cast<double>(rhs) / traced_floor_rhs;
 }
 // BM_FullRun/<model>/<threads>. Wall time: the exploration and the shooting map may run on several threads
 // (ExplorationOptions::threads); on one thread the RHS count is the algorithm's work alone, on two it also
