@@ -115,6 +115,7 @@ Vector ModelExploration::FindPhysicalStart(std::string* why) {
   options.threads = 1;  // the predicate below writes `found`: one thread, the serial order
   Vector found;
   options.continuation.stop_predicate = [&](const Vector& u) {
+    if (found.size() > 0) return true;  // every later half-branch ends at its first point
     if (Classification quick; ClassifyByUnknowns(model_, u, ClassificationOptions{}, &quick)) return false;
     const OrbitTrace trace(model_, u, integrator_);
     if (ClassifyOrbit(model_, u, trace, ClassificationOptions{}).physical) found = u;

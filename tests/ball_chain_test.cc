@@ -131,10 +131,13 @@ TEST(BallChain, SegmentsOnTwoThreadsGiveTheSerialMapBitwise) {
   EXPECT_EQ(serial.counters().steps, threaded.counters().steps);
   EXPECT_EQ(serial.num_evaluations(), threaded.num_evaluations());
 
+  EXPECT_EQ(threaded.jacobian_tolerance(), TimeBasedShooting::kXiHessianTolerance);  // the default
+  threaded.set_jacobian_tolerance(0.0);  // exact: a clone must evaluate as the original does
   const std::unique_ptr<ZeroProblem> clone = threaded.Clone();
   ASSERT_NE(clone, nullptr);
   const auto& clone_map = dynamic_cast<const TimeBasedShooting&>(*clone);
   EXPECT_EQ(clone_map.threads(), 1);
+  EXPECT_EQ(clone->jacobian_tolerance(), 0.0);
   ASSERT_TRUE(clone->Evaluate(u, &r_only, nullptr).ok);
   EXPECT_TRUE(r_only == r1);
   const long before = threaded.counters().rhs_evaluations;

@@ -68,6 +68,26 @@ class PartlySymmetric : public ZeroProblem {
   std::unique_ptr<ZeroProblem> Clone() const override { return std::make_unique<PartlySymmetric>(*this); }
 };
 
+// x ((λ − 3)² + x² − 1)((λ + 3)² + x² − 1) = 0 with λ -> −λ: the line x = 0 and two circles, mirror
+// images, each a closed loop from its SB points (a reviewer's case: the last point of a closed loop is its
+// singular start, which the image check must not take for a failed mapping).
+class TwoCircles : public ZeroProblem {
+ public:
+  int num_equations() const override { return 1; }
+  std::vector<std::string> unknown_names() const override { return {"x", "lambda"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0), l = u(1);
+    const double a = (l - 3) * (l - 3) + x * x - 1, b = (l + 3) * (l + 3) + x * x - 1;
+    if (r) *r = Vector::Constant(1, x * a * b);
+    if (dr) {
+      dr->resize(1, 2);
+      *dr << a * b + x * (2 * x * b + a * 2 * x), x * (2 * (l - 3) * b + a * 2 * (l + 3));
+    }
+    return {};
+  }
+  std::vector<Symmetry> symmetries() const override { return {{"lambda-flip", Eigen::Vector2d(1, -1)}}; }
+};
+
 int Images(const BifurcationDiagram& d) {
   int images = 0;
   for (const Branch& b : d.branches) images += b.image_of >= 0;
@@ -199,6 +219,24 @@ TEST(ExplorationSymmetry, BranchesCrossingAtSmallAnglesAreNotImages) {
     }
     EXPECT_GE(messages, 1) << mapped.FullReport();
   }
+}
+
+TEST(ExplorationSymmetry, AClosedLoopIsMappedOntoItsImage) {
+  ExplorationOptions options;
+  options.continuation.bounds = {{"lambda", -5, 5}, {"x", -2, 2}};
+  TwoCircles problem;
+  const BifurcationDiagram mapped = Explore(&problem, Eigen::Vector2d(0, 0.5), options);
+  EXPECT_TRUE(mapped.warnings.empty()) << mapped.FullReport();
+  int loops = 0, mapped_loops = 0;
+  for (const Branch& b : mapped.branches) {
+    if (b.termination != TerminationReason::kClosedLoop) continue;
+    ++loops;
+    if (b.image_of >= 0) ++mapped_loops;
+  }
+  EXPECT_EQ(loops, 2) << mapped.FullReport();
+  EXPECT_EQ(mapped_loops, 1) << mapped.FullReport();
+  options.use_symmetries = false;
+  ExpectSameDiagram(Explore(&problem, Eigen::Vector2d(0, 0.5), options), mapped, 1e-9);
 }
 
 // A declaration that holds on one branch only: switching directions are computed, never mapped, and the

@@ -1,5 +1,6 @@
 // Lyapunov–Schmidt reduction at singular points (branch_switching.h).
 #include "hybridcont/branch_switching.h"
+#include "continuation/jacobian_tolerance_scope.h"
 
 #include <Eigen/SVD>
 #include <algorithm>
@@ -117,6 +118,8 @@ std::string BranchSwitch::BriefReport() const {
 
 BranchDirections AnalyzeSingularPoint(ZeroProblem* problem, const Vector& u0, const StartOptions& options) {
   if (const std::string error = options.Validate(); !error.empty()) throw std::invalid_argument(error);
+  // Kernels and second derivatives (finite differences of dr) from the exact Jacobian.
+  const internal::JacobianToleranceScope exact(problem, 0.0, internal::JacobianToleranceScope::Mode::kExactly);
   const int n = problem->num_unknowns();
   if (u0.size() != n) {
     throw std::invalid_argument("AnalyzeSingularPoint: u0 has size " + std::to_string(u0.size()) +
@@ -229,6 +232,8 @@ std::vector<Vector> BranchDirectionsAt(ZeroProblem& problem, const Vector& u0, c
 
 BranchSwitch SwitchDirectionAt(ZeroProblem* problem, const SpecialPoint& sb, const BranchSwitchOptions& options) {
   if (const std::string error = options.Validate(); !error.empty()) throw std::invalid_argument(error);
+  // Kernel and second derivatives (finite differences of dr) from the exact Jacobian.
+  const internal::JacobianToleranceScope exact(problem, 0.0, internal::JacobianToleranceScope::Mode::kExactly);
   BranchSwitch out;
   Matrix dr;
   if (const EvaluationStatus status = problem->Evaluate(sb.u, nullptr, &dr); !status.ok) {

@@ -686,9 +686,10 @@ class Explorer {
       image.points.push_back(std::move(q));
     }
     // The check: r and the induced tangent at the first point after the start (the start may be singular)
-    // and at the last one.
+    // and at the last one (of a closed loop: the one before it, the last being the start again).
     double sb_sign = 1.0;
-    for (const size_t i : {size_t{1}, image.points.size() - 1}) {
+    const size_t last = image.points.size() - (source.termination == TerminationReason::kClosedLoop ? 2 : 1);
+    for (const size_t i : {size_t{1}, std::max<size_t>(1, last)}) {
       const ContinuationPoint& point = image.points[i];
       Vector r;
       Matrix dr;

@@ -111,7 +111,8 @@ class ContinuationStepper::Impl {
             result.iterations == 0) {
           // [dr; pᵀ] singular at the very predictor: along a curve of singular points (e.g. the rod's
           // at-rest ξ-line) halving h cannot help. Said once, instead of ~20 rejected steps.
-          // dr at the predictor, exact (the corrector's was taken with predictor_jacobian_tolerance).
+          // dr at the predictor to the problem's own accuracy (the corrector's was taken with
+          // predictor_jacobian_tolerance).
           Matrix dr;
           if (const int k = problem_->Evaluate(predictor, nullptr, &dr).ok ? KernelDimension(dr) : 0; k >= 2) {
             return Finish(TerminationReason::kStartFailed,

@@ -60,6 +60,7 @@ std::unique_ptr<ZeroProblem> TimeBasedShooting::Clone() const {
   auto clone = std::make_unique<TimeBasedShooting>(*model_, options_);
   clone->SetFixedLevels(fixed_levels_);
   clone->set_threads(1);
+  clone->set_jacobian_tolerance(jacobian_tolerance_);  // the same zero set and the same accuracy
   return clone;
 }
 
