@@ -87,8 +87,9 @@ class TimeBasedShooting : public ZeroProblem {
   // is O(|u − u*|): the order by which dr(u) already differs from dr(u*). Newton without it converges
   // quadratically all the same, and the dr of an accepted point (at most max_jacobian_distance =
   // 1e-8·(1 + ||u||) from the solution, corrector.h) errs by ~1e-8 with or without it. Sizable ξ (the
-  // at-rest ξ-branches, derivative checks) keeps it. The SB test functions of the root finder ask for 0
-  // (branch_geometry.h): with 1e-8 there, located SB points of the SLIP moved by up to 4e-12 in H.
+  // at-rest ξ-branches, derivative checks) keeps it. The SB test functions of the root finder, branch
+  // switching and the analysis of singular starts (finite differences of dr) ask for 0: with 1e-8 in the
+  // SB tests, located SB points of the SLIP moved by up to 4e-12 in H.
   // Measured on the SLIP's complete diagram: the Hessian jets were 17% of the profile; 232 -> 192 ms.
   static constexpr double kXiHessianTolerance = 1e-8;
   void set_jacobian_tolerance(double tolerance) override { jacobian_tolerance_ = tolerance; }
