@@ -3,6 +3,7 @@
 
 #include "continuation/branch_geometry.h"
 #include "continuation/linear_stop.h"
+#include "continuation/progress_report.h"
 
 #include <algorithm>
 #include <atomic>
@@ -237,9 +238,7 @@ class Explorer {
       }
     }
     stops_ = internal::LinearStops(options_.continuation, *problem_);
-    for (const std::string& name : options_.continuation.progress_components) {
-      progress_indices_.push_back(problem_->UnknownIndex(name));
-    }
+    progress_indices_ = internal::ProgressIndices(options_.continuation, *problem_);
   }
 
   BifurcationDiagram Run(const Vector& u0, const Vector* tangent) {
@@ -764,19 +763,9 @@ class Explorer {
   // The progress reports the stepper would have made for the image's points.
   void ReportImage(const Branch& image, std::vector<ProgressInfo>* reports) const {
     for (size_t i = 0; i < image.points.size(); ++i) {
-      const ContinuationPoint& p = image.points[i];
-      ProgressInfo info;
-      info.branch_id = image.id;
-      info.point_index = static_cast<int>(i);
-      if (progress_indices_.empty()) {
-        info.values.assign(p.u.data(), p.u.data() + p.u.size());
-      } else {
-        for (const int k : progress_indices_) info.values.push_back(p.u(k));
-      }
-      info.step = p.step;
-      info.next_step = i + 1 < image.points.size() ? image.points[i + 1].step : p.step;
-      info.newton_iterations = p.newton_iterations;
-      reports->push_back(std::move(info));
+      const double next_step = i + 1 < image.points.size() ? image.points[i + 1].step : image.points[i].step;
+      reports->push_back(internal::PointProgress(image.points[i], image.id, static_cast<int>(i), progress_indices_,
+                                                 next_step, 0));
     }
   }
 

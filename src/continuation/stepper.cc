@@ -10,6 +10,7 @@
 #include "continuation/bordered_solver.h"
 #include "continuation/branch_geometry.h"
 #include "continuation/linear_stop.h"
+#include "continuation/progress_report.h"
 #include "hybridcont/continuation.h"
 
 namespace hybridcont {
@@ -27,7 +28,7 @@ class ContinuationStepper::Impl {
     std::vector<std::string> turning = options_.turning_point_components;
     if (turning.empty() && problem_->UnknownIndex("H") >= 0) turning.push_back("H");
     for (const std::string& name : turning) turning_.push_back(problem_->UnknownIndex(name));
-    for (const std::string& name : options_.progress_components) progress_.push_back(problem_->UnknownIndex(name));
+    progress_ = internal::ProgressIndices(options_, *problem_);
     stops_ = internal::LinearStops(options_, *problem_);
   }
 
@@ -441,20 +442,9 @@ class ContinuationStepper::Impl {
 
   void Report() const {
     if (!options_.progress) return;
-    const ContinuationPoint& point = branch_.points.back();
-    ProgressInfo info;
-    info.branch_id = branch_.id;
-    info.point_index = static_cast<int>(branch_.points.size()) - 1;
-    if (progress_.empty()) {
-      info.values.assign(point.u.data(), point.u.data() + point.u.size());
-    } else {
-      for (const int k : progress_) info.values.push_back(point.u(k));
-    }
-    info.step = point.step;
-    info.next_step = h_;
-    info.newton_iterations = point.newton_iterations;
-    info.rejected_steps = branch_.rejected_steps;
-    options_.progress(info);
+    options_.progress(internal::PointProgress(branch_.points.back(), branch_.id,
+                                              static_cast<int>(branch_.points.size()) - 1, progress_, h_,
+                                              branch_.rejected_steps));
   }
 
   ZeroProblem* problem_;
