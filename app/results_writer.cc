@@ -102,6 +102,10 @@ void ResultsWriter::EndBranch(const Branch& b) {
     summary_["branches"].back()["image_of"] = b.image_of;
     summary_["branches"].back()["symmetry"] = b.symmetry;
   }
+  if (b.reflected_from >= 0) {  // a loop traced to its midpoint and completed by reflection
+    summary_["branches"].back()["reflected_from"] = b.reflected_from;
+    summary_["branches"].back()["symmetry"] = b.symmetry;
+  }
   WriteSummary();
 }
 

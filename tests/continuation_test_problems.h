@@ -102,6 +102,26 @@ class CircleAndLine : public ZeroProblem {
   }
 };
 
+// λ(x² + λ² − 1) = 0 with its symmetry λ -> −λ: the axis λ = 0 and the unit circle, crossing at the SB
+// points (±1, 0). From (1, 0) the circle is a loop that the symmetry maps onto itself reversed, with its
+// midpoint at the SB point (−1, 0) (the exploration completes it by reflection).
+class CircleOnAxis : public ZeroProblem {
+ public:
+  int num_equations() const override { return 1; }
+  std::vector<std::string> unknown_names() const override { return {"x", "lambda"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0), l = u(1);
+    const double p = x * x + l * l - 1;
+    if (r) *r = Vector::Constant(1, l * p);
+    if (dr) {
+      dr->resize(1, 2);
+      *dr << 2 * x * l, p + 2 * l * l;
+    }
+    return {};
+  }
+  std::vector<Symmetry> symmetries() const override { return {{"lambda-flip", Eigen::Vector2d(1, -1)}}; }
+};
+
 // [x·y; λ(x − y)] = 0: the three coordinate axes, all through the origin, where dr = 0 (kernel of
 // dimension 3, cokernel of dimension 2).
 class ThreeAxes : public ZeroProblem {

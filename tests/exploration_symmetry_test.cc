@@ -1,6 +1,8 @@
 // Exploration with symmetries (exploration.h, "Symmetries"): half-branches that are images of traced
 // ones are mapped, and the diagram is the one traced without symmetries.
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -95,14 +97,18 @@ int Images(const BifurcationDiagram& d) {
 }
 
 // Same branches (count, terminations, ends) and special points as a diagram traced without symmetries.
-void ExpectSameDiagram(const BifurcationDiagram& traced, const BifurcationDiagram& mapped, double tolerance) {
+// `unreliable`: special points whose location is known not to be reproducible (compared by type only).
+void ExpectSameDiagram(const BifurcationDiagram& traced, const BifurcationDiagram& mapped, double tolerance,
+                       const std::function<bool(const SpecialPoint&)>& unreliable = {}) {
   ASSERT_EQ(traced.branches.size(), mapped.branches.size()) << traced.FullReport() << mapped.FullReport();
   for (size_t i = 0; i < traced.branches.size(); ++i) {
     const Branch& a = traced.branches[i];
     const Branch& b = mapped.branches[i];
     EXPECT_EQ(a.termination, b.termination) << "branch " << i;
     EXPECT_EQ(a.parent_special_point, b.parent_special_point) << "branch " << i;
-    ASSERT_EQ(a.points.size(), b.points.size()) << "branch " << i;
+    // A loop completed by reflection has points of its own past its midpoint: the same curve, ending
+    // at the same point (checked), sampled otherwise.
+    if (a.reflected_from < 0 && b.reflected_from < 0) ASSERT_EQ(a.points.size(), b.points.size()) << "branch " << i;
     EXPECT_LE((a.points.back().u - b.points.back().u).lpNorm<Eigen::Infinity>(), tolerance) << "branch " << i;
   }
   ASSERT_EQ(traced.special_points.size(), mapped.special_points.size());
@@ -110,6 +116,7 @@ void ExpectSameDiagram(const BifurcationDiagram& traced, const BifurcationDiagra
     const SpecialPoint& a = traced.special_points[k];
     const SpecialPoint& b = mapped.special_points[k];
     EXPECT_EQ(a.type, b.type) << "special point " << k;
+    if (unreliable && unreliable(a)) continue;
     EXPECT_EQ(a.status, b.status) << "special point " << k;
     // within `tolerance` or the points' own precision (componentwise width of their final brackets)
     const auto width = [](const SpecialPoint& p) {
@@ -239,6 +246,40 @@ TEST(ExplorationSymmetry, AClosedLoopIsMappedOntoItsImage) {
   ExpectSameDiagram(Explore(&problem, Eigen::Vector2d(0, 0.5), options), mapped, 1e-9);
 }
 
+TEST(ExplorationSymmetry, ASelfSymmetricLoopIsCompletedByReflection) {
+  ExplorationOptions options;
+  options.continuation.bounds = {{"x", -2, 2}};
+  testing::CircleOnAxis problem;
+  const BifurcationDiagram reflected = Explore(&problem, Eigen::Vector2d(0.3, 0), options);
+  options.use_symmetries = false;
+  const BifurcationDiagram traced = Explore(&problem, Eigen::Vector2d(0.3, 0), options);
+  ExpectSameDiagram(traced, reflected, 1e-9);
+  const Branch* loop = nullptr;
+  for (const Branch& b : reflected.branches) {
+    if (b.reflected_from >= 0) loop = &b;
+  }
+  ASSERT_NE(loop, nullptr) << reflected.FullReport();
+  EXPECT_EQ(loop->termination, TerminationReason::kClosedLoop);
+  const int j = loop->reflected_from - 1;
+  EXPECT_EQ(static_cast<int>(loop->points.size()), 2 * j + 2);
+  for (const ContinuationPoint& p : loop->points) EXPECT_NEAR(p.u.squaredNorm(), 1.0, 1e-10);
+  // Its midpoint, the SB point (−1, 0), is its only special point (the start, (1, 0), is not searched).
+  ASSERT_EQ(loop->special_points.size(), 1u) << loop->FullReport();
+  const SpecialPoint& mid = loop->special_points[0];
+  EXPECT_EQ(mid.type, SpecialPointType::kSimpleBifurcation);
+  EXPECT_LE((mid.u - Eigen::Vector2d(-1, 0)).norm(), 1e-10);
+  EXPECT_EQ(mid.index, j);
+  for (int i = 1; i <= j; ++i) {
+    const ContinuationPoint& a = loop->points[i];
+    const ContinuationPoint& b = loop->points[2 * j + 1 - i];
+    EXPECT_EQ(b.u, Vector(Eigen::Vector2d(a.u(0), -a.u(1))));
+    EXPECT_EQ(b.arclength, 2 * mid.arclength - a.arclength);
+    EXPECT_EQ(b.tangent, Vector(Eigen::Vector2d(-a.tangent(0), a.tangent(1))));  // −g(τ)
+    // the SB test changes sign across the midpoint
+    EXPECT_LT(a.sb_test * b.sb_test, 0) << i;
+  }
+}
+
 // A declaration that holds on one branch only: switching directions are computed, never mapped, and the
 // diagram is the traced one, on any number of threads.
 TEST(ExplorationSymmetry, ADeclarationTrueOnOneBranchOnlyChangesNothing) {
@@ -300,16 +341,49 @@ ScenarioRun RunScenario(const std::string& name, bool use_symmetries, int max_br
 }
 
 // The SLIP's complete diagram: with symmetries the same branches (in the same order: switching
-// directions have a canonical sign), SB and turning points as traced without, at about 60% of the map
-// evaluations.
+// directions have a canonical sign), SB and turning points as traced without, at about 55% of the map
+// evaluations; the closed loop (branch 8) is traced to its midpoint and completed by reflection.
+//
+// Except two: the loop's turning points where all durations pass through 0 together (T ≈ 0, H̄ ≈ 1.5714)
+// are not reproducible — any perturbation of dr at the 1e-8 level moves them by up to 1e-2 (bench/README,
+// "found on the way"), and the traced loop's pair is not mirror-symmetric to that level. The reflected
+// loop's pair is, exactly; that is asserted instead.
 TEST(ExplorationSymmetry, SlipDiagramIsTheTracedOneAtLessWork) {
   const ScenarioRun traced = RunScenario("slip", false);
   const ScenarioRun mapped = RunScenario("slip", true);
   EXPECT_EQ(Images(traced.diagram), 0);
   EXPECT_GE(Images(mapped.diagram), 10) << mapped.diagram.FullReport();
   EXPECT_TRUE(mapped.diagram.warnings.empty());
-  EXPECT_LT(mapped.evaluations, 0.65 * traced.evaluations) << traced.evaluations << " " << mapped.evaluations;
-  ExpectSameDiagram(traced.diagram, mapped.diagram, 1e-9);
+  EXPECT_LT(mapped.evaluations, 0.55 * traced.evaluations) << traced.evaluations << " " << mapped.evaluations;
+  const std::vector<std::string>& names = mapped.diagram.unknown_names;
+  const auto index = [&](const std::string& name) {
+    return static_cast<int>(std::find(names.begin(), names.end(), name) - names.begin());
+  };
+  const auto period = [&](const Vector& u) { return u(index("t1")) + u(index("t2")) + u(index("t3")); };
+  const auto at_zero_period = [&](const SpecialPoint& p) {
+    return p.type == SpecialPointType::kTurningPoint && std::abs(period(p.u)) < 1e-3;
+  };
+  ExpectSameDiagram(traced.diagram, mapped.diagram, 1e-9, at_zero_period);
+
+  const Branch* loop = nullptr;
+  for (const Branch& b : mapped.diagram.branches) {
+    if (b.reflected_from >= 0) loop = &b;
+  }
+  ASSERT_NE(loop, nullptr) << mapped.diagram.FullReport();
+  EXPECT_EQ(loop->termination, TerminationReason::kClosedLoop);
+  EXPECT_EQ(loop->symmetry, "mirror");
+  const Symmetry mirror = TimeBasedShooting(MakeSlip(), IntegratorOptions{}).symmetries().front();
+  ASSERT_EQ(mirror.name, "mirror");
+  std::vector<const SpecialPoint*> pair;
+  for (const SpecialPoint& p : loop->special_points) {
+    if (at_zero_period(p)) pair.push_back(&p);
+  }
+  ASSERT_EQ(pair.size(), 2u) << loop->FullReport(names);
+  EXPECT_EQ(mirror.Apply(pair[0]->u), pair[1]->u);
+  // Every point of the reflected half is the mirror image of one of the traced half.
+  const int j = loop->reflected_from - 1;
+  for (int i = 1; i <= j; ++i) EXPECT_EQ(loop->points[2 * j + 1 - i].u, mirror.Apply(loop->points[i].u)) << i;
+  EXPECT_EQ(loop->points.back().u, loop->points.front().u);
 }
 
 // With a branch budget the same branches make it in, with or without symmetries.

@@ -39,7 +39,8 @@ auto Fields(const ContinuationPoint& p) {
 }
 auto Fields(const Branch& b) {
   return std::tie(b.id, b.direction, b.parent_special_point, b.depth, b.termination, b.message,
-                  b.newton_iterations, b.rejected_steps, b.located_iterations, b.image_of, b.symmetry);
+                  b.newton_iterations, b.rejected_steps, b.located_iterations, b.image_of, b.symmetry,
+                  b.reflected_from);
 }
 auto Fields(const SwitchRecord& r) { return std::tie(r.special_point, r.traced, r.skipped, r.result.status); }
 
@@ -138,6 +139,9 @@ TEST(ExplorationThreads, AlgebraicDiagramsAreTheSerialOnes) {
   ExpectSameOnThreads<testing::SymmetricPitchfork>(Eigen::Vector2d(0, -0.5), options);
   ExpectSameOnThreads<testing::SymmetricPitchfork>(Eigen::Vector2d(0, 0), options);
   ExpectSameOnThreads<testing::FalselySymmetricPitchfork>(Eigen::Vector2d(0, -0.5), options);
+  ExplorationOptions loop;  // a loop completed by reflection on a worker
+  loop.continuation.bounds = {{"x", -2, 2}};
+  ExpectSameOnThreads<testing::CircleOnAxis>(Eigen::Vector2d(0.3, 0), loop);
 
   // Two SB points on the line: at the second one both line rays are known, its half-branches skipped.
   ExplorationOptions parabola;

@@ -214,6 +214,9 @@ struct Branch {
   // (zero_problem.h), mapped instead of traced (no Newton iterations of its own); −1 if traced.
   int image_of = -1;
   std::string symmetry;
+  // Exploration: a loop mapped onto itself by `symmetry` with its orientation reversed, traced to its
+  // midpoint; its points from this index on are the images of the earlier ones. −1 if traced throughout.
+  int reflected_from = -1;
 
   std::string BriefReport() const;
   std::string FullReport(const std::vector<std::string>& unknown_names = {}) const;

@@ -42,6 +42,12 @@
 // Mapped branches are exact images (the time-based map is equivariant to the last bit on the built-in
 // models: durations, states and ξ change sign in exact arithmetic), so the diagram is the traced one
 // up to the tracing's own noise; the SLIP's complete diagram costs about half.
+// A half-branch leaving a g-fixed point p0 along τ0 with g τ0 = −τ0 may be a loop that g maps onto itself
+// reversed (the SLIP's closed loop from an SB point of hopping in place). When a special point M located
+// on it is g-fixed with g τ_M = −τ_M (the loop meets the g-fixed family again there), the trace stops
+// and the loop is completed by reflection: g(P_j), ..., g(P_1), then p0, with tangents −g τ, arclength
+// 2 s_M − s, the special points before M mirrored (Branch::reflected_from). One evaluation at g(P_j)
+// checks it as for images; the loop ends kClosedLoop at p0, as the trace would.
 //
 // Tiny example (pitchfork x³ − λx from a regular point of the trivial branch):
 //

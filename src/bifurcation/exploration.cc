@@ -35,6 +35,8 @@ struct HalfBranch {
   int parent = -1;                                        // special point it leaves
   Vector direction;                                       // the ray it leaves `parent` along
   Vector ray_point;                                       // where it starts, once known (symmetries)
+  // Symmetries usable for completing a self-symmetric loop by reflection (TraceHalfBranch); may be null.
+  const std::vector<Symmetry>* symmetries = nullptr;
   bool reserved = false;  // an id is reserved for it, not handed to a worker: expected to be an image
   int id = 0;                                             // branch id it is traced under
   std::vector<const Branch*> known;                       // branches merged before it was traced
@@ -81,15 +83,127 @@ int OnTracedBranch(const ContinuationPoint& p, std::span<const Branch* const> br
 
 std::string KnownBranchMessage(int other) { return "runs along branch " + std::to_string(other) + " (already traced)"; }
 
+// A half-branch leaving a point p0 with g(p0) = p0 along τ0 with g(τ0) = −τ0 may be a loop that g maps
+// onto itself with its orientation reversed (the SLIP's closed loop from an SB point of hopping in place:
+// its second half is the mirror image of the first, traversed backwards). Its midpoint M is g-fixed with
+// g(τ_M) = −τ_M; where M is a located special point (there the loop meets the g-fixed family again, at an
+// SB point), the trace stops and the loop is completed by reflection: after P_0..P_j (M between P_j and
+// P_j+1) come g(P_j), ..., g(P_1) and the start point again, with tangents −g(τ), arclength 2 s_M − s,
+// the special points before M mirrored likewise. It ends as the trace would: kClosedLoop at its start.
+struct Reflection {
+  const Symmetry* g = nullptr;
+  int midpoint = -1;  // index of the special point M in the traced branch
+  double sb_sign = 1;
+};
+
+bool IsFixed(const Symmetry& g, const Vector& u, const Vector& tangent, const ExplorationOptions& options) {
+  return (g.Apply(u) - u).lpNorm<Eigen::Infinity>() <= options.same_point_tolerance * (1 + u.norm()) &&
+         internal::AngleBetween(-g.Apply(tangent).normalized(), tangent.normalized()) <= options.known_branch_angle;
+}
+
+// Whether special point `m` of the branch traced so far is the midpoint of a loop reflected by g, checked
+// by one evaluation at g(P_j), the first reflected point (residual, induced tangent, and the SB test's
+// sign there).
+bool FindReflection(ZeroProblem* problem, const Branch& branch, int m, const Symmetry& g,
+                    const ExplorationOptions& options, Reflection* out) {
+  const SpecialPoint& mid = branch.special_points[m];
+  const int j = mid.index;
+  if (mid.status != LocationStatus::kLocated || mid.tangent.size() == 0 || j < 1 ||
+      j + 2 != static_cast<int>(branch.points.size()) || 2 * j + 2 > options.continuation.max_points ||
+      !IsFixed(g, mid.u, mid.tangent, options)) {
+    return false;
+  }
+  const ContinuationPoint& pj = branch.points[j];
+  const Vector u = g.Apply(pj.u);
+  const Vector reference = -g.Apply(pj.tangent);
+  Vector r, tangent;
+  Matrix dr;
+  double sb_own = 0, sb_reference = 0;
+  internal::BorderedSolver solver;
+  if (!problem->Evaluate(u, &r, &dr).ok || !(r.lpNorm<Eigen::Infinity>() <= 1e-6 * (1 + u.norm())) ||
+      !internal::InducedTangent(&solver, dr, reference, &tangent, &sb_own, &sb_reference) ||
+      internal::AngleBetween(tangent, reference) > options.known_branch_angle) {
+    return false;
+  }
+  out->g = &g;
+  out->midpoint = m;
+  out->sb_sign = (sb_own < 0) == (pj.sb_test < 0) ? 1.0 : -1.0;
+  return true;
+}
+
+void CompleteByReflection(const Reflection& reflection, Branch* branch) {
+  const Symmetry& g = *reflection.g;
+  const SpecialPoint mid = branch->special_points[reflection.midpoint];
+  const int j = mid.index;
+  const double s_mid = mid.arclength;
+  const ContinuationPoint start = branch->points.front();
+  branch->points.resize(j + 1);
+  for (int i = j; i >= 0; --i) {  // g(P_j), ..., g(P_1), then the start point itself
+    const ContinuationPoint& p = branch->points[i];
+    ContinuationPoint q = i == 0 ? start : p;
+    if (i > 0) {
+      q.u = g.Apply(p.u);
+      q.tangent = -g.Apply(p.tangent);
+      q.sb_test = reflection.sb_sign * p.sb_test;
+      q.newton_iterations = 0;
+      q.contraction = 0;
+    }
+    q.arclength = 2 * s_mid - p.arclength;
+    q.step = i == j ? (q.u - branch->points[j].u).norm() : branch->points[i + 1].step;
+    branch->points.push_back(std::move(q));
+  }
+  // Special points within 1e-4 of the chord across M (P_j to g(P_j)) count as at M (the loop's turning point in every
+  // g-invariant component lies exactly there, located next to the SB point to the noise of that
+  // singular place): kept, and their own images.
+  std::vector<SpecialPoint> kept, mirrored;
+  const double at_mid = 1e-4 * (branch->points[j + 1].arclength - branch->points[j].arclength);
+  for (const SpecialPoint& sp : branch->special_points) {
+    if (sp.arclength > s_mid + at_mid) continue;  // beyond M: replaced by the mirror images below
+    kept.push_back(sp);
+    if (sp.arclength >= s_mid - at_mid) continue;  // at M
+    SpecialPoint q = sp;
+    q.index = 2 * j - sp.index;
+    q.arclength = 2 * s_mid - sp.arclength;
+    q.interval_lo = 2 * s_mid - sp.interval_hi;
+    q.interval_hi = 2 * s_mid - sp.interval_lo;
+    q.u = g.Apply(sp.u);
+    q.tangent = -g.Apply(sp.tangent);
+    q.tangent_before = -g.Apply(sp.tangent_after);
+    q.tangent_after = -g.Apply(sp.tangent_before);
+    q.test_value *= sp.type == SpecialPointType::kTurningPoint ? -g.signs(sp.component_index) : reflection.sb_sign;
+    mirrored.push_back(std::move(q));
+  }
+  std::reverse(mirrored.begin(), mirrored.end());
+  kept.insert(kept.end(), std::make_move_iterator(mirrored.begin()), std::make_move_iterator(mirrored.end()));
+  for (size_t i = 0; i < kept.size(); ++i) kept[i].id = static_cast<int>(i);
+  branch->special_points = std::move(kept);
+  branch->termination = TerminationReason::kClosedLoop;
+  branch->message = "the branch returned to its start point (its second half is the image of the first under " +
+                    g.name + ")";
+  branch->symmetry = g.name;
+  branch->reflected_from = j + 1;
+}
+
 // Traces `half` on `problem`, ending it with kKnownBranch where one of its first points lies on a known
-// branch. `concurrent`: buffers progress and keeps checkpoints for the merge.
+// branch, and completing a self-symmetric loop by reflection. `concurrent`: buffers progress and keeps
+// checkpoints for the merge (progress is buffered for a possible loop too: its reports past the midpoint
+// are replaced by those of the reflected points).
 void TraceHalfBranch(ZeroProblem* problem, const ExplorationOptions& exploration, bool concurrent, HalfBranch* half) {
+  std::vector<const Symmetry*> reversing;
+  if (half->symmetries != nullptr && half->ray_point.size() > 0) {
+    for (const Symmetry& g : *half->symmetries) {
+      if (IsFixed(g, half->ray_point, half->direction, exploration)) reversing.push_back(&g);
+    }
+  }
   ContinuationOptions options = half->options;
-  if (concurrent && options.progress) {
+  const bool buffer = concurrent || !reversing.empty();
+  if (buffer && options.progress) {
     options.progress = [half](const ProgressInfo& info) { half->progress.push_back(info); };
   }
   ContinuationStepper stepper(problem, options, half->id);
   StepStatus status = half->start(&stepper);
+  Reflection reflection;
+  size_t checked = 0;  // special points looked at as midpoints
   while (status == StepStatus::kContinuing && !half->cancelled.load(std::memory_order_relaxed)) {
     status = stepper.Step();
     const auto& points = stepper.branch().points;
@@ -102,8 +216,32 @@ void TraceHalfBranch(ZeroProblem* problem, const ExplorationOptions& exploration
         half->checkpoints.push_back(stepper.branch());
       }
     }
+    for (const auto& specials = stepper.branch().special_points;
+         status == StepStatus::kContinuing && checked < specials.size(); ++checked) {
+      for (const Symmetry* g : reversing) {
+        if (FindReflection(problem, stepper.branch(), static_cast<int>(checked), *g, exploration, &reflection)) {
+          stepper.Terminate(TerminationReason::kClosedLoop, "");
+          status = StepStatus::kFinished;
+          break;
+        }
+      }
+    }
   }
   half->branch = stepper.TakeBranch();
+  if (reflection.g != nullptr) {
+    CompleteByReflection(reflection, &half->branch);
+    if (options.progress) {
+      const Branch& b = half->branch;
+      const int j = b.reflected_from - 1;
+      half->progress.resize(std::min(half->progress.size(), static_cast<size_t>(j + 1)));
+      const std::vector<int> indices = internal::ProgressIndices(half->options, *problem);
+      for (size_t i = j + 1; i < b.points.size(); ++i) {
+        const double next_step = i + 1 < b.points.size() ? b.points[i + 1].step : b.points[i].step;
+        half->progress.push_back(
+            internal::PointProgress(b.points[i], b.id, static_cast<int>(i), indices, next_step, b.rejected_steps));
+      }
+    }
+  }
 }
 
 // Worker threads, each with a clone of the problem, tracing submitted half-branches in submission order;
@@ -238,6 +376,7 @@ class Explorer {
       }
     }
     stops_ = internal::LinearStops(options_.continuation, *problem_);
+    reflecting_ = symmetries_;
     progress_indices_ = internal::ProgressIndices(options_.continuation, *problem_);
   }
 
@@ -347,6 +486,7 @@ class Explorer {
     half->parent = id;
     half->direction = direction;
     half->ray_point = diagram_.special_points[id].u;
+    half->symmetries = &reflecting_;
     half->start = [u = diagram_.special_points[id].u, direction](ContinuationStepper* stepper) {
       return stepper->StartAtSingularPoint(u, direction);
     };
@@ -782,6 +922,7 @@ class Explorer {
   std::unique_ptr<TracingPool> pool_;         // null: serial (destroyed before groups_: joins first)
   ZeroProblem* evaluator_ = nullptr;          // evaluations on this thread: problem_, or the pool's clone
   std::vector<Symmetry> symmetries_;          // those used (exploration.h, "Symmetries")
+  std::vector<Symmetry> reflecting_;          // for self-symmetric loops; fixed: workers read it
   std::vector<internal::LinearStop> stops_;   // ContinuationOptions' linear stops, for image messages
   std::vector<int> progress_indices_;         // ContinuationOptions::progress_components
 };

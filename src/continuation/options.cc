@@ -122,6 +122,7 @@ std::string Branch::BriefReport() const {
       << " special points, " << ToString(termination) << ", " << newton_iterations << " Newton iterations, "
       << rejected_steps << " rejected steps";
   if (image_of >= 0) out << ", image of branch " << image_of << " under " << symmetry;
+  if (reflected_from >= 0) out << ", points from " << reflected_from << " on reflected under " << symmetry;
   return out.str();
 }
 
