@@ -280,6 +280,32 @@ TEST(ExplorationSymmetry, ASelfSymmetricLoopIsCompletedByReflection) {
   }
 }
 
+// The special points at the midpoint (the SB point and the turning point in x, τ_x(M) = 0) are kept
+// once whatever the steps: over 400 maximal steps (a reviewer found two that dropped or doubled the
+// turning point, among them 0.02 + 0.2 · 922/3000), the reflected diagram has the traced one's special points.
+TEST(ExplorationSymmetry, TheMidpointsSpecialPointsDoNotDependOnTheSteps) {
+  std::vector<double> steps = {0.02 + 0.2 * 922 / 3000.0, 0.09985, 0.050697032478347948};
+  for (int i = 0; i < 400; ++i) steps.push_back(0.02 + 0.2 * i / 400.0);
+  for (const double h : steps) {
+    SCOPED_TRACE(h);
+    ExplorationOptions options;
+    options.continuation.bounds = {{"x", -2, 2}};
+    options.continuation.turning_point_components = {"x", "lambda"};
+    options.continuation.max_step = h;
+    options.continuation.initial_step = std::min(h, 0.05);
+    testing::CircleOnAxis problem;
+    const BifurcationDiagram reflected = Explore(&problem, Eigen::Vector2d(0.3, 0), options);
+    options.use_symmetries = false;
+    const BifurcationDiagram traced = Explore(&problem, Eigen::Vector2d(0.3, 0), options);
+    ASSERT_EQ(reflected.BriefReport(), traced.BriefReport());
+    ASSERT_EQ(reflected.special_points.size(), traced.special_points.size());
+    for (size_t k = 0; k < traced.special_points.size(); ++k) {
+      EXPECT_EQ(reflected.special_points[k].type, traced.special_points[k].type) << k;
+      EXPECT_LE((reflected.special_points[k].u - traced.special_points[k].u).norm(), 1e-4) << k;
+    }
+  }
+}
+
 // A declaration that holds on one branch only: switching directions are computed, never mapped, and the
 // diagram is the traced one, on any number of threads.
 TEST(ExplorationSymmetry, ADeclarationTrueOnOneBranchOnlyChangesNothing) {

@@ -108,21 +108,34 @@ bool FindReflection(ZeroProblem* problem, const Branch& branch, int m, const Sym
                     const ExplorationOptions& options, Reflection* out) {
   const SpecialPoint& mid = branch.special_points[m];
   const int j = mid.index;
-  if (mid.status != LocationStatus::kLocated || mid.tangent.size() == 0 || j < 1 ||
-      j + 2 != static_cast<int>(branch.points.size()) || 2 * j + 2 > options.continuation.max_points ||
-      !IsFixed(g, mid.u, mid.tangent, options)) {
+  // M beyond the points the known-branch check looks at (a concurrent merge may still end the branch at
+  // one of those, with the reports of its traced points), and within max_points once reflected.
+  if (mid.status != LocationStatus::kLocated || mid.tangent.size() == 0 ||
+      j < options.known_branch_check_points || j + 2 != static_cast<int>(branch.points.size()) ||
+      2 * j + 2 > options.continuation.max_points || !IsFixed(g, mid.u, mid.tangent, options)) {
     return false;
   }
   const ContinuationPoint& pj = branch.points[j];
+  const ContinuationPoint& next = branch.points[j + 1];  // traced past M
   const Vector u = g.Apply(pj.u);
-  const Vector reference = -g.Apply(pj.tangent);
+  // g(P_j) lies on the curve at arclength 2 s_M − s_j; where that is within the traced step past M, it
+  // must lie on that step's chord within the chord sag (the check of the reflection itself; a residual
+  // alone only checks the equivariance of r).
+  const double s_image = 2 * mid.arclength - pj.arclength;
+  if (s_image <= next.arclength) {
+    const Vector chord = next.u - pj.u;
+    const double t = chord.dot(u - pj.u) / chord.squaredNorm();
+    const double sag = chord.norm() * (internal::AngleBetween(pj.tangent, next.tangent) / 4 + 1e-3);
+    if (!(t >= 0 && t <= 1 && (pj.u + t * chord - u).norm() <= sag + options.known_branch_tolerance * (1 + u.norm()))) {
+      return false;
+    }
+  }
   Vector r, tangent;
   Matrix dr;
   double sb_own = 0, sb_reference = 0;
   internal::BorderedSolver solver;
   if (!problem->Evaluate(u, &r, &dr).ok || !(r.lpNorm<Eigen::Infinity>() <= 1e-6 * (1 + u.norm())) ||
-      !internal::InducedTangent(&solver, dr, reference, &tangent, &sb_own, &sb_reference) ||
-      internal::AngleBetween(tangent, reference) > options.known_branch_angle) {
+      !internal::InducedTangent(&solver, dr, -g.Apply(pj.tangent), &tangent, &sb_own, &sb_reference)) {
     return false;
   }
   out->g = &g;
@@ -152,15 +165,26 @@ void CompleteByReflection(const Reflection& reflection, Branch* branch) {
     q.step = i == j ? (q.u - branch->points[j].u).norm() : branch->points[i + 1].step;
     branch->points.push_back(std::move(q));
   }
-  // Special points within 1e-4 of the chord across M (P_j to g(P_j)) count as at M (the loop's turning point in every
-  // g-invariant component lies exactly there, located next to the SB point to the noise of that
-  // singular place): kept, and their own images.
+  // At M: the SB point there, and the turning point that every g-invariant component has there
+  // (τ_k(M) = −τ_k(M)), located next to the SB point only to the noise of that singular place — on
+  // either side, even in the segment before P_j (the tangent stored at P_j, next to the SB point, may
+  // have that component's sign wrong): special points of those kinds in the last two segments closer to
+  // the fixed set of g than P_{j−1}. Kept once, their own images. Others past M are the images of ones
+  // before it.
+  const Vector& before = branch->points[j - 1].u;
+  const double fixed_distance = (before - g.Apply(before)).norm();
+  const auto at_mid = [&](const SpecialPoint& sp) {
+    if (sp.type == SpecialPointType::kTurningPoint && g.signs(sp.component_index) < 0) return false;
+    return sp.index >= j - 1 && (sp.u - g.Apply(sp.u)).norm() <= fixed_distance;
+  };
   std::vector<SpecialPoint> kept, mirrored;
-  const double at_mid = 1e-4 * (branch->points[j + 1].arclength - branch->points[j].arclength);
   for (const SpecialPoint& sp : branch->special_points) {
-    if (sp.arclength > s_mid + at_mid) continue;  // beyond M: replaced by the mirror images below
+    if (at_mid(sp)) {
+      kept.push_back(sp);
+      continue;
+    }
+    if (sp.arclength > s_mid) continue;  // beyond M: replaced by the mirror images below
     kept.push_back(sp);
-    if (sp.arclength >= s_mid - at_mid) continue;  // at M
     SpecialPoint q = sp;
     q.index = 2 * j - sp.index;
     q.arclength = 2 * s_mid - sp.arclength;
@@ -173,8 +197,9 @@ void CompleteByReflection(const Reflection& reflection, Branch* branch) {
     q.test_value *= sp.type == SpecialPointType::kTurningPoint ? -g.signs(sp.component_index) : reflection.sb_sign;
     mirrored.push_back(std::move(q));
   }
-  std::reverse(mirrored.begin(), mirrored.end());
   kept.insert(kept.end(), std::make_move_iterator(mirrored.begin()), std::make_move_iterator(mirrored.end()));
+  std::stable_sort(kept.begin(), kept.end(),
+                   [](const SpecialPoint& a, const SpecialPoint& b) { return a.arclength < b.arclength; });
   for (size_t i = 0; i < kept.size(); ++i) kept[i].id = static_cast<int>(i);
   branch->special_points = std::move(kept);
   branch->termination = TerminationReason::kClosedLoop;
@@ -911,6 +936,9 @@ class Explorer {
 
   ZeroProblem* problem_;
   ExplorationOptions options_;
+  // For self-symmetric loops; fixed after construction. Workers read it: declared before pool_, so that
+  // it outlives the workers (pool_ joins them when destroyed), also when an exception leaves Explore.
+  std::vector<Symmetry> reflecting_;
   BifurcationDiagram diagram_;
   std::deque<Branch> branches_;     // merged branches, id == index; elements never move (workers read them)
   std::vector<int> depth_;          // per unique special point: depth of the branch it was found on
@@ -922,7 +950,6 @@ class Explorer {
   std::unique_ptr<TracingPool> pool_;         // null: serial (destroyed before groups_: joins first)
   ZeroProblem* evaluator_ = nullptr;          // evaluations on this thread: problem_, or the pool's clone
   std::vector<Symmetry> symmetries_;          // those used (exploration.h, "Symmetries")
-  std::vector<Symmetry> reflecting_;          // for self-symmetric loops; fixed: workers read it
   std::vector<internal::LinearStop> stops_;   // ContinuationOptions' linear stops, for image messages
   std::vector<int> progress_indices_;         // ContinuationOptions::progress_components
 };
