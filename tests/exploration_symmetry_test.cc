@@ -90,6 +90,19 @@ class TwoCircles : public ZeroProblem {
   std::vector<Symmetry> symmetries() const override { return {{"lambda-flip", Eigen::Vector2d(1, -1)}}; }
 };
 
+// The diagram from u0 with the problem's symmetries and without (every half-branch traced).
+struct TwoRuns {
+  BifurcationDiagram mapped, traced;
+};
+TwoRuns ExploreWithAndWithout(ZeroProblem* problem, const Vector& u0, ExplorationOptions options) {
+  TwoRuns runs;
+  options.use_symmetries = true;
+  runs.mapped = Explore(problem, u0, options);
+  options.use_symmetries = false;
+  runs.traced = Explore(problem, u0, options);
+  return runs;
+}
+
 int Images(const BifurcationDiagram& d) {
   int images = 0;
   for (const Branch& b : d.branches) images += b.image_of >= 0;
@@ -195,9 +208,9 @@ TEST(ExplorationSymmetry, BranchesCrossingAtSmallAnglesAreNotImages) {
     options.continuation.bounds = {{"lambda", -40, 40}, {"x", -0.05, 3}};
     options.threads = 1;
     NarrowCrossing problem(m);
-    const BifurcationDiagram mapped = Explore(&problem, Eigen::Vector2d(1, 1 + m), options);
-    options.use_symmetries = false;
-    const BifurcationDiagram traced = Explore(&problem, Eigen::Vector2d(1, 1 + m), options);
+    const TwoRuns runs = ExploreWithAndWithout(&problem, Eigen::Vector2d(1, 1 + m), options);
+    const BifurcationDiagram& mapped = runs.mapped;
+    const BifurcationDiagram& traced = runs.traced;
     ExpectSameDiagram(traced, mapped, 1e-9);
     EXPECT_EQ(Images(mapped), 0) << mapped.FullReport();
   }
@@ -207,9 +220,9 @@ TEST(ExplorationSymmetry, BranchesCrossingAtSmallAnglesAreNotImages) {
     options.continuation.bounds = {{"lambda", -40, 40}, {"x", -10, 10}};
     options.threads = 1;
     NarrowCrossing problem(m);
-    const BifurcationDiagram mapped = Explore(&problem, Eigen::Vector2d(0, 0.5), options);
-    options.use_symmetries = false;
-    const BifurcationDiagram traced = Explore(&problem, Eigen::Vector2d(0, 0.5), options);
+    const TwoRuns runs = ExploreWithAndWithout(&problem, Eigen::Vector2d(0, 0.5), options);
+    const BifurcationDiagram& mapped = runs.mapped;
+    const BifurcationDiagram& traced = runs.traced;
     ExpectSameDiagram(traced, mapped, 1e-9);
     EXPECT_GE(Images(mapped), 2) << mapped.FullReport();
     // Images end on the mapped bound: the image of a branch that reached λ = 40 reaches λ = −40.
@@ -250,9 +263,9 @@ TEST(ExplorationSymmetry, ASelfSymmetricLoopIsCompletedByReflection) {
   ExplorationOptions options;
   options.continuation.bounds = {{"x", -2, 2}};
   testing::CircleOnAxis problem;
-  const BifurcationDiagram reflected = Explore(&problem, Eigen::Vector2d(0.3, 0), options);
-  options.use_symmetries = false;
-  const BifurcationDiagram traced = Explore(&problem, Eigen::Vector2d(0.3, 0), options);
+  const TwoRuns runs = ExploreWithAndWithout(&problem, Eigen::Vector2d(0.3, 0), options);
+  const BifurcationDiagram& reflected = runs.mapped;
+  const BifurcationDiagram& traced = runs.traced;
   ExpectSameDiagram(traced, reflected, 1e-9);
   const Branch* loop = nullptr;
   for (const Branch& b : reflected.branches) {
@@ -294,9 +307,9 @@ TEST(ExplorationSymmetry, TheMidpointsSpecialPointsDoNotDependOnTheSteps) {
     options.continuation.max_step = h;
     options.continuation.initial_step = std::min(h, 0.05);
     testing::CircleOnAxis problem;
-    const BifurcationDiagram reflected = Explore(&problem, Eigen::Vector2d(0.3, 0), options);
-    options.use_symmetries = false;
-    const BifurcationDiagram traced = Explore(&problem, Eigen::Vector2d(0.3, 0), options);
+    const TwoRuns runs = ExploreWithAndWithout(&problem, Eigen::Vector2d(0.3, 0), options);
+    const BifurcationDiagram& reflected = runs.mapped;
+    const BifurcationDiagram& traced = runs.traced;
     ASSERT_EQ(reflected.BriefReport(), traced.BriefReport());
     ASSERT_EQ(reflected.special_points.size(), traced.special_points.size());
     for (size_t k = 0; k < traced.special_points.size(); ++k) {
