@@ -135,9 +135,14 @@ CorrectorResult Segment::CorrectFrom(const Vector& predictor, double max_distanc
   if (with_sb_test_) corrector_->set_accept_on_error_estimate(false);
   // and the exact Jacobian: the SB test function is taken from it
   const JacobianToleranceScope exact(problem_, with_sb_test_ ? 0.0 : -1.0, JacobianToleranceScope::Mode::kExactly);
+  // dr at the predictor as exact as the later ones: once the bracket is small the interpolant lies on
+  // the curve to the rounding level, and the corrector then accepts it after one evaluation
+  // (CorrectorOptions::kOnCurveStep) instead of evaluating again one rounding error away.
+  corrector_->set_predictor_jacobian_tolerance(0.0);
   const CorrectorResult result = corrector_->CorrectPseudoArclength(predictor, a_.tangent, &probe->u);
   corrector_->set_max_distance(saved.max_distance);
   corrector_->set_accept_on_error_estimate(saved.accept_on_error_estimate);
+  corrector_->set_predictor_jacobian_tolerance(saved.predictor_jacobian_tolerance);
   return result;
 }
 

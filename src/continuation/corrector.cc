@@ -172,6 +172,8 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
   CorrectorResult result;
   double last_step = 0, previous_step = 0, before_previous_step = 0, previous_residual = 0;
   w.sparse = problem_->prefers_sparse_jacobian();
+  // Whether dr at the predictor is as exact as the later ones (CorrectorOptions::kOnCurveStep).
+  const bool exact_at_predictor = !(options_.predictor_jacobian_tolerance > problem_->jacobian_tolerance());
   for (int k = 0;; ++k) {
     const EvaluationStatus evaluation = [&] {
       // The predictor's dr only steers the first step (CorrectorOptions::predictor_jacobian_tolerance);
@@ -277,7 +279,10 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
                        std::to_string(options_.max_distance) + " around the predictor";
       return result;
     }
-    if (options_.accept_on_error_estimate && k >= 1 && AcceptNewtonStep(before_previous_step, previous_step, last_step, u)) {
+    const bool on_curve = k == 0 && exact_at_predictor && result.residual_norm <= options_.residual_tolerance &&
+                          last_step <= CorrectorOptions::kOnCurveStep * (1.0 + u.norm());
+    if (on_curve ||
+        (options_.accept_on_error_estimate && k >= 1 && AcceptNewtonStep(before_previous_step, previous_step, last_step, u))) {
       // u_{k+1} = u_k + Δ_k is returned without evaluating r there: its error is estimated by θ_k·|Δ_k|
       // (AcceptNewtonStep). jacobian() stays the one at u_k, |Δ_k| away.
       result.distance = (u - u_pred).norm();
