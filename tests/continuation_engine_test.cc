@@ -70,6 +70,40 @@ TEST(CorrectorTest, AcceptsTheNewtonStepOnItsErrorEstimate) {
   EXPECT_NEAR(v(0), x, 2e-16);
 }
 
+// A predictor on the curve to the rounding level costs one evaluation when dr there is exact (the root
+// finders' trial points): (0.6, 0.8) is on the unit circle to within one rounding error.
+TEST(CorrectorTest, AcceptsAPredictorOnTheCurveAfterOneExactEvaluation) {
+  Circle circle;
+  CorrectorOptions exact;
+  exact.accept_on_error_estimate = false;  // as for SB trial points: plain Newton otherwise
+  exact.predictor_jacobian_tolerance = 0;
+  Corrector corrector(&circle, exact);
+  Vector u;
+  CorrectorResult result = corrector.CorrectPseudoArclength(Eigen::Vector2d(0.6, 0.8), Eigen::Vector2d(-0.8, 0.6), &u);
+  ASSERT_TRUE(result.converged()) << result.BriefReport();
+  EXPECT_EQ(result.evaluations, 1);
+  EXPECT_EQ(result.iterations, 1);
+  EXPECT_NEAR(u(0), 0.6, 1e-16);
+  EXPECT_NEAR(u(1), 0.8, 1e-16);
+  EXPECT_NEAR(corrector.jacobian()(0, 0), 1.2, 1e-15);
+
+  // dr at the predictor loosened by predictor_jacobian_tolerance (the problem's own is 0 here): the point
+  // is evaluated once more.
+  exact.predictor_jacobian_tolerance = 1e-2;
+  Corrector loosened(&circle, exact);
+  result = loosened.CorrectPseudoArclength(Eigen::Vector2d(0.6, 0.8), Eigen::Vector2d(-0.8, 0.6), &u);
+  ASSERT_TRUE(result.converged()) << result.BriefReport();
+  EXPECT_EQ(result.evaluations, 2);
+
+  // 1e-12 off the curve: the first step (~1e-12) is above kOnCurveStep·(1 + ||u||) = 2e-13, so Newton goes on.
+  exact.predictor_jacobian_tolerance = 0;
+  Corrector off(&circle, exact);
+  result = off.CorrectPseudoArclength(Eigen::Vector2d(0.6 * (1 + 1e-12), 0.8 * (1 + 1e-12)), Eigen::Vector2d(-0.8, 0.6), &u);
+  ASSERT_TRUE(result.converged()) << result.BriefReport();
+  EXPECT_EQ(result.evaluations, 2);
+  EXPECT_NEAR(u.norm(), 1.0, 1e-15);
+}
+
 // r = x + 1e5x² + 1e7x³ (λ free, pinned by the border): Newton from x₀ = −5e-3 lands exactly on the root
 // (r(x) = x r'(x) there), so from 3e-8 beside it the first step lands 6e-8 from the root by chance:
 // θ₁ = 1.2e-5 and θ₁|Δ₁| = 7e-13 promise convergence, yet u₁ + Δ₁ is 3.6e-10 off (the contraction is a
