@@ -3,6 +3,7 @@
 
 #include <Eigen/QR>
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cmath>
 #include <utility>
@@ -86,6 +87,7 @@ bool Segment::Evaluate(double sigma, const Probe& left, double sigma_left, const
     result = correct(ReliableTangent(left, sigma_left), ReliableTangent(right, sigma_right), &predictor);
   }
   probe->noise_limited = false;
+  probe->singular_at_trial = result.status == CorrectorStatus::kSingular && result.iterations == 0;
   if (with_sb_test_ && result.converged() &&
       result.predictor_residual_norm <= corrector_->options().residual_tolerance &&
       result.distance > kResolvedFraction * w) {
@@ -106,11 +108,12 @@ bool Segment::Evaluate(double sigma, const Probe& left, double sigma_left, const
     // Newton amplifies the residual noise of a shooting map (~1e-12) along the second kernel direction.
     // When the interpolant's residual is already at the corrector's tolerance, the failure says that the
     // curve cannot be resolved on the scale of the bracket: the bracket is as good as the noise allows.
-    Vector r;
-    if (const EvaluationStatus status = problem_->Evaluate(predictor, &r, nullptr);
-        status.ok && r.norm() <= corrector_->options().residual_tolerance) {
+    // The corrector's first evaluation was at the interpolant itself, where the arclength equation holds:
+    // its residual norm is |r| there.
+    if (result.evaluations >= 1 && result.status != CorrectorStatus::kEvaluationFailed &&
+        result.predictor_residual_norm <= corrector_->options().residual_tolerance) {
       probe->noise_limited = true;
-      probe->residual = r.norm();
+      probe->residual = result.predictor_residual_norm;
     }
     return false;
   }
@@ -266,13 +269,19 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
     bool corrected = false, noise_limited = false;
     double scatter = 0;
     const double x0 = x;
-    for (const double trial_point : {x0, x0 + 0.5 * tolerance, x0 - 0.5 * tolerance, 0.5 * (lo + x0), 0.5 * (x0 + hi)}) {
-      const double trial = std::clamp(trial_point, lo + margin, hi - margin);
+    bool retry_nearby = false;
+    const std::array<double, 5> trials = {x0, x0 + 0.5 * tolerance, x0 - 0.5 * tolerance, 0.5 * (lo + x0), 0.5 * (x0 + hi)};
+    for (size_t attempt = 0; attempt < trials.size(); ++attempt) {
+      // The retries half a tolerance away only for a trial exactly on the root: any other failure recurs
+      // a rounding error away (SLIP: ~2 wasted evaluations per noise-limited iteration).
+      if ((attempt == 1 || attempt == 2) && !retry_nearby) continue;
+      const double trial = std::clamp(trials[attempt], lo + margin, hi - margin);
       if (segment->Evaluate(trial, lo_probe, lo, hi_probe, hi, &probe, &message)) {
         x = trial;
         corrected = true;
         break;
       }
+      if (attempt == 0) retry_nearby = probe.singular_at_trial;
       noise_limited = noise_limited || probe.noise_limited;
       if (probe.noise_limited) scatter = std::max(scatter, probe.scatter);
     }

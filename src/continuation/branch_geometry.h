@@ -53,6 +53,10 @@ class Segment {
     // For a noise-limited trial that Newton did correct: how far it moved (the scatter of points that
     // the corrector accepts there, against which the bracket cannot be resolved).
     double scatter = 0;
+    // Set when Evaluate fails because the bordered matrix is singular at the trial point itself (before
+    // any Newton step): a point exactly on a root of the SB test. Any other failure happens on the way
+    // from the interpolant and recurs for trial points a rounding error away.
+    bool singular_at_trial = false;
   };
   // Absolute part of the largest accepted correction of a trial point, · (1 + ||u||).
   static constexpr double kDistanceFloor = 1e-12;
