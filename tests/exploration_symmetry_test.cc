@@ -403,6 +403,14 @@ TEST(ExplorationSymmetry, SlipDiagramIsTheTracedOneAtLessWork) {
     return p.type == SpecialPointType::kTurningPoint && std::abs(period(p.u)) < 1e-3;
   };
   ExpectSameDiagram(traced.diagram, mapped.diagram, 1e-9, at_zero_period);
+  // Every SB point located (issue 6): the one in the cluster of nearly tangent crossings near H̄ ≈ 1.6115
+  // on the four images of one branch stayed bracketed while the SB interpolant extrapolated from nodes
+  // scattered by the noise (Segment::kMaxLebesgue).
+  for (const SpecialPoint& p : mapped.diagram.special_points) {
+    if (p.type == SpecialPointType::kSimpleBifurcation) {
+      EXPECT_EQ(p.status, LocationStatus::kLocated) << p.BriefReport(names);
+    }
+  }
 
   const Branch* loop = nullptr;
   for (const Branch& b : mapped.diagram.branches) {

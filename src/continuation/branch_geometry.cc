@@ -80,8 +80,7 @@ bool Segment::Evaluate(double sigma, const Probe& left, double sigma_left, const
   };
   Vector predictor;
   CorrectorResult result;
-  if (with_sb_test_ && nodes_.size() >= 4) {
-    predictor = InterpolateNodes(sigma);
+  if (with_sb_test_ && nodes_.size() >= kNodes && InterpolateNodes(sigma, &predictor)) {
     result = CorrectFrom(predictor, 0.25 * w, probe);
   } else {
     result = correct(ReliableTangent(left, sigma_left), ReliableTangent(right, sigma_right), &predictor);
@@ -149,7 +148,7 @@ CorrectorResult Segment::CorrectFrom(const Vector& predictor, double max_distanc
   return result;
 }
 
-Vector Segment::InterpolateNodes(double sigma) const {
+bool Segment::InterpolateNodes(double sigma, Vector* u_out) const {
   // The kNodes corrected points nearest to σ; Lagrange interpolation in σ (on the hyperplane σ exactly:
   // every node lies on its own hyperplane and interpolation reproduces the linear function τ_aᵀ(u − u_a)).
   std::vector<const std::pair<double, Vector>*> nearest;
@@ -158,15 +157,25 @@ Vector Segment::InterpolateNodes(double sigma) const {
   std::partial_sort(nearest.begin(), nearest.begin() + count, nearest.end(), [sigma](const auto* x, const auto* y) {
     return std::abs(x->first - sigma) < std::abs(y->first - sigma);
   });
-  Vector u = Vector::Zero(a_.u.size());
+  std::array<double, kNodes> weights{};
+  double lebesgue = 0;
   for (size_t i = 0; i < count; ++i) {
     double weight = 1;
     for (size_t j = 0; j < count; ++j) {
       if (j != i) weight *= (sigma - nearest[j]->first) / (nearest[i]->first - nearest[j]->first);
     }
-    u += weight * nearest[i]->second;
+    weights[i] = weight;
+    lebesgue += std::abs(weight);
   }
-  return u;
+  // The interpolant amplifies the scatter of its nodes (points accepted inside the noise next to the SB
+  // lie ~noise/σ_min off the curve) by Σ|w_i| (the Lebesgue function): clustered nodes, or a trial
+  // outside their span, raise it to 1e2–1e3 and the predictor's residual with it (SLIP: |r| = 5e-5).
+  // Beyond kMaxLebesgue the Hermite interpolant of the bracketing probes is used instead.
+  if (!(lebesgue <= kMaxLebesgue)) return false;
+  Vector& u = *u_out;
+  u = Vector::Zero(a_.u.size());
+  for (size_t i = 0; i < count; ++i) u += weights[i] * nearest[i]->second;
+  return true;
 }
 
 Vector Segment::ReliableTangent(const Probe& probe, double sigma) const {

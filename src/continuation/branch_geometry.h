@@ -83,6 +83,9 @@ class Segment {
   Vector ReliableTangent(const Probe& probe, double sigma) const;
   // Nodes of the interpolant that locates SB points once kNodes corrected points of the segment are known.
   static constexpr size_t kNodes = 4;
+  // Largest noise amplification Σ|w_i| of the nodes' Lagrange weights at which that interpolant is used
+  // (1 at a node, ~1.2–2 between spread nodes).
+  static constexpr double kMaxLebesgue = 4.0;
   // An SB trial point whose interpolant already had a residual at the corrector's tolerance and which
   // Newton moved by more than this fraction of the bracket width is noise, not a correction (Evaluate).
   static constexpr double kResolvedFraction = 1.0 / 16;
@@ -107,7 +110,9 @@ class Segment {
   // interpolated tangents (error ~ width · tangent error) as soon as the bracket is small.
   std::vector<std::pair<double, Vector>> nodes_;
   CorrectorResult CorrectFrom(const Vector& predictor, double max_distance, Probe* probe);
-  Vector InterpolateNodes(double sigma) const;
+  // The Lagrange interpolant at sigma; false (nothing written) when it would amplify the nodes' scatter
+  // by more than kMaxLebesgue.
+  bool InterpolateNodes(double sigma, Vector* u) const;
   Matrix dr_;
   const ContinuationPoint& a_;
   const ContinuationPoint& b_;
