@@ -181,8 +181,10 @@ void AnalyzePhysicalOrbit(const HybridModel& model, TimeBasedShooting& floquet_m
 }
 
 // BP (a further multiplier crosses +1) and PD (one crosses -1) points: sign changes of the Floquet test
-// functions between consecutive physical points of a branch, located on the branch (test_function_root.h).
-// Returns report lines; appends the points to special_points.
+// functions between consecutive physical points of a branch, located on the branch (test_function_root.h),
+// and pairs of crossings inside one step (FindHiddenRootPair: the SLIP's two −1 crossings of hopping in
+// place, 0.036 apart in H̄, are found with steps up to 0.3 instead of only while a step falls between
+// them). Returns report lines; appends the points to special_points.
 constexpr double kStartNoise = 1e-3;
 std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::map<int, std::vector<double>>& bp,
                                 const std::map<int, std::vector<double>>& pd, TimeBasedShooting& map,
@@ -194,19 +196,12 @@ std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::ma
       const auto it = tests->find(b.id);
       if (it == tests->end()) continue;
       const std::vector<double>& values = it->second;
-      for (std::size_t i = 0; i + 1 < values.size() && i + 1 < b.points.size(); ++i) {
-        if (!(values[i] * values[i + 1] < 0.0)) continue;  // NaN (non-physical) compares false
-        // A branch that leaves a bifurcation point starts on it: where a test function vanishes there
-        // (to kStartNoise of its value at the next point), its sign at the start is noise and the
-        // "crossing" is that point itself, reported on the parent branch (SLIP: the branches leaving the
-        // SB at H = 1.24674 reported it again as BPs). A test that is not small there is searched as usual.
-        if (i == 0 && b.parent_special_point >= 0 && std::abs(values[0]) <= kStartNoise * std::abs(values[1])) continue;
-        const auto test = [&, type = std::string(type)](const Vector& u) {
-          const FloquetResult f = ComputeFloquet(map, u);
-          return f.ok() ? (type == "BP" ? f.bp_test : f.pd_test) : std::nan("");
-        };
-        const TestFunctionRoot root =
-            LocateTestFunctionRoot(&map, b.points[i].u, b.points[i + 1].u, test, TestFunctionRootOptions{});
+      const auto test = [&, type = std::string(type)](const Vector& u) {
+        const FloquetResult f = ComputeFloquet(map, u);
+        return f.ok() ? (type == "BP" ? f.bp_test : f.pd_test) : std::nan("");
+      };
+      const auto locate = [&](std::size_t i, const Vector& u_a, const Vector& u_b) {
+        const TestFunctionRoot root = LocateTestFunctionRoot(&map, u_a, u_b, test, TestFunctionRootOptions{});
         nlohmann::json j = {{"id", static_cast<int>(special_points->size())},
                             {"type", type},
                             {"branch", b.id},
@@ -223,6 +218,29 @@ std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::ma
                               root.located ? "located" : "bracketed", root.precision,
                               root.message.empty() ? "" : " " + root.message);
         ++count;
+      };
+      const std::size_t n = std::min(values.size(), b.points.size());
+      for (std::size_t i = 0; i + 1 < n; ++i) {
+        if (values[i] * values[i + 1] < 0.0) {  // NaN (non-physical) compares false
+          // A branch that leaves a bifurcation point starts on it: where a test function vanishes there
+          // (to kStartNoise of its value at the next point), its sign at the start is noise and the
+          // "crossing" is that point itself, reported on the parent branch (SLIP: the branches leaving the
+          // SB at H = 1.24674 reported it again as BPs). A test that is not small there is searched as usual.
+          if (i == 0 && b.parent_special_point >= 0 && std::abs(values[0]) <= kStartNoise * std::abs(values[1])) continue;
+          locate(i, b.points[i].u, b.points[i + 1].u);
+        } else if (i >= 1) {
+          // Two crossings inside one step cancel in the signs: a local minimum of |test| whose parabola
+          // dips through zero is probed (FindHiddenRootPair), and a confirmed pair located on both sides.
+          const HiddenRootPair pair = FindHiddenRootPair(
+              &map, {&b.points[i - 1].u, &b.points[i].u, &b.points[i + 1].u},
+              {b.points[i - 1].arclength, b.points[i].arclength, b.points[i + 1].arclength},
+              {values[i - 1], values[i], values[i + 1]}, test);
+          if (pair.found) {
+            const std::size_t k = i - 1 + static_cast<std::size_t>(pair.segment);
+            locate(k, b.points[k].u, pair.u);
+            locate(k, pair.u, b.points[k + 1].u);
+          }
+        }
       }
     }
   }

@@ -36,5 +36,58 @@ TEST(TestFunctionRoot, NoSignChangeIsReportedNotLocated) {
   EXPECT_NE(root.message.find("no sign change"), std::string::npos);
 }
 
+// Two roots inside one step: g = (y − sin 0.5)² − 0.02² is positive at the samples θ = 0.2, 0.45, 0.75
+// of the unit circle (arclength θ) and negative for |y − sin 0.5| < 0.02, between θ = 0.45 and 0.75. The
+// parabola through the samples dips to −2e-3 near θ = 0.52, the probe there is negative, and the two
+// roots are located on both sides of it.
+TEST(TestFunctionRoot, FindsTwoRootsBetweenSamplesOfOneSign) {
+  testing::Circle circle;
+  const auto at = [](double theta) { return Vector((Vector(2) << std::cos(theta), std::sin(theta)).finished()); };
+  const double center = std::sin(0.5), width = 0.02;
+  const auto test = [&](const Vector& u) { return (u(1) - center) * (u(1) - center) - width * width; };
+  const std::array<double, 3> s = {0.2, 0.45, 0.75};
+  const Vector u0 = at(s[0]), u1 = at(s[1]), u2 = at(s[2]);
+  const std::array<double, 3> g = {test(u0), test(u1), test(u2)};
+  ASSERT_GT(g[0], 0);
+  ASSERT_GT(g[1], 0);
+  ASSERT_GT(g[2], 0);
+  const std::optional<double> dip = ParabolaDipThroughZero(s, g);
+  ASSERT_TRUE(dip.has_value());
+  EXPECT_GT(*dip, s[1]);
+  EXPECT_LT(*dip, s[2]);
+
+  const HiddenRootPair pair = FindHiddenRootPair(&circle, {&u0, &u1, &u2}, s, g, test);
+  ASSERT_TRUE(pair.found);
+  EXPECT_EQ(pair.segment, 1);
+  EXPECT_LT(pair.value, 0);
+  EXPECT_NEAR(pair.u.norm(), 1.0, 1e-12);  // on the curve
+  const TestFunctionRoot low = LocateTestFunctionRoot(&circle, u1, pair.u, test, TestFunctionRootOptions{});
+  const TestFunctionRoot high = LocateTestFunctionRoot(&circle, pair.u, u2, test, TestFunctionRootOptions{});
+  ASSERT_TRUE(low.located) << low.message;
+  ASSERT_TRUE(high.located) << high.message;
+  EXPECT_NEAR(low.u(1), center - width, 1e-11);
+  EXPECT_NEAR(high.u(1), center + width, 1e-11);
+}
+
+// A minimum that stays above zero is not a pair: the parabola's extremum has the samples' sign (offset
+// 5e-3), or it dips (offset 1e-3: the function is not a parabola in θ) and the probe refutes it.
+TEST(TestFunctionRoot, AMinimumAboveZeroIsNoPair) {
+  testing::Circle circle;
+  const auto at = [](double theta) { return Vector((Vector(2) << std::cos(theta), std::sin(theta)).finished()); };
+  const double center = std::sin(0.5);
+  const std::array<double, 3> s = {0.2, 0.45, 0.75};
+  const Vector u0 = at(s[0]), u1 = at(s[1]), u2 = at(s[2]);
+  for (const double offset : {5e-3, 1e-3}) {
+    const auto test = [&](const Vector& u) { return (u(1) - center) * (u(1) - center) + offset; };
+    const std::array<double, 3> g = {test(u0), test(u1), test(u2)};
+    EXPECT_EQ(ParabolaDipThroughZero(s, g).has_value(), offset < 2e-3) << offset;
+    EXPECT_FALSE(FindHiddenRootPair(&circle, {&u0, &u1, &u2}, s, g, test).found) << offset;
+  }
+  // Not a local minimum of |g| (monotone samples): never probed.
+  EXPECT_FALSE(ParabolaDipThroughZero({0.0, 1.0, 2.0}, {3.0, 2.0, 1.0}).has_value());
+  // Samples of both signs: an ordinary sign change, not a hidden pair.
+  EXPECT_FALSE(ParabolaDipThroughZero({0.0, 1.0, 2.0}, {1.0, -0.1, 1.0}).has_value());
+}
+
 }  // namespace
 }  // namespace hybridcont

@@ -12,7 +12,9 @@
 #ifndef HYBRIDCONT_TEST_FUNCTION_ROOT_H_
 #define HYBRIDCONT_TEST_FUNCTION_ROOT_H_
 
+#include <array>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "hybridcont/zero_problem.h"
@@ -40,6 +42,27 @@ struct TestFunctionRoot {
 TestFunctionRoot LocateTestFunctionRoot(ZeroProblem* problem, const Vector& u_a, const Vector& u_b,
                                         const std::function<double(const Vector&)>& test,
                                         const TestFunctionRootOptions& options);
+
+// Two roots between samples: a smooth test function sampled at three consecutive points of a branch
+// with one sign and its smallest |value| in the middle may dip through zero and back between them (two
+// crossings inside one continuation step cancel in the signs: the SLIP's two −1 crossings of hopping in
+// place are 0.036 apart in H̄). The parabola through the samples (in arclength s) predicts the dip; when
+// its extremum has the other sign the test is evaluated on the curve there (one corrector solve on the
+// chord of the sample interval that holds it). A value of the other sign confirms two roots, bracketed
+// by [u_k, probe] and [probe, u_k+1] around it (`segment` = k, 0 or 1).
+struct HiddenRootPair {
+  bool found = false;
+  Vector u;          // the probe on the curve (valid when found)
+  double value = 0;  // the test there
+  int segment = -1;  // the probe lies between samples segment and segment + 1
+};
+// The extremum of the parabola through (s_k, g_k), k = 0, 1, 2, when it has the opposite sign of g_1 and
+// lies strictly between s_0 and s_2; nullopt otherwise (also when the samples are not a local minimum of
+// |g| of one sign).
+std::optional<double> ParabolaDipThroughZero(const std::array<double, 3>& s, const std::array<double, 3>& g);
+HiddenRootPair FindHiddenRootPair(ZeroProblem* problem, const std::array<const Vector*, 3>& u,
+                                  const std::array<double, 3>& s, const std::array<double, 3>& g,
+                                  const std::function<double(const Vector&)>& test);
 
 }  // namespace hybridcont
 

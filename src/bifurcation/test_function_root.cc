@@ -57,4 +57,41 @@ TestFunctionRoot LocateTestFunctionRoot(ZeroProblem* problem, const Vector& u_a,
   return root;
 }
 
+std::optional<double> ParabolaDipThroughZero(const std::array<double, 3>& s, const std::array<double, 3>& g) {
+  const bool one_sign = (g[0] > 0 && g[1] > 0 && g[2] > 0) || (g[0] < 0 && g[1] < 0 && g[2] < 0);
+  if (!one_sign || !(std::abs(g[1]) < std::abs(g[0]) && std::abs(g[1]) <= std::abs(g[2]))) return std::nullopt;
+  if (!(s[0] < s[1] && s[1] < s[2])) return std::nullopt;
+  // Newton's divided differences: p(x) = g0 + d01 (x − s0) + d012 (x − s0)(x − s1).
+  const double d01 = (g[1] - g[0]) / (s[1] - s[0]);
+  const double d12 = (g[2] - g[1]) / (s[2] - s[1]);
+  const double d012 = (d12 - d01) / (s[2] - s[0]);
+  if (d012 == 0) return std::nullopt;
+  const double x = 0.5 * (s[0] + s[1]) - d01 / (2 * d012);  // p'(x) = 0
+  if (!(x > s[0] && x < s[2])) return std::nullopt;
+  const double extremum = g[0] + d01 * (x - s[0]) + d012 * (x - s[0]) * (x - s[1]);
+  if (!(extremum != 0 && std::signbit(extremum) != std::signbit(g[1]))) return std::nullopt;
+  return x;
+}
+
+HiddenRootPair FindHiddenRootPair(ZeroProblem* problem, const std::array<const Vector*, 3>& u,
+                                  const std::array<double, 3>& s, const std::array<double, 3>& g,
+                                  const std::function<double(const Vector&)>& test) {
+  HiddenRootPair pair;
+  const std::optional<double> x = ParabolaDipThroughZero(s, g);
+  if (!x) return pair;
+  const int k = *x < s[1] ? 0 : 1;
+  const Vector chord = *u[k + 1] - *u[k];
+  const double sigma = (*x - s[k]) / (s[k + 1] - s[k]);
+  Corrector corrector(problem);
+  Vector probe;
+  if (!corrector.CorrectPseudoArclength(*u[k] + sigma * chord, chord, &probe).converged()) return pair;
+  const double value = test(probe);
+  if (!(std::isfinite(value) && value != 0 && std::signbit(value) != std::signbit(g[1]))) return pair;
+  pair.found = true;
+  pair.u = std::move(probe);
+  pair.value = value;
+  pair.segment = k;
+  return pair;
+}
+
 }  // namespace hybridcont
