@@ -221,7 +221,8 @@ std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::ma
       };
       const std::size_t n = std::min(values.size(), b.points.size());
       for (std::size_t i = 0; i + 1 < n; ++i) {
-        if (values[i] * values[i + 1] < 0.0) {  // NaN (non-physical) compares false
+        const bool finite = std::isfinite(values[i]) && std::isfinite(values[i + 1]);  // NaN: non-physical
+        if (finite && values[i] != 0 && values[i + 1] != 0 && std::signbit(values[i]) != std::signbit(values[i + 1])) {
           // A branch that leaves a bifurcation point starts on it: where a test function vanishes there
           // (to kStartNoise of its value at the next point), its sign at the start is noise and the
           // "crossing" is that point itself, reported on the parent branch (SLIP: the branches leaving the

@@ -67,9 +67,9 @@ Scenario DefaultScenario(const HybridModel& model) {
     // Steps stay at 0.1. Larger steps cost fewer evaluations (0.2: 1661 instead of 1916) and, since the
     // Floquet pass finds crossing pairs inside one step (FindHiddenRootPair), keep the PD points of
     // hopping in place. But the cluster of nearly tangent crossings near H = 1.6116 (four images of one
-    // branch) is resolved differently from one step to the next above 0.135 (measured: 23 or 31
-    // half-branches, 19 or 23 SB points for max_step in 0.14–0.23), while 0.09–0.135 all give the same 23
-    // half-branches and 23 located SB points.
+    // branch) is resolved differently from one step to the next above 0.135 (measured for max_step in
+    // 0.14–0.23: 23 or 31 half-branches, 17 to 23 SB points), while 0.09–0.135 all give the same 23
+    // half-branches and 21 SB points, all located.
     s.describe = [layout](const Vector& u) {
       const double dx = u(layout.state_offset(1) + 2);  // x2_dx: forward speed in flight
       return std::string(std::abs(dx) < 1e-6 ? "hopping in place" : dx > 0 ? "forward hopping" : "backward hopping");

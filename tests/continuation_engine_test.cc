@@ -495,6 +495,30 @@ TEST(ContinuationTest, SimpleBifurcationOfANoisyMapLocatedToTheNoiseLevel) {
   EXPECT_NEAR(std::abs(sb.tangent(1)), 1.0, 1e-12);
 }
 
+// The same map failing where Newton's corrections of the noise jump off the branch (|x| > 1e-10), as a
+// shooting map may when a jump makes a duration or state leave its domain: a trial point whose first
+// evaluation succeeded at the noise level and whose later one failed is noise-limited too.
+TEST(ContinuationTest, SimpleBifurcationLocatedToTheNoiseLevelWhenTheJumpFailsToEvaluate) {
+  class FailingOffTheAxis : public NoisyTranscritical {
+   public:
+    EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+      if (std::abs(u(0)) > 1e-10) return EvaluationStatus::Failure("x = " + std::to_string(u(0)) + " outside |x| <= 1e-10");
+      return NoisyTranscritical::Evaluate(u, r, dr);
+    }
+  } curve;
+  ContinuationOptions options;
+  options.bounds = {{"lambda", -1, 1}};
+  ContinuationStepper stepper(&curve, options);
+  StepStatus status = stepper.Start(Eigen::Vector2d(0, -0.5), Eigen::Vector2d(0, 1));
+  while (status == StepStatus::kContinuing) status = stepper.Step();
+  const Branch& branch = stepper.branch();
+  ASSERT_EQ(branch.special_points.size(), 1u) << branch.FullReport();
+  const SpecialPoint& sb = branch.special_points[0];
+  EXPECT_EQ(sb.status, LocationStatus::kLocated) << sb.BriefReport();
+  EXPECT_NE(sb.message.find("located to the noise level"), std::string::npos) << sb.BriefReport();
+  EXPECT_LE(sb.u.lpNorm<Eigen::Infinity>(), sb.precision()) << sb.BriefReport();
+}
+
 // Curve x = 0, y = λ² whose bordered matrix has a singular value δ in the x direction and a residual
 // quadratic in the predictor's error e = y − λ²: r₂ = δx + e². Newton's first step overshoots by e²/δ
 // along x and the second one takes it back exactly: |Δ₁| ≈ |Δ₀| although Newton converges in three steps.

@@ -89,5 +89,36 @@ TEST(TestFunctionRoot, AMinimumAboveZeroIsNoPair) {
   EXPECT_FALSE(ParabolaDipThroughZero({0.0, 1.0, 2.0}, {1.0, -0.1, 1.0}).has_value());
 }
 
+// Two curves 0.03 apart, y = x² and y = x² + 0.03; the test (x − 0.3)⁴ + 1e-3 − (y − x²) is positive all
+// along the first and negative on the second near x = 0.3. Samples on the first at x = −0.5, 0.1, 0.5
+// predict a dip at x = 0.3; the chord point there lies 0.04 above the first curve, 0.01 from the second,
+// where Newton went. The probe must stay on the sampled branch: no pair.
+TEST(TestFunctionRoot, AProbeOnANeighbouringBranchConfirmsNoPair) {
+  class TwoParabolas : public ZeroProblem {
+   public:
+    int num_equations() const override { return 1; }
+    std::vector<std::string> unknown_names() const override { return {"x", "y"}; }
+    EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+      const double a = u(1) - u(0) * u(0), b = a - 0.03;
+      if (r) *r = Vector::Constant(1, a * b);
+      if (dr) {
+        dr->resize(1, 2);
+        *dr << -2 * u(0) * (a + b), a + b;
+      }
+      return {};
+    }
+  } curves;
+  const auto test = [](const Vector& u) {
+    return std::pow(u(0) - 0.3, 4) + 1e-3 - (u(1) - u(0) * u(0));
+  };
+  const auto at = [](double x) { return Vector((Vector(2) << x, x * x).finished()); };
+  const std::array<double, 3> s = {-0.5, 0.1, 0.5};
+  const Vector u0 = at(s[0]), u1 = at(s[1]), u2 = at(s[2]);
+  const std::array<double, 3> g = {test(u0), test(u1), test(u2)};
+  ASSERT_TRUE(ParabolaDipThroughZero(s, g).has_value());
+  const HiddenRootPair pair = FindHiddenRootPair(&curves, {&u0, &u1, &u2}, s, g, test);
+  EXPECT_FALSE(pair.found) << "probe (" << pair.u.transpose() << "), test " << pair.value;
+}
+
 }  // namespace
 }  // namespace hybridcont

@@ -102,8 +102,9 @@ struct CorrectorOptions {
   double predictor_jacobian_tolerance = 1e-2;
   // A predictor already on the curve: when the evaluation at it is exact (predictor_jacobian_tolerance
   // does not loosen the problem's own Jacobian tolerance), its residual is below residual_tolerance and
-  // the first Newton step is at the rounding level of u (||Δ₀|| <= kOnCurveStep·(1 + ||u||)), u_0 + Δ₀
-  // is returned with the Jacobian at u_0: the second evaluation would only confirm it. The root finders'
+  // the first Newton step is at the rounding level of u (||Δ₀|| <= kOnCurveStep·(1 + ||u||), and within
+  // max_jacobian_distance), u_0 + Δ₀ is returned with the Jacobian at u_0: the second evaluation would
+  // only confirm it. The root finders'
   // trial points (branch_geometry.h) are often interpolated onto the curve to ~1e-15 once the bracket is
   // small: SLIP exploration, 75 of ~730 location evaluations.
   static constexpr double kOnCurveStep = 1e-13;

@@ -81,10 +81,23 @@ HiddenRootPair FindHiddenRootPair(ZeroProblem* problem, const std::array<const V
   if (!x) return pair;
   const int k = *x < s[1] ? 0 : 1;
   const Vector chord = *u[k + 1] - *u[k];
-  const double sigma = (*x - s[k]) / (s[k + 1] - s[k]);
-  Corrector corrector(problem);
+  // Predictor: the quadratic interpolant of the three samples in s (the chord point lies off a curved
+  // branch by ~|chord|²·curvature); corrected on the hyperplane ⟂ chord through it, within a quarter of
+  // the chord: a probe that Newton takes to a neighbouring branch (whose test may have the other sign)
+  // must not confirm a pair.
+  Vector predictor = Vector::Zero(chord.size());
+  for (int i = 0; i < 3; ++i) {
+    double weight = 1;
+    for (int j = 0; j < 3; ++j) {
+      if (j != i) weight *= (*x - s[j]) / (s[i] - s[j]);
+    }
+    predictor += weight * *u[i];
+  }
+  CorrectorOptions options;
+  options.max_distance = 0.25 * chord.norm();
+  Corrector corrector(problem, options);
   Vector probe;
-  if (!corrector.CorrectPseudoArclength(*u[k] + sigma * chord, chord, &probe).converged()) return pair;
+  if (!corrector.CorrectPseudoArclength(predictor, chord, &probe).converged()) return pair;
   const double value = test(probe);
   if (!(std::isfinite(value) && value != 0 && std::signbit(value) != std::signbit(g[1]))) return pair;
   pair.found = true;

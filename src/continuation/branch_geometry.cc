@@ -108,9 +108,11 @@ bool Segment::Evaluate(double sigma, const Probe& left, double sigma_left, const
     // When the interpolant's residual is already at the corrector's tolerance, the failure says that the
     // curve cannot be resolved on the scale of the bracket: the bracket is as good as the noise allows.
     // The corrector's first evaluation was at the interpolant itself, where the arclength equation holds:
-    // its residual norm is |r| there.
-    if (result.evaluations >= 1 && result.status != CorrectorStatus::kEvaluationFailed &&
-        result.predictor_residual_norm <= corrector_->options().residual_tolerance) {
+    // its residual norm is |r| there (unknown only when that very evaluation failed; a later one failing
+    // on Newton's jump is the noise-limited case too).
+    const bool predictor_evaluated =
+        result.evaluations >= 2 || (result.evaluations == 1 && result.status != CorrectorStatus::kEvaluationFailed);
+    if (predictor_evaluated && result.predictor_residual_norm <= corrector_->options().residual_tolerance) {
       probe->noise_limited = true;
       probe->residual = result.predictor_residual_norm;
     }
@@ -281,8 +283,9 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
     bool retry_nearby = false;
     const std::array<double, 5> trials = {x0, x0 + 0.5 * tolerance, x0 - 0.5 * tolerance, 0.5 * (lo + x0), 0.5 * (x0 + hi)};
     for (size_t attempt = 0; attempt < trials.size(); ++attempt) {
-      // The retries half a tolerance away only for a trial exactly on the root: any other failure recurs
-      // a rounding error away (SLIP: ~2 wasted evaluations per noise-limited iteration).
+      // The retries half a tolerance away only for a trial exactly on the root: any other failure (a jump
+      // along the nearly singular direction, a poor interpolant) recurs half a tolerance away (SLIP: ~2
+      // wasted evaluations per noise-limited iteration).
       if ((attempt == 1 || attempt == 2) && !retry_nearby) continue;
       const double trial = std::clamp(trials[attempt], lo + margin, hi - margin);
       if (segment->Evaluate(trial, lo_probe, lo, hi_probe, hi, &probe, &message)) {

@@ -55,7 +55,7 @@ class Segment {
     double scatter = 0;
     // Set when Evaluate fails because the bordered matrix is singular at the trial point itself (before
     // any Newton step): a point exactly on a root of the SB test. Any other failure happens on the way
-    // from the interpolant and recurs for trial points a rounding error away.
+    // from the interpolant and recurs for trial points half a location tolerance away.
     bool singular_at_trial = false;
   };
   // Absolute part of the largest accepted correction of a trial point, · (1 + ||u||).

@@ -280,7 +280,8 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
       return result;
     }
     const bool on_curve = k == 0 && exact_at_predictor && result.residual_norm <= options_.residual_tolerance &&
-                          last_step <= CorrectorOptions::kOnCurveStep * (1.0 + u.norm());
+                          last_step <= std::min(CorrectorOptions::kOnCurveStep, options_.max_jacobian_distance) *
+                                           (1.0 + u.norm());
     if (on_curve ||
         (options_.accept_on_error_estimate && k >= 1 && AcceptNewtonStep(before_previous_step, previous_step, last_step, u))) {
       // u_{k+1} = u_k + Δ_k is returned without evaluating r there: its error is estimated by θ_k·|Δ_k|
