@@ -471,14 +471,19 @@ class NoisyTranscritical : public ZeroProblem {
 
 // Next to an SB point the bordered matrix is singular for every border, so Newton corrections of the
 // residual noise (1e-12 / distance) leave the bracket: located to the noise level, the bracket honest.
+// The λ axis of a transcritical map from λ = −0.5 to the bound λ = 1.
+Branch TraceTheAxis(ZeroProblem* curve, const ContinuationOptions& options) {
+  ContinuationStepper stepper(curve, options);
+  StepStatus status = stepper.Start(Eigen::Vector2d(0, -0.5), Eigen::Vector2d(0, 1));
+  while (status == StepStatus::kContinuing) status = stepper.Step();
+  return stepper.TakeBranch();
+}
+
 TEST(ContinuationTest, SimpleBifurcationOfANoisyMapLocatedToTheNoiseLevel) {
   NoisyTranscritical curve;
   ContinuationOptions options;
   options.bounds = {{"lambda", -1, 1}};
-  ContinuationStepper stepper(&curve, options);
-  StepStatus status = stepper.Start(Eigen::Vector2d(0, -0.5), Eigen::Vector2d(0, 1));
-  while (status == StepStatus::kContinuing) status = stepper.Step();
-  const Branch& branch = stepper.branch();
+  const Branch branch = TraceTheAxis(&curve, options);
   ASSERT_EQ(branch.termination, TerminationReason::kBoundReached) << branch.FullReport();
   ASSERT_EQ(branch.special_points.size(), 1u) << branch.FullReport();
   const SpecialPoint& sb = branch.special_points[0];
@@ -508,10 +513,7 @@ TEST(ContinuationTest, SimpleBifurcationLocatedToTheNoiseLevelWhenTheJumpFailsTo
   } curve;
   ContinuationOptions options;
   options.bounds = {{"lambda", -1, 1}};
-  ContinuationStepper stepper(&curve, options);
-  StepStatus status = stepper.Start(Eigen::Vector2d(0, -0.5), Eigen::Vector2d(0, 1));
-  while (status == StepStatus::kContinuing) status = stepper.Step();
-  const Branch& branch = stepper.branch();
+  const Branch branch = TraceTheAxis(&curve, options);
   ASSERT_EQ(branch.special_points.size(), 1u) << branch.FullReport();
   const SpecialPoint& sb = branch.special_points[0];
   EXPECT_EQ(sb.status, LocationStatus::kLocated) << sb.BriefReport();
