@@ -32,8 +32,8 @@
 // below its tolerance but the steps stop contracting (the rounding floor, e.g. near a bifurcation point
 // where B is ill-conditioned), the point is accepted as converged — the residual test decides there.
 // At least one Newton step is always taken, so a converged u is never the raw predictor (a predictor on
-// the curve to the rounding level is returned after that one step: CorrectorOptions::kOnCurveStep). From the second
-// step on, u_k is also accepted when Deuflhard's error estimate — the simplified Newton correction
+// the curve to the rounding level is returned after that one step: CorrectorOptions::kOnCurveStep). From
+// the second step on, u_k is also accepted when Deuflhard's error estimate — the simplified Newton correction
 // Δ̄ = −B_{k−1}⁻¹F(u_k) — is below the step tolerance; u_k + Δ̄ is returned (NLEQ-ERR's termination).
 // And after every full Newton step Δ_k from k = 1 on, u_k + Δ_k is returned without evaluating r there
 // when its estimated error θ_k|Δ_k| (θ_k = |Δ_k|/|Δ_{k−1}|) is below the step tolerance
@@ -104,9 +104,8 @@ struct CorrectorOptions {
   // does not loosen the problem's own Jacobian tolerance), its residual is below residual_tolerance and
   // the first Newton step is at the rounding level of u (||Δ₀|| <= kOnCurveStep·(1 + ||u||), and within
   // max_jacobian_distance), u_0 + Δ₀ is returned with the Jacobian at u_0: the second evaluation would
-  // only confirm it. The root finders'
-  // trial points (branch_geometry.h) are often interpolated onto the curve to ~1e-15 once the bracket is
-  // small: SLIP exploration, 75 of ~730 location evaluations.
+  // only confirm it. The root finders' trial points (branch_geometry.h) are often interpolated onto the
+  // curve to ~1e-15 once the bracket is small: SLIP exploration, 75 of ~730 location evaluations.
   static constexpr double kOnCurveStep = 1e-13;
   // A step ratio ||Δ_{k+1}|| / ||Δ_k|| above this, with a residual that did not decrease either, is
   // divergence: Newton inside its basin contracts. (Steps alone may grow once: a first step overshooting
