@@ -280,6 +280,12 @@ class AutoDiffPhase final : public Phase {
     using Gradients = Eigen::Matrix<double, Eigen::Dynamic, N, 0, kMaxPhaseDim, N == Eigen::Dynamic ? kMaxPhaseDim : N>;
     const int n = dim();
     const int k = num_first_integrals();
+    if constexpr (N != Eigen::Dynamic) {
+      if (!need_hessians) {
+        UnfoldedFirstOrder<N>(x, xi, f_tilde, A, B, dissipative);
+        return;
+      }
+    }
     VectorField(x, f_tilde, A);
     // dH (k x n), rows filled from the jets; a row of a constant first integral stays zero.
     Gradients dH = Gradients::Zero(k, n);
@@ -297,6 +303,35 @@ class AutoDiffPhase final : public Phase {
       for (int i = 0; i < n; ++i) (*f_tilde)(i) += dH.col(i).dot(xi);
     }
     if (B) *B = dH.transpose();
+  }
+
+  // The first-order case at a fixed dimension N, the one almost every right-hand side takes (the Hessian
+  // term is left out below the map's Jacobian tolerance): f and H from one seeding, values and derivatives
+  // written straight into f~, A and B. Flattened, so that the compiler sees the model's sin(a), cos(a) in f
+  // and cos(a) in H on the same jet and evaluates them by one sincos (SLIP exploration: 2.99 -> 2.63 G
+  // instructions, sincos calls 215M -> 90M instructions; without flatten the separate VectorField/H calls
+  // made it 1.5x the sincos calls of the generic path and the gain was 1.6%). Same arithmetic, same bits.
+  template <int N>
+  [[gnu::flatten]] void UnfoldedFirstOrder(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
+                                           Vector* f_tilde, Matrix* A, Matrix* B, bool dissipative) const {
+    using J = typename JetTypes<N>::J;
+    const int k = num_first_integrals();
+    const StateVector<J> xj = SeedJets<J>(x);
+    const StateVector<J> fj = F::template VectorField<J>(xj, *p_);
+    const StateVector<J> h = EvaluateFirstIntegrals<F, P, J>(xj, *p_);
+    if (f_tilde->size() != N) f_tilde->resize(N);
+    if (A != nullptr && (A->rows() != N || A->cols() != N)) A->resize(N, N);
+    if (B != nullptr && (B->rows() != N || B->cols() != k)) B->resize(N, k);
+    for (int i = 0; i < N; ++i) {
+      double sum = 0;
+      for (int j = 0; j < k; ++j) {
+        const double gradient = h(j).derivatives()(i);
+        if (dissipative) sum += gradient * xi(j);
+        if (B != nullptr) (*B)(i, j) = gradient;
+      }
+      (*f_tilde)(i) = dissipative ? fj(i).value() + sum : fj(i).value();
+      if (A != nullptr) A->row(i) = fj(i).derivatives().transpose();
+    }
   }
 
   const P* p_;
