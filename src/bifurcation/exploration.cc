@@ -50,6 +50,13 @@ struct HalfBranch {
   std::exception_ptr error;
   std::atomic<bool> cancelled{false};  // its result will not be used: stop tracing
   bool done = false;                   // traced (or cancelled); guarded by the pool's mutex
+  // Concurrent: the depth its branch gets, and the SB points its worker has located so far (guarded by the
+  // pool's mutex; `early_seen` of them looked at by the exploring thread): their switch groups may start
+  // before this half-branch is merged (Explorer::Speculate).
+  int depth = 0;
+  std::function<void(const SpecialPoint&)> publish;
+  std::vector<SpecialPoint> early;
+  size_t early_seen = 0;
 };
 
 // Id of a branch among `branches` that p lies on (within the chord sag of one of its chords, parallel
@@ -228,9 +235,15 @@ void TraceHalfBranch(ZeroProblem* problem, const ExplorationOptions& exploration
   ContinuationStepper stepper(problem, options, half->id);
   StepStatus status = half->start(&stepper);
   Reflection reflection;
-  size_t checked = 0;  // special points looked at as midpoints
+  size_t checked = 0;    // special points looked at as midpoints
+  size_t published = 0;  // special points handed to half->publish
   while (status == StepStatus::kContinuing && !half->cancelled.load(std::memory_order_relaxed)) {
     status = stepper.Step();
+    if (half->publish) {
+      for (const auto& specials = stepper.branch().special_points; published < specials.size(); ++published) {
+        if (specials[published].type == SpecialPointType::kSimpleBifurcation) half->publish(specials[published]);
+      }
+    }
     const auto& points = stepper.branch().points;
     const int index = static_cast<int>(points.size()) - 1;
     if (index >= 1 && index <= exploration.known_branch_check_points && status == StepStatus::kContinuing) {
@@ -311,6 +324,37 @@ class TracingPool {
     work_.notify_one();
   }
 
+  // From a worker: an SB point located on `half` (HalfBranch::early); wakes the exploring thread.
+  void Publish(HalfBranch* half, const SpecialPoint& point) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      half->early.push_back(point);
+      ++events_;
+    }
+    done_.notify_all();
+  }
+
+  // Blocks until `half` is traced (true) or an SB point was published since *seen (false).
+  bool WaitOrEvent(HalfBranch* half, long* seen) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [&] { return half->done || events_ != *seen; });
+    *seen = events_;
+    return half->done;
+  }
+
+  // The SB points `half` published after the first `from`.
+  std::vector<SpecialPoint> Early(HalfBranch* half, size_t from) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (from >= half->early.size()) return {};
+    return std::vector<SpecialPoint>(half->early.begin() + static_cast<long>(from), half->early.end());
+  }
+
+  // No half-branch waits for a worker.
+  bool Idle() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return pending_.empty();
+  }
+
   // Blocks until `half` is traced; rethrows what its tracing threw.
   void Wait(HalfBranch* half) {
     std::unique_lock<std::mutex> lock(mutex_);
@@ -381,6 +425,7 @@ class TracingPool {
   std::condition_variable done_;
   std::deque<HalfBranch*> pending_;
   std::vector<HalfBranch*> running_;  // per worker
+  long events_ = 0;                   // SB points published so far
   bool stop_ = false;
 };
 
@@ -485,36 +530,144 @@ class Explorer {
     auto group = std::make_unique<Group>();
     group->kind = Group::Kind::kSingularStart;
     for (const Vector& line : diagram_.start.directions) {
-      for (const int d : {+1, -1}) group->halves.push_back(FromPoint(id, d * line, d));
+      for (const int d : {+1, -1}) {
+        group->halves.push_back(FromPoint(id, d * line, d));
+        group->halves.back()->depth = 1;
+      }
     }
     return group;
   }
 
   // The group of a queued SB point: the transverse ABE root v gives the half-branches ±v.
   std::unique_ptr<Group> Switch(int id) {
+    if (std::unique_ptr<Group> group = AdoptSpeculative(id)) return group;
+    auto group = SwitchGroup(diagram_.special_points[id], depth_[id] + 1);
+    group->record.special_point = id;
+    for (const auto& half : group->halves) half->parent = id;
+    const BranchSwitch& result = group->record.result;
+    if (!group->halves.empty()) NoteLines(id, {result.direction, result.incoming_direction});
+    return group;
+  }
+
+  // The switch group of an SB point, its half-branches at `depth`, not yet tied to a diagram id.
+  std::unique_ptr<Group> SwitchGroup(const SpecialPoint& point, int depth) {
     auto group = std::make_unique<Group>();
     group->kind = Group::Kind::kSwitch;
-    group->record.special_point = id;
-    group->record.result = SwitchDirectionAt(evaluator_, diagram_.special_points[id], options_.switching);
+    group->record.result = SwitchDirectionAt(evaluator_, point, options_.switching);
     const BranchSwitch& result = group->record.result;
     if (result.status == BranchSwitchStatus::kOk || result.status == BranchSwitchStatus::kFallback) {
-      NoteLines(id, {result.direction, result.incoming_direction});
-      for (const int d : {+1, -1}) group->halves.push_back(FromPoint(id, d * result.direction, d));
+      for (const int d : {+1, -1}) {
+        group->halves.push_back(FromPoint(point.u, d * result.direction, d));
+        group->halves.back()->depth = depth;
+      }
     }
     return group;
   }
 
+  // --- Speculative switch groups (concurrent) ---
+  // A worker publishes every SB point it locates (HalfBranch::early). While the exploring thread waits for
+  // the half-branch it merges next and no half-branch waits for a worker, the switch group of such a point
+  // is launched at once, before the branch it lies on is merged: the SLIP's workers otherwise idled ~9 of
+  // ~106 ms waiting for the children of branch 3. Its switching direction is computed from the very point
+  // the merge will register (the same bits), its half-branches are traced like any launched ahead (checked
+  // at their merge against the branches merged since), and the serial run's decisions stay the merge's:
+  // when the merge queues that point the group is adopted in place of a new one (AdoptSpeculative); when it
+  // does not (a known point, a branch ended earlier at the merge, an image), the group is dropped.
+  struct Speculative {
+    const HalfBranch* source;
+    Vector u;
+    std::unique_ptr<Group> group;
+  };
+
+  void Speculate() {
+    std::vector<HalfBranch*> sources;
+    const auto collect = [&](const Group& group) {
+      for (const auto& half : group.halves) {
+        if (half->with_worker && !half->cancelled) sources.push_back(half.get());
+      }
+    };
+    for (const auto& group : groups_) collect(*group);
+    for (const Speculative& speculative : speculative_) collect(*speculative.group);
+    for (HalfBranch* source : sources) {
+      for (const SpecialPoint& point : pool_->Early(source, source->early_seen)) {
+        if (!pool_->Idle() || BranchBudgetSpent()) return;  // looked at again on the next event
+        ++source->early_seen;
+        if (source->depth >= options_.max_depth || Known(point.u)) continue;
+        std::unique_ptr<Group> group = SwitchGroup(point, source->depth + 1);
+        Submit(group.get());
+        speculative_.push_back({source, point.u, std::move(group)});
+      }
+    }
+  }
+
+  // An SB point registered already, or one a speculative group was launched for.
+  bool Known(const Vector& u) const {
+    const auto same = [&](const Vector& v) {
+      return (u - v).lpNorm<Eigen::Infinity>() <= options_.same_point_tolerance * (1 + v.norm());
+    };
+    return std::any_of(diagram_.special_points.begin(), diagram_.special_points.end(),
+                       [&](const SpecialPoint& p) { return same(p.u); }) ||
+           std::any_of(speculative_.begin(), speculative_.end(), [&](const Speculative& s) { return same(s.u); });
+  }
+
+  std::unique_ptr<Group> AdoptSpeculative(int id) {
+    const SpecialPoint& point = diagram_.special_points[id];
+    const auto it = std::find_if(speculative_.begin(), speculative_.end(),
+                                 [&](const Speculative& s) { return s.u == point.u; });
+    if (it == speculative_.end()) return nullptr;
+    std::unique_ptr<Group> group = std::move(it->group);
+    speculative_.erase(it);
+    group->record.special_point = id;
+    for (const auto& half : group->halves) half->parent = id;
+    const BranchSwitch& result = group->record.result;
+    if (!group->halves.empty()) NoteLines(id, {result.direction, result.incoming_direction});
+    return group;
+  }
+
+  // After `source` was merged (or skipped): its speculative groups whose point was not queued are dropped,
+  // with whatever was launched from their own half-branches.
+  void DropSpeculative(const HalfBranch* source) {
+    const auto queued = [&](const Vector& u) {
+      return std::any_of(queue_.begin(), queue_.end(), [&](int id) { return diagram_.special_points[id].u == u; });
+    };
+    for (size_t i = 0; i < speculative_.size();) {
+      if (speculative_[i].source != source || queued(speculative_[i].u)) {
+        ++i;
+        continue;
+      }
+      std::unique_ptr<Group> group = std::move(speculative_[i].group);
+      speculative_.erase(speculative_.begin() + static_cast<long>(i));
+      for (const auto& half : group->halves) {
+        if (half->reserved) {
+          half->reserved = false;
+          --in_flight_;
+        }
+        if (half->with_worker) {
+          pool_->RequestCancel(half.get());
+          half->with_worker = false;
+          --in_flight_;
+        }
+        DropSpeculative(half.get());
+      }
+      dropped_.push_back(std::move(group));  // kept until the workers are joined
+      i = 0;
+    }
+  }
+
   std::unique_ptr<HalfBranch> FromPoint(int id, const Vector& direction, int d) {
+    auto half = FromPoint(diagram_.special_points[id].u, direction, d);
+    half->parent = id;
+    return half;
+  }
+
+  std::unique_ptr<HalfBranch> FromPoint(const Vector& u, const Vector& direction, int d) {
     auto half = std::make_unique<HalfBranch>();
     half->options = options_.continuation;
     half->d = d;
-    half->parent = id;
     half->direction = direction;
-    half->ray_point = diagram_.special_points[id].u;
+    half->ray_point = u;
     half->symmetries = &reflecting_;
-    half->start = [u = diagram_.special_points[id].u, direction](ContinuationStepper* stepper) {
-      return stepper->StartAtSingularPoint(u, direction);
-    };
+    half->start = [u, direction](ContinuationStepper* stepper) { return stepper->StartAtSingularPoint(u, direction); };
     return half;
   }
 
@@ -522,21 +675,26 @@ class Explorer {
   // each under the branch id it gets if no half-branch before it is skipped, as long as they can still
   // become branches within max_branches (one that is not handed over is traced when its turn comes).
   void Launch(std::unique_ptr<Group> group) {
-    if (pool_) {
-      for (size_t i = 0; i < group->halves.size(); ++i) {
-        HalfBranch* half = group->halves[i].get();
-        if (BranchBudgetSpent()) break;
-        half->id = static_cast<int>(branches_.size()) + in_flight_++;
-        if (ExpectedImage(*half, std::span(group->halves).first(i))) {
-          half->reserved = true;  // mapped at its merge (or traced there if its source does not come)
-          continue;
-        }
-        half->known = MergedBranches();
-        half->with_worker = true;
-        pool_->Submit(half);
-      }
-    }
+    if (pool_) Submit(group.get());
     groups_.push_back(std::move(group));
+  }
+
+  // The group's half-branches not yet launched (an adopted speculative group has them launched already).
+  void Submit(Group* group) {
+    for (size_t i = 0; i < group->halves.size(); ++i) {
+      HalfBranch* half = group->halves[i].get();
+      if (half->with_worker || half->reserved) continue;
+      if (BranchBudgetSpent()) break;
+      half->id = static_cast<int>(branches_.size()) + in_flight_++;
+      if (ExpectedImage(*half, std::span(group->halves).first(i))) {
+        half->reserved = true;  // mapped at its merge (or traced there if its source does not come)
+        continue;
+      }
+      half->known = MergedBranches();
+      half->with_worker = true;
+      half->publish = [pool = pool_.get(), half](const SpecialPoint& point) { pool->Publish(half, point); };
+      pool_->Submit(half);
+    }
   }
 
   bool BranchBudgetSpent() const { return static_cast<int>(branches_.size()) + in_flight_ >= options_.max_branches; }
@@ -592,6 +750,7 @@ class Explorer {
       }
     }
     for (const auto& half : group->halves) {  // skipped ones: their traces are dropped
+      DropSpeculative(half.get());
       if (half->reserved) {
         half->reserved = false;
         --in_flight_;
@@ -632,6 +791,7 @@ class Explorer {
     if (pool_) {
       CancelKnownRays();
       LaunchQueued();  // the SB points just found: their groups can start while this one merges
+      DropSpeculative(half);
     }
   }
 
@@ -659,7 +819,8 @@ class Explorer {
       TraceHalfBranch(evaluator_, options_, false, half);
       return std::move(half->branch);
     }
-    pool_->Wait(half);
+    for (long seen = -1; !pool_->WaitOrEvent(half, &seen);) Speculate();
+    pool_->Wait(half);  // rethrows what its tracing threw
     half->with_worker = false;
     --in_flight_;
     Branch branch = std::move(half->branch);
@@ -946,6 +1107,8 @@ class Explorer {
   std::vector<Ray> rays_;
   std::deque<int> queue_;                     // SB points not yet switched at
   std::deque<std::unique_ptr<Group>> groups_;  // launched, in the serial order, not yet merged
+  std::vector<Speculative> speculative_;       // launched ahead of the merge of their SB point (concurrent)
+  std::vector<std::unique_ptr<Group>> dropped_;  // speculative groups given up, kept until the pool joins
   int in_flight_ = 0;                         // half-branches of groups_ (concurrent)
   std::unique_ptr<TracingPool> pool_;         // null: serial (destroyed before groups_: joins first)
   ZeroProblem* evaluator_ = nullptr;          // evaluations on this thread: problem_, or the pool's clone
