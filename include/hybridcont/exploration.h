@@ -61,6 +61,9 @@
 // sequence of groups of half-branches (the start, then one group per queued SB point, steps 1 and 3);
 // each group is launched as soon as it is known, its switching direction computed at once and its
 // half-branches traced ahead by workers, each on its own clone of the problem, in the serial order.
+// Earlier still: an SB point a worker has located starts its group while the exploring thread waits and
+// no half-branch waits for a worker (speculatively: the merge that queues the point adopts the group, a
+// merge that does not drops it).
 // The exploring thread merges the groups in that order and replays every serial decision on the
 // results: a ray known by then skips a half-branch (its trace is dropped); the closed-loop and
 // max_branches rules likewise; the known-branch check, already made while tracing against the branches
