@@ -593,7 +593,15 @@ class Explorer {
         if (!pool_->Idle() || BranchBudgetSpent()) return;  // looked at again on the next event
         ++source->early_seen;
         if (source->depth >= options_.max_depth || Known(point.u)) continue;
-        std::unique_ptr<Group> group = SwitchGroup(point, source->depth + 1);
+        // The serial run may never switch at this point (a later duplicate, a point its merge cuts off):
+        // an exception of the problem here is not the run's. Switch(id) recomputes, and throws exactly when
+        // the serial run would (an independent review saw 8–12 of 180 concurrent runs throw without this).
+        std::unique_ptr<Group> group;
+        try {
+          group = SwitchGroup(point, source->depth + 1);
+        } catch (...) {
+          continue;
+        }
         Submit(group.get());
         speculative_.push_back({source, point.u, std::move(group)});
       }
