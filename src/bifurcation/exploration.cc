@@ -542,6 +542,11 @@ class Explorer {
   std::unique_ptr<Group> Switch(int id) {
     if (std::unique_ptr<Group> group = AdoptSpeculative(id)) return group;
     auto group = SwitchGroup(diagram_.special_points[id], depth_[id] + 1);
+    return TiedTo(id, std::move(group));
+  }
+
+  // A switch group tied to diagram point `id`: its record, its half-branches' parent, the point's lines.
+  std::unique_ptr<Group> TiedTo(int id, std::unique_ptr<Group> group) {
     group->record.special_point = id;
     for (const auto& half : group->halves) half->parent = id;
     const BranchSwitch& result = group->record.result;
@@ -625,11 +630,7 @@ class Explorer {
     if (it == speculative_.end()) return nullptr;
     std::unique_ptr<Group> group = std::move(it->group);
     speculative_.erase(it);
-    group->record.special_point = id;
-    for (const auto& half : group->halves) half->parent = id;
-    const BranchSwitch& result = group->record.result;
-    if (!group->halves.empty()) NoteLines(id, {result.direction, result.incoming_direction});
-    return group;
+    return TiedTo(id, std::move(group));
   }
 
   // After `source` was merged (or skipped): its speculative groups whose point was not queued are dropped,
