@@ -124,13 +124,14 @@ EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivitie
 namespace {
 
 // Where the Jacobian's blocks go: Add(row, col, block) adds a block (entries of blocks that overlap sum).
-// AddDiagonal(row, col, n, value) adds value·I (n x n). Neither allocates once warm.
+// Add(row, col, value) one entry, AddDiagonal(row, col, n, value) value·I (n x n). None allocates once warm.
 struct DenseSink {
   Matrix* dr;
   template <class Block>
   void Add(int row, int col, const Block& block) {
     dr->block(row, col, block.rows(), block.cols()).noalias() += block;
   }
+  void Add(int row, int col, double value) { (*dr)(row, col) += value; }
   void AddDiagonal(int row, int col, int n, double value) {
     dr->block(row, col, n, n).diagonal().array() += value;
   }
@@ -145,6 +146,7 @@ struct TripletSink {
       for (int i = 0; i < scratch->rows(); ++i) triplets->emplace_back(row + i, col + j, (*scratch)(i, j));
     }
   }
+  void Add(int row, int col, double value) { triplets->emplace_back(row, col, value); }
   void AddDiagonal(int row, int col, int n, double value) {
     for (int i = 0; i < n; ++i) triplets->emplace_back(row + i, col + i, value);
   }
@@ -228,12 +230,11 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
     }
     if (dr) {
       phase.UnfoldedVectorField(flow.x, xi, &f_tilde, nullptr, nullptr);
-      const int n = layout_.dim(i);
       const int ct = layout_.time_index(i);
       dr->Add(row, ct, D_ * f_tilde);
       dr->Add(row, ct + 1, D_ * flow.Phi);
       dr->Add(row, layout_.xi_index(), D_ * flow.Psi);
-      dr->Add(row + n_out, ct, Eigen::Matrix<double, 1, 1>(de_.dot(f_tilde)));
+      dr->Add(row + n_out, ct, de_.dot(f_tilde));
       dr->Add(row + n_out, ct + 1, de_ * flow.Phi);
       dr->Add(row + n_out, layout_.xi_index(), de_ * flow.Psi);
       // C: -I on x̄_{i+1}
@@ -252,7 +253,7 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
   }
   if (dr) {
     dr->Add(row, layout_.state_offset(0), dH_);
-    dr->Add(row, layout_.H_index(), Eigen::Matrix<double, 1, 1>(-1.0));
+    dr->Add(row, layout_.H_index(), -1.0);
   }
   return {};
 }
