@@ -201,7 +201,12 @@ std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::ma
         return f.ok() ? (type == "BP" ? f.bp_test : f.pd_test) : std::nan("");
       };
       const auto locate = [&](std::size_t i, const Vector& u_a, const Vector& u_b) {
-        const TestFunctionRoot root = LocateTestFunctionRoot(&map, u_a, u_b, test, TestFunctionRootOptions{});
+        TestFunctionRootOptions options;
+        options.refined_test = [type = std::string(type)](ZeroProblem& refined, const Vector& u) {
+          const FloquetResult f = ComputeFloquet(dynamic_cast<TimeBasedShooting&>(refined), u);
+          return f.ok() ? (type == "BP" ? f.bp_test : f.pd_test) : std::nan("");
+        };
+        const TestFunctionRoot root = LocateTestFunctionRoot(&map, u_a, u_b, test, options);
         nlohmann::json j = {{"id", static_cast<int>(special_points->size())},
                             {"type", type},
                             {"branch", b.id},

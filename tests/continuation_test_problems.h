@@ -2,6 +2,8 @@
 #ifndef HYBRIDCONT_TESTS_CONTINUATION_TEST_PROBLEMS_H_
 #define HYBRIDCONT_TESTS_CONTINUATION_TEST_PROBLEMS_H_
 
+#include <cmath>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,6 +22,31 @@ class Circle : public ZeroProblem {
     if (dr) *dr = 2.0 * u.transpose();
     return {};
   }
+};
+
+// The unit circle with a smooth "discretization error" ε·sin(7x + 3y) that shrinks with the tolerances
+// as an integrator's does: Refined(f) is the same curve with ε·f. Its turning point in x lies at
+// x ≈ 1 − 0.33ε, y ≈ −1.13ε (∂r/∂y = 2y + 3ε cos(7x + 3y) = 0), the exact one (ε = 0) at (1, 0).
+class PerturbedCircle : public ZeroProblem {
+ public:
+  explicit PerturbedCircle(double epsilon) : epsilon_(epsilon) {}
+  int num_equations() const override { return 1; }
+  std::vector<std::string> unknown_names() const override { return {"x", "y"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0), y = u(1), phase = 7 * x + 3 * y;
+    if (r) *r = Vector::Constant(1, x * x + y * y - 1 + epsilon_ * std::sin(phase));
+    if (dr) {
+      dr->resize(1, 2);
+      *dr << 2 * x + 7 * epsilon_ * std::cos(phase), 2 * y + 3 * epsilon_ * std::cos(phase);
+    }
+    return {};
+  }
+  std::unique_ptr<ZeroProblem> Refined(double factor) const override {
+    return std::make_unique<PerturbedCircle>(epsilon_ * factor);
+  }
+
+ private:
+  double epsilon_;
 };
 
 // x³ − λx = 0: the trivial branch x = 0 and the parabola λ = x², crossing at the SB point (0, 0).

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "continuation_test_problems.h"
+#include "hybridcont/corrector.h"
 #include "hybridcont/test_function_root.h"
 
 namespace hybridcont {
@@ -118,6 +119,34 @@ TEST(TestFunctionRoot, AProbeOnANeighbouringBranchConfirmsNoPair) {
   ASSERT_TRUE(ParabolaDipThroughZero(s, g).has_value());
   const HiddenRootPair pair = FindHiddenRootPair(&curves, {&u0, &u1, &u2}, s, g, test);
   EXPECT_FALSE(pair.found) << "probe (" << pair.u.transpose() << "), test " << pair.value;
+}
+
+// With refined_test, the integration error widens the precision: on the perturbed circle the root of
+// y (a test that does not depend on the problem) lies 0.33ε from the exact (1, 0), because the computed
+// curve does; the bracket alone says 1e-12.
+TEST(TestFunctionRoot, IntegrationErrorWidensThePrecision) {
+  const double epsilon = 1e-7;
+  testing::PerturbedCircle curve(epsilon);
+  const auto y = [](const Vector& u) { return u(1); };
+  const Eigen::Vector2d u_a(std::cos(0.3), -std::sin(0.3)), u_b(std::cos(0.3), std::sin(0.3));
+  // the branch points, on the perturbed curve
+  Vector a, b;
+  Corrector corrector(&curve);
+  ASSERT_TRUE(corrector.CorrectPseudoArclength(u_a, Eigen::Vector2d(1, 0), &a).converged());
+  ASSERT_TRUE(corrector.CorrectPseudoArclength(u_b, Eigen::Vector2d(1, 0), &b).converged());
+  const TestFunctionRoot bare = LocateTestFunctionRoot(&curve, a, b, y, TestFunctionRootOptions{});
+  ASSERT_TRUE(bare.located) << bare.message;
+  const double error = (bare.u - Eigen::Vector2d(1, 0)).norm();
+  EXPECT_NEAR(error, 0.5 * std::abs(std::sin(7.0)) * epsilon, 1e-2 * epsilon);
+  EXPECT_LT(bare.precision, 1e-11);
+
+  TestFunctionRootOptions options;
+  options.refined_test = [](ZeroProblem&, const Vector& u) { return u(1); };
+  const TestFunctionRoot root = LocateTestFunctionRoot(&curve, a, b, y, options);
+  EXPECT_EQ(root.u, bare.u);
+  EXPECT_NE(root.message.find("integration error"), std::string::npos) << root.message;
+  EXPECT_GE(0.5 * root.precision, error);
+  EXPECT_LE(0.5 * root.precision, 3 * error) << root.message;
 }
 
 }  // namespace

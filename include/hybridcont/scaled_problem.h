@@ -33,6 +33,8 @@ class ScaledProblem : public ZeroProblem {
   // Diagonal scaling commutes with sign changes: the same signs act on v.
   std::vector<Symmetry> symmetries() const override { return problem_->symmetries(); }
   std::unique_ptr<ZeroProblem> Clone() const override;
+  // A scaled refined copy of the wrapped problem (nullptr if that has none), which the copy owns.
+  std::unique_ptr<ZeroProblem> Refined(double factor) const override;
   // Forwards the work of the clone's wrapped problem to this one's.
   void AddWorkOf(const ZeroProblem& clone) override;
   // Forwarded: the column scaling leaves every entry's relative error as it is.
@@ -44,6 +46,9 @@ class ScaledProblem : public ZeroProblem {
   const Vector& scales() const { return scales_; }
 
  private:
+  // This scaling around `inner` (owned); nullptr for a null inner.
+  std::unique_ptr<ZeroProblem> Wrap(std::unique_ptr<ZeroProblem> inner) const;
+
   ZeroProblem* problem_;
   std::unique_ptr<ZeroProblem> owned_;  // problem_ of a clone
   Vector scales_;

@@ -37,6 +37,20 @@
 // (or by the noisy correction, if larger): its ends are themselves points inside the noise (e.g. ~5e-8 in
 // arclength for the bouncing rod's SB, not location_tolerance).
 //
+// Integration error (ContinuationOptions::check_integration_error, on by default): the bracket is where
+// the root of the *computed* test function lies. A shooting map is computed with integration error, and
+// a point where the curve is badly conditioned (the SLIP's loop near T = 0: dr has singular values down to
+// 6e-6 next to 0.5) amplifies it in the tangent and so in the test function. After locating, the estimate
+// is evaluated again with the problem's refined copy (ZeroProblem::Refined: integration tolerances × 0.1).
+// With errors proportional to the tolerances, the change Δg of the test function is 0.9 of its error,
+// and δs = |Δg| / (0.9 |slope|) (slope: the test's secant over the step) is how far the exact root may
+// lie along the branch; the refined Newton correction δu is how far the exact curve may lie from u. The
+// interval grows to [s − δs, s + δs] where that is wider, interval_width to 2(|τ_i| δs + |δu_i|), and
+// the message says so. Measured on the SLIP (session 6): regular turning and SB points are good to
+// 1e-11..5e-10 in arclength (the bracket alone said 2.5e-12), the loop's turning point near T = 0 to
+// 1.4e-4 (it said 2.5e-12); a test checks the estimate against an exploration at 10x the tolerances.
+// Problems exact to rounding (algebraic ones) have no refined copy: their precision is the bracket's.
+//
 // Tangent of an SB point: the induced tangent is undefined there and next to it numerically meaningless
 // when dr is noisy (it mixes the two branch directions). SpecialPoint::tangent is the estimate's induced
 // tangent only when it lies within the cone of the regular tangents at the bracketing points, otherwise
@@ -85,8 +99,9 @@ struct SpecialPoint {
   Vector tangent_before;       // tangent at branch point [index]
   Vector tangent_after;        // tangent at branch point [index + 1]
   double test_value = 0;       // test function at u (normalized determinant or τ_k)
-  // Final bracket in the arclength coordinate (absolute on the branch) and the componentwise width
-  // |u(σ_hi) − u(σ_lo)| of the curve over it: the honest precision of every component of u.
+  // Interval in the arclength coordinate (absolute on the branch) that holds the special point: the final
+  // bracket, widened by the integration error where that is larger ("Integration error" above), and the
+  // componentwise width of u over it: the honest precision of every component of u.
   double interval_lo = 0;
   double interval_hi = 0;
   Vector interval_width;

@@ -76,6 +76,8 @@ class StateBasedShooting : public ZeroProblem {
   // Same model, Poincaré options and fixed levels (zero_problem.h).
   std::unique_ptr<ZeroProblem> Clone() const override;
   void AddWorkOf(const ZeroProblem& clone) override;
+  // A clone with the integrators' rtol and atol times factor (event tolerances unchanged).
+  std::unique_ptr<ZeroProblem> Refined(double factor) const override;
 
   const FlowCounters& counters() const { return counters_; }
   long num_evaluations() const { return num_evaluations_; }

@@ -27,13 +27,21 @@ struct TestFunctionRootOptions {
   double sigma_tolerance = 1e-11;
   // Illinois converges superlinearly; the budget covers the bisection fallback too.
   int max_iterations = 60;
+  // The test function evaluated with a refined copy of the problem (ZeroProblem::Refined, tolerances
+  // times ContinuationOptions::kIntegrationErrorFactor). When set and the problem has one, the located root's integration error is estimated as
+  // for the continuation's special points (special_point.h, "Integration error"): the estimate is
+  // corrected onto the refined curve (on its hyperplane ⟂ the chord), the test evaluated there, and twice
+  // the implied error along and off the branch widens `precision` where that exceeds the bracket.
+  std::function<double(ZeroProblem& refined, const Vector& u)> refined_test;
 };
 
 struct TestFunctionRoot {
   bool located = false;  // bracket narrower than the tolerance; otherwise only bracketed
   Vector u;              // best estimate (corrected onto the curve)
   double sigma = 0;      // position along the chord
-  double precision = 0;  // width of the final bracket along the chord, in units of u
+  // Width of the final bracket along the chord, in units of u, or of the interval the integration error
+  // allows (TestFunctionRootOptions::refined_test) where that is wider.
+  double precision = 0;
   int iterations = 0;
   std::string message;   // why only bracketed
 };

@@ -106,6 +106,8 @@ class TimeBasedShooting : public ZeroProblem {
   std::vector<Symmetry> symmetries() const override;
   std::unique_ptr<ZeroProblem> Clone() const override;
   void AddWorkOf(const ZeroProblem& clone) override;
+  // A clone with rtol and atol times factor.
+  std::unique_ptr<ZeroProblem> Refined(double factor) const override;
 
   // Work done by all evaluations so far.
   const FlowCounters& counters() const { return counters_; }

@@ -113,6 +113,16 @@ class ZeroProblem {
   // Adds the work counters of `clone` (made by this problem's Clone()) to this problem's, so that totals
   // cover every thread's evaluations. Default: nothing is counted.
   virtual void AddWorkOf(const ZeroProblem& clone) { (void)clone; }
+  // A clone that evaluates more accurately: its discretization tolerances (the integrators' rtol and
+  // atol) times `factor` < 1. Evaluating a computed point again with it is an a-posteriori estimate of
+  // the problem's own error there (special_point.h, "Integration error"): where r and dr move little,
+  // the point is as good as its root finder says; where a badly conditioned point amplifies the
+  // integration error, the difference says by how much. Its work counts through AddWorkOf like a
+  // clone's. nullptr, the default: the problem is exact to rounding (algebraic problems).
+  virtual std::unique_ptr<ZeroProblem> Refined(double factor) const {
+    (void)factor;
+    return nullptr;
+  }
 
   // How exact the next evaluations' dr must be: terms of dr whose relative size is below `tolerance` may
   // be left out (0, the default: dr exact to the problem's own accuracy). The corrector raises it for the

@@ -1,10 +1,46 @@
 #include "hybridcont/test_function_root.h"
 
 #include <cmath>
+#include <cstdio>
+#include <memory>
 
+#include "hybridcont/continuation.h"
 #include "hybridcont/corrector.h"
 
 namespace hybridcont {
+namespace {
+
+// TestFunctionRootOptions::refined_test, with the factor and safety of the continuation's special points
+// (ContinuationOptions): with errors proportional to the tolerances, the refined change of a quantity is
+// (1 − factor) of its error at the problem's own tolerances.
+void AddIntegrationError(ZeroProblem* problem, const Vector& chord, double slope, double value,
+                         const std::function<double(ZeroProblem&, const Vector&)>& refined_test,
+                         TestFunctionRoot* root) {
+  constexpr double kFactor = ContinuationOptions::kIntegrationErrorFactor;
+  constexpr double kSafety = ContinuationOptions::kIntegrationErrorSafety;
+  const std::unique_ptr<ZeroProblem> refined = problem->Refined(kFactor);
+  if (refined == nullptr || !(slope != 0)) return;
+  Corrector corrector(refined.get());
+  Vector u;
+  const bool corrected = corrector.CorrectPseudoArclength(root->u, chord, &u).converged();
+  const double refined_value = corrected ? refined_test(*refined, u) : std::nan("");
+  problem->AddWorkOf(*refined);
+  if (!std::isfinite(refined_value)) return;
+  const double along = std::abs(refined_value - value) / std::abs(slope);
+  const double off = (u - root->u).norm();
+  const double reach = kSafety / (1 - kFactor) * (along + off);
+  if (2 * reach <= root->precision) return;
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "integration error: at %gx the tolerances the point moves by %.2g and the test by %.2g "
+                "(slope %.2g): precision %.2g (twice the estimate; the bracket was %.2g)",
+                kFactor, off, std::abs(refined_value - value), std::abs(slope), 2 * reach, root->precision);
+  root->precision = 2 * reach;
+  if (!root->message.empty()) root->message += "; ";
+  root->message += text;
+}
+
+}  // namespace
 
 TestFunctionRoot LocateTestFunctionRoot(ZeroProblem* problem, const Vector& u_a, const Vector& u_b,
                                         const std::function<double(const Vector&)>& test,
@@ -14,7 +50,9 @@ TestFunctionRoot LocateTestFunctionRoot(ZeroProblem* problem, const Vector& u_a,
   Corrector corrector(problem);
   double lo = 0.0, hi = 1.0;
   double f_lo = test(u_a), f_hi = test(u_b);
+  const double slope = (f_hi - f_lo) / chord.norm();  // the test's secant slope per unit of u
   root.u = std::abs(f_lo) < std::abs(f_hi) ? u_a : u_b;
+  double value = std::abs(f_lo) < std::abs(f_hi) ? f_lo : f_hi;  // the test at root.u
   if (!(f_lo * f_hi < 0.0)) {
     root.message = "no sign change between the two points";
     return root;
@@ -37,6 +75,7 @@ TestFunctionRoot LocateTestFunctionRoot(ZeroProblem* problem, const Vector& u_a,
     }
     root.u = u;
     root.sigma = sigma;
+    value = f;
     if (f == 0.0) {
       lo = hi = sigma;
       break;
@@ -54,6 +93,7 @@ TestFunctionRoot LocateTestFunctionRoot(ZeroProblem* problem, const Vector& u_a,
   root.precision = (hi - lo) * chord.norm();
   root.located = hi - lo <= options.sigma_tolerance;
   if (!root.located && root.message.empty()) root.message = "iteration budget exhausted";
+  if (options.refined_test) AddIntegrationError(problem, chord, slope, value, options.refined_test, &root);
   return root;
 }
 

@@ -97,6 +97,11 @@ class Segment {
   // Probes at the two ends, from the stored points (plus one evaluation of dr for the SB test).
   // Returns false if that evaluation fails.
   bool EndProbe(bool at_b, Probe* probe, std::string* message);
+  // The probe at probe.u evaluated again with `refined` (ZeroProblem::Refined): *fine gets the tangent
+  // and SB test from the refined dr (same border τ_a, orientation and scale as every probe of this
+  // segment), *correction the refined Newton correction −[dr; τ_aᵀ]⁻¹[r; 0]: how far the refined curve
+  // lies from probe.u on the probe's hyperplane. False if the evaluation or the bordered matrix fails.
+  bool RefinedProbe(ZeroProblem* refined, const Probe& probe, Probe* fine, Vector* correction);
 
  private:
   Corrector* corrector_;
@@ -119,6 +124,9 @@ class Segment {
   double sigma_b_;
 };
 
+// Bracket widths by which a location to the noise level widens its bracket on each side (LocateRoot).
+inline constexpr double kNoiseMargin = 4.0;
+
 struct RootLocation {
   bool located = false;       // bracket narrower than the tolerance (or exact zero)
   double lo = 0, hi = 0;      // final bracket in σ
@@ -126,6 +134,10 @@ struct RootLocation {
   Segment::Probe estimate;    // the trial point with the smallest |test|
   Vector u_lo, u_hi;          // curve points at the bracket ends
   double test = 0;
+  // The test function's secant slope over the whole segment, (test(b) − test(a)) / σ_b, from the end
+  // probes: what turns an error of the test function into an error of the root (stepper, "Integration
+  // error" in special_point.h). 0 when the end probes failed.
+  double slope = 0;
   int iterations = 0;
   // Located to the noise level: a trial point inside the bracket had a residual at the corrector's
   // tolerance already, yet Newton's correction of it left the bracket (Segment::Evaluate). The bracket,

@@ -19,13 +19,15 @@ ScaledProblem::ScaledProblem(ZeroProblem* problem, Vector scales) : problem_(pro
   }
 }
 
-std::unique_ptr<ZeroProblem> ScaledProblem::Clone() const {
-  std::unique_ptr<ZeroProblem> problem = problem_->Clone();
-  if (problem == nullptr) return nullptr;
-  auto clone = std::make_unique<ScaledProblem>(problem.get(), scales_);
-  clone->owned_ = std::move(problem);
-  return clone;
+std::unique_ptr<ZeroProblem> ScaledProblem::Wrap(std::unique_ptr<ZeroProblem> inner) const {
+  if (inner == nullptr) return nullptr;
+  auto wrapped = std::make_unique<ScaledProblem>(inner.get(), scales_);
+  wrapped->owned_ = std::move(inner);
+  return wrapped;
 }
+
+std::unique_ptr<ZeroProblem> ScaledProblem::Clone() const { return Wrap(problem_->Clone()); }
+std::unique_ptr<ZeroProblem> ScaledProblem::Refined(double factor) const { return Wrap(problem_->Refined(factor)); }
 
 void ScaledProblem::AddWorkOf(const ZeroProblem& clone) {
   problem_->AddWorkOf(*dynamic_cast<const ScaledProblem&>(clone).problem_);

@@ -2,7 +2,9 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -420,6 +422,10 @@ class ContinuationStepper::Impl {
       point.residual_norm = root.estimate.residual;
       point.iterations = root.iterations;
       point.message = root.message;
+      if (options_.check_integration_error) AddIntegrationError(&segment, root, test, &point);
+      // An interval wider than the bracket (noise-limited locations widen it, AddIntegrationError may):
+      // the components vary over all of it.
+      point.interval_width = point.interval_width.cwiseMax(point.tangent.cwiseAbs() * point.precision());
       branch_.located_iterations += root.iterations;
       found.push_back(std::move(point));
     };
@@ -432,11 +438,74 @@ class ContinuationStepper::Impl {
         locate(SpecialPointType::kTurningPoint, k, [k](const internal::Segment::Probe& p) { return p.tangent(k); });
       }
     }
+    // A turning point inside the interval of an SB point of the same step cannot be told apart from it:
+    // the tangent, and so τ_k, is undefined at the SB point and next to it set by the noise (SLIP: on
+    // branch 18 a turning point 1.2e-9 before the SB point where the branch passes the zero-duration
+    // family, on the SB point itself at 10x the tolerances). Its interval is widened to hold the SB's.
+    for (const SpecialPoint& sb : found) {
+      if (sb.type != SpecialPointType::kSimpleBifurcation) continue;
+      for (SpecialPoint& tp : found) {
+        if (tp.type != SpecialPointType::kTurningPoint || tp.arclength < sb.interval_lo ||
+            tp.arclength > sb.interval_hi) {
+          continue;
+        }
+        tp.interval_lo = std::min(tp.interval_lo, sb.interval_lo);
+        tp.interval_hi = std::max(tp.interval_hi, sb.interval_hi);
+        if (tp.interval_width.size() == sb.interval_width.size() && tp.u.size() == sb.u.size()) {
+          tp.interval_width = tp.interval_width.cwiseMax(sb.interval_width + 2 * (tp.u - sb.u).cwiseAbs());
+        }
+        if (!tp.message.empty()) tp.message += "; ";
+        tp.message += "inside the interval of the simple bifurcation point at s = " + std::to_string(sb.arclength) +
+                      ", where the tangent is undefined: located only as well as that point";
+      }
+    }
     std::sort(found.begin(), found.end(),
               [](const SpecialPoint& x, const SpecialPoint& y) { return x.arclength < y.arclength; });
     for (SpecialPoint& point : found) {
       point.id = static_cast<int>(branch_.special_points.size());
       branch_.special_points.push_back(std::move(point));
+    }
+  }
+
+  // special_point.h, "Integration error". The estimate evaluated again with the problem's refined copy:
+  // with the error of an evaluation proportional to the tolerances, the change Δ of a quantity is
+  // (1 − factor) of its error at the problem's own tolerances. The test function's error over its slope
+  // is how far the exact root may lie from the computed one (δs, along the branch), the refined Newton
+  // correction how far the exact curve may lie from the point (δu). Where δs or δu exceed the bracket,
+  // the interval and the componentwise widths grow to cover them, and the message says so.
+  void AddIntegrationError(internal::Segment* segment, const internal::RootLocation& root,
+                           const std::function<double(const internal::Segment::Probe&)>& test, SpecialPoint* point) {
+    constexpr double kFactor = ContinuationOptions::kIntegrationErrorFactor;
+    constexpr double kSafety = ContinuationOptions::kIntegrationErrorSafety;
+    const std::unique_ptr<ZeroProblem> refined = problem_->Refined(kFactor);
+    if (refined == nullptr || root.estimate.u.size() != problem_->num_unknowns() || !(root.slope != 0)) return;
+    internal::Segment::Probe fine;
+    Vector du;
+    const bool ok = segment->RefinedProbe(refined.get(), root.estimate, &fine, &du);
+    problem_->AddWorkOf(*refined);
+    if (!ok) return;
+    du *= kSafety / (1 - kFactor);
+    const double ds = kSafety * std::abs(test(fine) - root.test) / ((1 - kFactor) * std::abs(root.slope));
+    if (!std::isfinite(ds)) return;
+    const Vector tangent = point->tangent.size() == du.size() ? point->tangent : root.estimate.tangent;
+    const Vector spread = 2 * (tangent.cwiseAbs() * ds + du.cwiseAbs());
+    const double bracket = point->precision();
+    // The arclength interval also takes the point's distance from the exact curve: one number that
+    // bounds how far the exact special point may be from u, along the branch or off it.
+    const double reach = ds + du.norm();
+    point->interval_lo = std::min(point->interval_lo, point->arclength - reach);
+    point->interval_hi = std::max(point->interval_hi, point->arclength + reach);
+    if (point->interval_width.size() == spread.size()) point->interval_width = point->interval_width.cwiseMax(spread);
+    if (2 * reach > bracket) {
+      char text[640];
+      std::snprintf(text, sizeof(text),
+                    "integration error: evaluated with %gx the tolerances the test function moves by %.2g "
+                    "(slope %.2g along the branch) and Newton by %.2g, so the root may lie %.2g away along "
+                    "the branch and the point %.2g off it (twice the estimate; precision %.2g, the bracket was %.2g)",
+                    kFactor, std::abs(test(fine) - root.test), std::abs(root.slope), du.norm() * (1 - kFactor) / kSafety,
+                    ds, du.norm(), point->precision(), bracket);
+      if (!point->message.empty()) point->message += "; ";
+      point->message += text;
     }
   }
 

@@ -40,6 +40,15 @@ std::unique_ptr<ZeroProblem> StateBasedShooting::Clone() const {
   return clone;
 }
 
+std::unique_ptr<ZeroProblem> StateBasedShooting::Refined(double factor) const {
+  PoincareOptions options = map_.options();
+  options.event.integrator.rtol *= factor;
+  options.event.integrator.atol *= factor;
+  auto clone = std::make_unique<StateBasedShooting>(*model_, options);
+  clone->SetFixedLevels(fixed_levels_);
+  return clone;
+}
+
 void StateBasedShooting::AddWorkOf(const ZeroProblem& clone) {
   const auto& other = dynamic_cast<const StateBasedShooting&>(clone);
   counters_ += other.counters_;

@@ -64,6 +64,16 @@ std::unique_ptr<ZeroProblem> TimeBasedShooting::Clone() const {
   return clone;
 }
 
+std::unique_ptr<ZeroProblem> TimeBasedShooting::Refined(double factor) const {
+  IntegratorOptions options = options_;
+  options.rtol *= factor;
+  options.atol *= factor;
+  auto clone = std::make_unique<TimeBasedShooting>(*model_, options);
+  clone->SetFixedLevels(fixed_levels_);
+  clone->set_threads(1);
+  return clone;
+}
+
 void TimeBasedShooting::AddWorkOf(const ZeroProblem& clone) {
   const auto& other = dynamic_cast<const TimeBasedShooting&>(clone);
   counters_ += other.counters_;

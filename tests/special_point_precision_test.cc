@@ -1,0 +1,115 @@
+// The precision of located special points includes the integration error (special_point.h, "Integration
+// error"): checked on a curve with a known discretization error, and on the SLIP against an exploration
+// at 10x tighter integration tolerances.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "continuation_test_problems.h"
+#include "hybridcont/continuation.h"
+#include "hybridcont/exploration.h"
+#include "hybridcont/models.h"
+#include "model_exploration.h"
+#include "scenario.h"
+
+namespace hybridcont {
+namespace {
+
+using testing::PerturbedCircle;
+
+Branch TraceToTheTurningPoint(ZeroProblem* curve, bool check_integration_error) {
+  ContinuationOptions options;
+  options.turning_point_components = {"x"};
+  options.bounds = {{"y", -2, 0.5}};
+  options.check_integration_error = check_integration_error;
+  ContinuationStepper stepper(curve, options);
+  StepStatus status = stepper.Start(Eigen::Vector2d(0, -1), Eigen::Vector2d(1, 0));
+  while (status == StepStatus::kContinuing) status = stepper.Step();
+  return stepper.TakeBranch();
+}
+
+TEST(SpecialPointPrecision, CoversTheDiscretizationErrorOfATurningPoint) {
+  const double epsilon = 1e-7;
+  PerturbedCircle curve(epsilon);
+  const Eigen::Vector2d exact(1, 0);
+
+  const Branch bare = TraceToTheTurningPoint(&curve, false);
+  ASSERT_EQ(bare.special_points.size(), 1u) << bare.FullReport();
+  const SpecialPoint& located = bare.special_points[0];
+  ASSERT_EQ(located.type, SpecialPointType::kTurningPoint);
+  // The root of the computed test function, 1.18ε from the exact turning point: the bracket alone
+  // (location_tolerance) does not hold the exact point.
+  const double error = (located.u - exact).norm();
+  EXPECT_NEAR(error, std::hypot(0.5 * std::sin(7.0), 1.5 * std::cos(7.0)) * epsilon, 1e-2 * epsilon);
+  EXPECT_LT(located.precision(), 1e-10);
+
+  const Branch checked = TraceToTheTurningPoint(&curve, true);
+  ASSERT_EQ(checked.special_points.size(), 1u) << checked.FullReport();
+  const SpecialPoint& tp = checked.special_points[0];
+  EXPECT_EQ(tp.u, located.u);  // the same location, now with its error
+  EXPECT_NE(tp.message.find("integration error"), std::string::npos) << tp.BriefReport();
+  // The interval holds the exact point, componentwise, and is not vacuous: its half-width is within 3x
+  // the true error (the estimate is doubled, and the errors along and off the branch are added).
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_LE(std::abs(tp.u(i) - exact(i)), 0.5 * tp.interval_width(i)) << i << ": " << tp.BriefReport();
+  }
+  EXPECT_GE(0.5 * tp.precision(), error);
+  EXPECT_LE(0.5 * tp.precision(), 3 * error) << tp.BriefReport();
+}
+
+// A problem exact to rounding has no refined copy: the precision stays the bracket's.
+TEST(SpecialPointPrecision, ExactProblemsKeepTheBracket) {
+  struct Exact : PerturbedCircle {
+    Exact() : PerturbedCircle(0.0) {}
+    std::unique_ptr<ZeroProblem> Refined(double) const override { return nullptr; }
+  } exact;
+  const Branch branch = TraceToTheTurningPoint(&exact, true);
+  ASSERT_EQ(branch.special_points.size(), 1u) << branch.FullReport();
+  EXPECT_LE(branch.special_points[0].precision(), ContinuationOptions().location_tolerance);
+  EXPECT_TRUE(branch.special_points[0].message.empty()) << branch.special_points[0].BriefReport();
+}
+
+BifurcationDiagram ExploreSlip(double tolerance_factor) {
+  const HybridModel model = MakeSlip();
+  const app::Scenario scenario = app::DefaultScenario(model);
+  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+  options.threads = 1;
+  IntegratorOptions integrator;
+  integrator.rtol *= tolerance_factor;
+  integrator.atol *= tolerance_factor;
+  app::ModelExploration exploration(model, scenario, integrator, options);
+  return exploration.Run();
+}
+
+// The independent check: the SLIP explored again at 10x tighter tolerances. Every special point of the
+// default run lies within the two runs' precisions of its counterpart (the exact point is within each
+// run's half-width of it), also the loop's turning point near T = 0, whose bracket is 2.5e-12 but which
+// moves by ~1e-6 to 1e-4 with the tolerances.
+TEST(SpecialPointPrecision, SlipSpecialPointsMoveWithinTheirPrecisionWhenTheTolerancesShrink) {
+  const BifurcationDiagram coarse = ExploreSlip(1.0);
+  const BifurcationDiagram fine = ExploreSlip(0.1);
+  ASSERT_EQ(coarse.branches.size(), fine.branches.size());
+  int compared = 0, widened = 0;
+  for (const SpecialPoint& p : coarse.special_points) {
+    if (p.duplicate_of >= 0 || p.type == SpecialPointType::kSingularStart) continue;
+    const SpecialPoint* match = nullptr;
+    for (const SpecialPoint& q : fine.special_points) {
+      if (q.type != p.type || q.duplicate_of >= 0) continue;
+      if (match == nullptr || (q.u - p.u).norm() < (match->u - p.u).norm()) match = &q;
+    }
+    ASSERT_NE(match, nullptr) << p.BriefReport(coarse.unknown_names);
+    const double allowed =
+        0.5 * (p.interval_width.norm() + match->interval_width.norm()) + 1e-12 * (1 + p.u.norm());
+    EXPECT_LE((p.u - match->u).norm(), allowed) << p.BriefReport(coarse.unknown_names) << "\n"
+                                                 << match->BriefReport(fine.unknown_names);
+    ++compared;
+    if (p.message.find("integration error") != std::string::npos) ++widened;
+  }
+  EXPECT_GE(compared, 40);
+  // Most points: the integration error (1e-11..5e-10) exceeds the 2.5e-12 bracket.
+  EXPECT_GE(widened, compared / 2);
+}
+
+}  // namespace
+}  // namespace hybridcont
