@@ -105,6 +105,10 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
   for (const SpecialPoint& sp : d.special_points) {
     const double H = sp.u.size() ? sp.u(layout.H_index()) : std::nan("");
     const double precision_H = sp.interval_width.size() ? sp.interval_width(layout.H_index()) : std::nan("");
+    // "precision": the width of the interval that holds the point, as a distance in u (model units), like
+    // the Floquet points' (LocateFloquetPoints); "precision_arclength": the same interval along the branch
+    // in the engine's scaled arclength (SpecialPoint::precision()).
+    const double precision_u = sp.interval_width.size() ? sp.interval_width.norm() : sp.precision();
     nlohmann::json j = {{"id", sp.id},
                         {"type", SpecialPointTypeCode(sp.type)},
                         {"branch", sp.branch_id},
@@ -112,7 +116,8 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
                         {"H", H},
                         {"T", sp.u.size() ? layout.Period(sp.u) : std::nan("")},
                         {"status", ToString(sp.status)},
-                        {"precision", sp.precision()},
+                        {"precision", precision_u},
+                        {"precision_arclength", sp.precision()},
                         {"precision_H", precision_H},
                         {"residual", sp.residual_norm},
                         {"component", sp.component},

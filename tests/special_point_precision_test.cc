@@ -58,6 +58,60 @@ TEST(SpecialPointPrecision, CoversTheDiscretizationErrorOfATurningPoint) {
   EXPECT_LE(0.5 * tp.precision(), 3 * error) << tp.BriefReport();
 }
 
+// A turning point where the test function is much flatter than across the step: x = −(a y² + y⁴) with
+// a = 1e-4 has its turning point in x at (0, 0), and with the perturbation ε·sin(7x + 3y) (ε scaled by
+// Refined) it moves to y ≈ 1.5ε/a, far more than on the circle. τ_x changes ~50x faster across a step of
+// 0.1 than at the root: an error estimate with the step's secant slope alone said 30x too little (an
+// independent review's case); RootLocation::slope takes the flatter final bracket's.
+class PerturbedQuartic : public ZeroProblem {
+ public:
+  explicit PerturbedQuartic(double epsilon) : epsilon_(epsilon) {}
+  int num_equations() const override { return 1; }
+  std::vector<std::string> unknown_names() const override { return {"x", "y"}; }
+  EvaluationStatus Evaluate(const Vector& u, Vector* r, Matrix* dr) override {
+    const double x = u(0), y = u(1), phase = 7 * x + 3 * y;
+    if (r) *r = Vector::Constant(1, x + kA * y * y + y * y * y * y + epsilon_ * std::sin(phase));
+    if (dr) {
+      dr->resize(1, 2);
+      *dr << 1 + 7 * epsilon_ * std::cos(phase), 2 * kA * y + 4 * y * y * y + 3 * epsilon_ * std::cos(phase);
+    }
+    return {};
+  }
+  std::unique_ptr<ZeroProblem> Refined(double factor) const override {
+    return std::make_unique<PerturbedQuartic>(epsilon_ * factor);
+  }
+  static constexpr double kA = 1e-4;
+
+ private:
+  double epsilon_;
+};
+
+TEST(SpecialPointPrecision, CoversATurningPointWhereTheTestIsFlat) {
+  const double epsilon = 1e-9;
+  PerturbedQuartic curve(epsilon);
+  ContinuationOptions options;
+  options.turning_point_components = {"x"};
+  options.bounds = {{"y", -1, 0.5}};
+  options.max_step = 0.1;
+  ContinuationStepper stepper(&curve, options);
+  const double y0 = -0.5;
+  StepStatus status = stepper.Start(Eigen::Vector2d(-(PerturbedQuartic::kA * y0 * y0 + std::pow(y0, 4)), y0),
+                                    Eigen::Vector2d(0.5, 1).normalized());
+  while (status == StepStatus::kContinuing) status = stepper.Step();
+  const Branch branch = stepper.TakeBranch();
+  ASSERT_EQ(branch.special_points.size(), 1u) << branch.FullReport();
+  const SpecialPoint& tp = branch.special_points[0];
+  ASSERT_EQ(tp.type, SpecialPointType::kTurningPoint);
+  const Eigen::Vector2d exact(0, 0);
+  const double error = (tp.u - exact).norm();
+  EXPECT_GT(error, 1e3 * epsilon);  // the flat test amplifies ε ~1e4-fold
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_LE(std::abs(tp.u(i) - exact(i)), 0.5 * tp.interval_width(i)) << i << ": " << tp.BriefReport();
+  }
+  EXPECT_GE(0.5 * tp.precision(), error) << tp.BriefReport();
+  EXPECT_LE(0.5 * tp.precision(), 10 * error) << tp.BriefReport();
+}
+
 // A problem exact to rounding has no refined copy: the precision stays the bracket's.
 TEST(SpecialPointPrecision, ExactProblemsKeepTheBracket) {
   struct Exact : PerturbedCircle {

@@ -50,7 +50,8 @@ TestFunctionRoot LocateTestFunctionRoot(ZeroProblem* problem, const Vector& u_a,
   Corrector corrector(problem);
   double lo = 0.0, hi = 1.0;
   double f_lo = test(u_a), f_hi = test(u_b);
-  const double slope = (f_hi - f_lo) / chord.norm();  // the test's secant slope per unit of u
+  double slope = (f_hi - f_lo) / chord.norm();  // the test's secant slope per unit of u
+  double g_lo = f_lo, g_hi = f_hi;              // the test at the bracket ends (f_*: Illinois-halved)
   root.u = std::abs(f_lo) < std::abs(f_hi) ? u_a : u_b;
   double value = std::abs(f_lo) < std::abs(f_hi) ? f_lo : f_hi;  // the test at root.u
   if (!(f_lo * f_hi < 0.0)) {
@@ -81,11 +82,11 @@ TestFunctionRoot LocateTestFunctionRoot(ZeroProblem* problem, const Vector& u_a,
       break;
     }
     if ((f < 0.0) == (f_lo < 0.0)) {
-      lo = sigma, f_lo = f;
+      lo = sigma, f_lo = g_lo = f;
       if (side == -1) f_hi *= 0.5;
       side = -1;
     } else {
-      hi = sigma, f_hi = f;
+      hi = sigma, f_hi = g_hi = f;
       if (side == +1) f_lo *= 0.5;
       side = +1;
     }
@@ -93,6 +94,11 @@ TestFunctionRoot LocateTestFunctionRoot(ZeroProblem* problem, const Vector& u_a,
   root.precision = (hi - lo) * chord.norm();
   root.located = hi - lo <= options.sigma_tolerance;
   if (!root.located && root.message.empty()) root.message = "iteration budget exhausted";
+  // The flatter of the secants over the chord and over the final bracket (as RootLocation::slope).
+  if (hi > lo) {
+    const double local = (g_hi - g_lo) / ((hi - lo) * chord.norm());
+    if (std::abs(local) < std::abs(slope)) slope = local;
+  }
   if (options.refined_test) AddIntegrationError(problem, chord, slope, value, options.refined_test, &root);
   return root;
 }

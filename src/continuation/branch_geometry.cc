@@ -266,6 +266,11 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
     out.test = use_hi ? g_hi : g_lo;
     out.u_lo = lo_probe.u;
     out.u_hi = hi_probe.u;
+    // The flatter of the segment's secant and the final bracket's (RootLocation::slope).
+    if (hi > lo && g_lo != 0 && g_hi != 0 && std::signbit(g_lo) != std::signbit(g_hi)) {
+      const double local = (g_hi - g_lo) / (hi - lo);
+      if (std::abs(local) < std::abs(out.slope)) out.slope = local;
+    }
     return out;
   };
   if (g_lo != 0 && g_hi != 0 && std::signbit(g_lo) == std::signbit(g_hi)) {
@@ -320,7 +325,7 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
         out.message = "located to the noise level: a trial point inside the bracket has |r| = " +
                       FormatShort(probe.residual) + " before any correction, and Newton's correction of that " +
                       "noise is not small against the bracket (the precision is the bracket widened by " +
-                      "four times its width, or that correction if larger, on both sides)";
+                      "four times its width, or that correction if larger, on both sides: an estimate, not a bound)";
         // The bracket ends are themselves points accepted inside the noise: near the SB they scatter
         // across both branches, and an end on the crossing branch carries a test value of the wrong sign.
         // The SB is then only known to lie within a few bracket widths (or the scatter) of the bracket.

@@ -438,25 +438,31 @@ class ContinuationStepper::Impl {
         locate(SpecialPointType::kTurningPoint, k, [k](const internal::Segment::Probe& p) { return p.tangent(k); });
       }
     }
-    // A turning point inside the interval of an SB point of the same step cannot be told apart from it:
-    // the tangent, and so τ_k, is undefined at the SB point and next to it set by the noise (SLIP: on
-    // branch 18 a turning point 1.2e-9 before the SB point where the branch passes the zero-duration
-    // family, on the SB point itself at 10x the tolerances). Its interval is widened to hold the SB's.
+    // A turning point inside the interval of an SB point of the same step, or closer to it than
+    // kCoincidence of the step, cannot be told apart from it: the tangent, and so τ_k, is undefined at
+    // the SB point and next to it set by the noise (SLIP: on branch 18, where the branch passes the
+    // zero-duration family, the turning point lands 1.2e-9 before the SB point or on it, depending on the
+    // tolerances, and at rtol 1e-12 the SB's interval is narrower than that). Its interval is widened to
+    // hold the SB point's.
+    const double step = b.arclength - a.arclength;
     for (const SpecialPoint& sb : found) {
       if (sb.type != SpecialPointType::kSimpleBifurcation) continue;
       for (SpecialPoint& tp : found) {
-        if (tp.type != SpecialPointType::kTurningPoint || tp.arclength < sb.interval_lo ||
-            tp.arclength > sb.interval_hi) {
+        const bool inside = tp.arclength >= sb.interval_lo && tp.arclength <= sb.interval_hi;
+        if (tp.type != SpecialPointType::kTurningPoint ||
+            !(inside || std::abs(tp.arclength - sb.arclength) <= kCoincidence * step)) {
           continue;
         }
-        tp.interval_lo = std::min(tp.interval_lo, sb.interval_lo);
-        tp.interval_hi = std::max(tp.interval_hi, sb.interval_hi);
+        const double distance = std::abs(tp.arclength - sb.arclength);
+        tp.interval_lo = std::min({tp.interval_lo, sb.interval_lo, tp.arclength - distance});
+        tp.interval_hi = std::max({tp.interval_hi, sb.interval_hi, tp.arclength + distance});
         if (tp.interval_width.size() == sb.interval_width.size() && tp.u.size() == sb.u.size()) {
           tp.interval_width = tp.interval_width.cwiseMax(sb.interval_width + 2 * (tp.u - sb.u).cwiseAbs());
         }
         if (!tp.message.empty()) tp.message += "; ";
-        tp.message += "inside the interval of the simple bifurcation point at s = " + std::to_string(sb.arclength) +
-                      ", where the tangent is undefined: located only as well as that point";
+        tp.message += "at the simple bifurcation point at s = " + std::to_string(sb.arclength) +
+                      " (within its interval or 1e-6 of the step), where the tangent is undefined: located " +
+                      "only as well as that point";
       }
     }
     std::sort(found.begin(), found.end(),
@@ -478,15 +484,22 @@ class ContinuationStepper::Impl {
     constexpr double kFactor = ContinuationOptions::kIntegrationErrorFactor;
     constexpr double kSafety = ContinuationOptions::kIntegrationErrorSafety;
     const std::unique_ptr<ZeroProblem> refined = problem_->Refined(kFactor);
-    if (refined == nullptr || root.estimate.u.size() != problem_->num_unknowns() || !(root.slope != 0)) return;
+    if (refined == nullptr) return;  // exact to rounding: the bracket is the precision
+    const auto not_estimated = [point](const std::string& why) {
+      if (!point->message.empty()) point->message += "; ";
+      point->message += "integration error not estimated (" + why + "): the precision is the bracket's";
+    };
+    if (root.estimate.u.size() != problem_->num_unknowns() || !(root.slope != 0)) {
+      return not_estimated("no test function slope");
+    }
     internal::Segment::Probe fine;
     Vector du;
     const bool ok = segment->RefinedProbe(refined.get(), root.estimate, &fine, &du);
     problem_->AddWorkOf(*refined);
-    if (!ok) return;
+    if (!ok) return not_estimated("the evaluation at 0.1x the tolerances failed");
     du *= kSafety / (1 - kFactor);
     const double ds = kSafety * std::abs(test(fine) - root.test) / ((1 - kFactor) * std::abs(root.slope));
-    if (!std::isfinite(ds)) return;
+    if (!std::isfinite(ds)) return not_estimated("not finite");
     const Vector tangent = point->tangent.size() == du.size() ? point->tangent : root.estimate.tangent;
     const Vector spread = 2 * (tangent.cwiseAbs() * ds + du.cwiseAbs());
     const double bracket = point->precision();
@@ -496,7 +509,7 @@ class ContinuationStepper::Impl {
     point->interval_lo = std::min(point->interval_lo, point->arclength - reach);
     point->interval_hi = std::max(point->interval_hi, point->arclength + reach);
     if (point->interval_width.size() == spread.size()) point->interval_width = point->interval_width.cwiseMax(spread);
-    if (2 * reach > bracket) {
+    if (point->precision() > bracket) {
       char text[640];
       std::snprintf(text, sizeof(text),
                     "integration error: evaluated with %gx the tolerances the test function moves by %.2g "
@@ -535,6 +548,9 @@ class ContinuationStepper::Impl {
   static constexpr double kFailedStepMargin = 0.75;
   static constexpr double kFailedStepRelease = 1.1;
   static constexpr double kFailedStepMemory = 4;
+  // A turning point this close to an SB point of the same step, relative to the step, is taken to be at
+  // it (DetectSpecialPoints).
+  static constexpr double kCoincidence = 1e-6;
   bool start_singular_ = false;
 };
 
