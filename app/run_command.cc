@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -106,9 +107,12 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
     const double H = sp.u.size() ? sp.u(layout.H_index()) : std::nan("");
     const double precision_H = sp.interval_width.size() ? sp.interval_width(layout.H_index()) : std::nan("");
     // "precision": the width of the interval that holds the point, as a distance in u (model units), like
-    // the Floquet points' (LocateFloquetPoints); "precision_arclength": the same interval along the branch
-    // in the engine's scaled arclength (SpecialPoint::precision()).
-    const double precision_u = sp.interval_width.size() ? sp.interval_width.norm() : sp.precision();
+    // the Floquet points' (LocateFloquetPoints); state-based runs know the widths of their own unknowns
+    // only (x̄_1, ξ, H̄; NaN for the rest). "precision_arclength": the same interval along the branch in
+    // the engine's scaled arclength (SpecialPoint::precision()).
+    const double precision_u =
+        sp.interval_width.size() ? sp.interval_width.array().isNaN().select(0.0, sp.interval_width.array()).matrix().norm()
+                                 : sp.precision();
     nlohmann::json j = {{"id", sp.id},
                         {"type", SpecialPointTypeCode(sp.type)},
                         {"branch", sp.branch_id},
@@ -361,11 +365,22 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
       if (u->size() && exploration->ToTimeBased(*u, &u_time).ok) *u = u_time;
       else *u = Vector::Constant(layout.num_unknowns(), std::nan(""));
     };
+    // Widths of the unknowns both layouts have (x̄_1, ξ, H̄: the same names), NaN for the others.
+    const std::vector<std::string> state_names = diagram.unknown_names, time_names = layout.unknown_names();
+    const auto convert_width = [&](Vector* width) {
+      if (width->size() != static_cast<Eigen::Index>(state_names.size())) return width->resize(0);
+      Vector w = Vector::Constant(layout.num_unknowns(), std::nan(""));
+      for (size_t i = 0; i < state_names.size(); ++i) {
+        const auto it = std::find(time_names.begin(), time_names.end(), state_names[i]);
+        if (it != time_names.end()) w(it - time_names.begin()) = (*width)(static_cast<Eigen::Index>(i));
+      }
+      *width = w;
+    };
     for (Branch& b : diagram.branches) {
       for (ContinuationPoint& p : b.points) convert(&p.u), p.tangent.resize(0);
-      for (SpecialPoint& sp : b.special_points) convert(&sp.u), sp.interval_width.resize(0);
+      for (SpecialPoint& sp : b.special_points) convert(&sp.u), convert_width(&sp.interval_width);
     }
-    for (SpecialPoint& sp : diagram.special_points) convert(&sp.u), sp.interval_width.resize(0);
+    for (SpecialPoint& sp : diagram.special_points) convert(&sp.u), convert_width(&sp.interval_width);
     diagram.unknown_names = layout.unknown_names();
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();

@@ -186,7 +186,14 @@ TEST(Cli, SlipSimpleBifurcationsAreFloquetCrossingsInBothFormulations) {
       if (sp["type"] == "BP" || sp["type"] == "PD") {
         EXPECT_TRUE(sp["index"] != 0 || summary["branches"][sp["branch"].get<int>()]["parent"] == -1) << sp.dump();
       }
-      if (sp["type"] == "SB" && sp["status"] == "located") sb.push_back(sp["H"]);
+      if (sp["type"] == "SB" && sp["status"] == "located") {
+        sb.push_back(sp["H"]);
+        // Precision in model units, integration error included, in both formulations (the state-based
+        // one knows the widths of x̄_1, ξ and H̄): at least the width in H, and small here.
+        EXPECT_GE(sp["precision"].get<double>(), sp["precision_H"].get<double>()) << sp.dump();
+        EXPECT_GT(sp["precision_H"].get<double>(), 0.0) << sp.dump();
+        EXPECT_LT(sp["precision"].get<double>(), 1e-8) << sp.dump();
+      }
       if (sp["type"] == "BP") bp.push_back(sp["H"]);
       if (sp["type"] == "PD") pd.push_back(sp["H"]);
     }
