@@ -383,8 +383,6 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     for (SpecialPoint& sp : diagram.special_points) convert(&sp.u), convert_width(&sp.interval_width);
     diagram.unknown_names = layout.unknown_names();
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-
   // ---- 3. summary, key-frame orbits, report, figures
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
   nlohmann::json special_points = SpecialPointsJson(diagram, layout);
@@ -411,9 +409,16 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     writer.AddOrbit(trace, b.id, best, u(layout.H_index()), layout.Period(u), sc.describe(u));
     ++orbits;
   }
+  // Wall time of the whole computation (exploration, classification and replays, Floquet multipliers and
+  // their crossings, key-frame orbits) before any file is written; the work of the exploration and of the
+  // Floquet multipliers.
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   const std::string report =
-      diagram.FullReport() + floquet_report + fmt::format("\nwall time {:.3f} s, {} right-hand-side evaluations in {} map evaluations\n",
-                                         seconds, exploration->counters().rhs_evaluations, exploration->num_evaluations());
+      diagram.FullReport() + floquet_report +
+      fmt::format("\nwall time {:.3f} s, {} right-hand-side evaluations in {} map evaluations; Floquet multipliers "
+                  "and their crossings: {} in {}\n",
+                  seconds, exploration->counters().rhs_evaluations, exploration->num_evaluations(),
+                  floquet_map.counters().rhs_evaluations, floquet_map.num_evaluations());
   writer.SetReport(report);
   writer.WriteSummary();
   out << report;
