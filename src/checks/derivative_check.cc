@@ -165,8 +165,9 @@ class Checker {
           *out = g.row(j).transpose();
           return out->allFinite();
         }, x, o_.model_step, &ok);
-        Record(tag + "d2H/dx2" + (k > 1 ? "[" + std::to_string(j + 1) + "]" : ""), o_.model_tolerance, d2H[j], fd,
-               ok);
+        // (std::string(...).append: GCC 12 warns, a false positive, on "literal" + std::string&&)
+        const std::string index = k > 1 ? std::string("[").append(std::to_string(j + 1)).append("]") : "";
+        Record(tag + "d2H/dx2" + index, o_.model_tolerance, d2H[j], fd, ok);
       }
       // flow sensitivities with xi != 0 and a duration of either sign
       const double t = Uniform(-o_.max_duration, o_.max_duration);

@@ -14,8 +14,11 @@ ShootingLayout::ShootingLayout(const HybridModel& model) : k_(model.num_first_in
   int row = 0;
   for (int i = m; i >= 0; --i) {
     time_index_[i] = col;
-    names_.push_back("t" + std::to_string(i + 1));
-    for (const std::string& s : model.phase(i).state_names()) names_.push_back("x" + std::to_string(i + 1) + "_" + s);
+    // std::string(...).append: GCC 12 warns (-Wrestrict, a false positive) on "literal" + std::string&&.
+    names_.push_back(std::string("t").append(std::to_string(i + 1)));
+    for (const std::string& s : model.phase(i).state_names()) {
+      names_.push_back(std::string("x").append(std::to_string(i + 1)).append("_").append(s));
+    }
     col += 1 + dims_[i];
     block_row_[i] = row;
     row += dims_[(i + 1) % (m + 1)] + 1;
