@@ -190,6 +190,9 @@ struct ContinuationOptions {
   // (an adaptive step sequence changes with them). Measured: 1.0x the true error on a curve whose error
   // is exactly proportional to its tolerance, 0.4–0.9x on the SLIP across tolerances x0.03 to x3.
   static constexpr double kIntegrationErrorSafety = 2;
+  // What turns the change a refined evaluation shows into the bound: safety over the part (1 − factor)
+  // of the error the change is (errors proportional to the tolerances).
+  static constexpr double kIntegrationErrorScale = kIntegrationErrorSafety / (1 - kIntegrationErrorFactor);
   std::vector<ComponentBound> bounds;
   std::vector<ComponentTarget> targets;
   std::vector<SumBound> sum_bounds;

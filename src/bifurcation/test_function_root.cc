@@ -10,14 +10,12 @@
 namespace hybridcont {
 namespace {
 
-// TestFunctionRootOptions::refined_test, with the factor and safety of the continuation's special points
-// (ContinuationOptions): with errors proportional to the tolerances, the refined change of a quantity is
-// (1 − factor) of its error at the problem's own tolerances.
+// TestFunctionRootOptions::refined_test, with the factor and scale of the continuation's special points
+// (ContinuationOptions::kIntegrationErrorScale).
 void AddIntegrationError(ZeroProblem* problem, const Vector& chord, double slope, double value,
                          const std::function<double(ZeroProblem&, const Vector&)>& refined_test,
                          TestFunctionRoot* root) {
   constexpr double kFactor = ContinuationOptions::kIntegrationErrorFactor;
-  constexpr double kSafety = ContinuationOptions::kIntegrationErrorSafety;
   const std::unique_ptr<ZeroProblem> refined = problem->Refined(kFactor);
   if (refined == nullptr || !(slope != 0)) return;
   Corrector corrector(refined.get());
@@ -28,7 +26,7 @@ void AddIntegrationError(ZeroProblem* problem, const Vector& chord, double slope
   if (!std::isfinite(refined_value)) return;
   const double along = std::abs(refined_value - value) / std::abs(slope);
   const double off = (u - root->u).norm();
-  const double reach = kSafety / (1 - kFactor) * (along + off);
+  const double reach = ContinuationOptions::kIntegrationErrorScale * (along + off);
   if (2 * reach <= root->precision) return;
   char text[256];
   std::snprintf(text, sizeof(text),

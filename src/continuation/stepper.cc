@@ -460,9 +460,10 @@ class ContinuationStepper::Impl {
           tp.interval_width = tp.interval_width.cwiseMax(sb.interval_width + 2 * (tp.u - sb.u).cwiseAbs());
         }
         if (!tp.message.empty()) tp.message += "; ";
-        tp.message += "at the simple bifurcation point at s = " + std::to_string(sb.arclength) +
-                      " (within its interval or 1e-6 of the step), where the tangent is undefined: located " +
-                      "only as well as that point";
+        std::ostringstream text;
+        text << "at the simple bifurcation point at s = " << sb.arclength << " (within its interval or "
+             << kCoincidence << " of the step), where the tangent is undefined: located only as well as that point";
+        tp.message += text.str();
       }
     }
     std::sort(found.begin(), found.end(),
@@ -482,7 +483,7 @@ class ContinuationStepper::Impl {
   void AddIntegrationError(internal::Segment* segment, const internal::RootLocation& root,
                            const std::function<double(const internal::Segment::Probe&)>& test, SpecialPoint* point) {
     constexpr double kFactor = ContinuationOptions::kIntegrationErrorFactor;
-    constexpr double kSafety = ContinuationOptions::kIntegrationErrorSafety;
+    constexpr double kScale = ContinuationOptions::kIntegrationErrorScale;
     const std::unique_ptr<ZeroProblem> refined = problem_->Refined(kFactor);
     if (refined == nullptr) return;  // exact to rounding: the bracket is the precision
     const auto not_estimated = [point](const std::string& why) {
@@ -497,8 +498,9 @@ class ContinuationStepper::Impl {
     const bool ok = segment->RefinedProbe(refined.get(), root.estimate, &fine, &du);
     problem_->AddWorkOf(*refined);
     if (!ok) return not_estimated("the evaluation at 0.1x the tolerances failed");
-    du *= kSafety / (1 - kFactor);
-    const double ds = kSafety * std::abs(test(fine) - root.test) / ((1 - kFactor) * std::abs(root.slope));
+    const double change = std::abs(test(fine) - root.test), refined_step = du.norm();
+    du *= kScale;
+    const double ds = kScale * change / std::abs(root.slope);
     if (!std::isfinite(ds)) return not_estimated("not finite");
     const Vector tangent = point->tangent.size() == du.size() ? point->tangent : root.estimate.tangent;
     const Vector spread = 2 * (tangent.cwiseAbs() * ds + du.cwiseAbs());
@@ -515,8 +517,7 @@ class ContinuationStepper::Impl {
                     "integration error: evaluated with %gx the tolerances the test function moves by %.2g "
                     "(slope %.2g along the branch) and Newton by %.2g, so the root may lie %.2g away along "
                     "the branch and the point %.2g off it (twice the estimate; precision %.2g, the bracket was %.2g)",
-                    kFactor, std::abs(test(fine) - root.test), std::abs(root.slope), du.norm() * (1 - kFactor) / kSafety,
-                    ds, du.norm(), point->precision(), bracket);
+                    kFactor, change, std::abs(root.slope), refined_step, ds, du.norm(), point->precision(), bracket);
       if (!point->message.empty()) point->message += "; ";
       point->message += text;
     }
