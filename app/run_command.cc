@@ -410,13 +410,13 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     ++orbits;
   }
   // Wall time of the whole computation (exploration, classification and replays, Floquet multipliers and
-  // their crossings, key-frame orbits) before any file is written; the work of the exploration and of the
-  // Floquet multipliers.
+  // their crossings, key-frame orbits, and the branch and orbit files written on the way), before the
+  // summary, report and figures; the work of the exploration and of the Floquet multipliers.
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   const std::string report =
       diagram.FullReport() + floquet_report +
       fmt::format("\nwall time {:.3f} s, {} right-hand-side evaluations in {} map evaluations; Floquet multipliers "
-                  "and their crossings: {} in {}\n",
+                  "and their crossings: {} right-hand-side evaluations in {} map evaluations\n",
                   seconds, exploration->counters().rhs_evaluations, exploration->num_evaluations(),
                   floquet_map.counters().rhs_evaluations, floquet_map.num_evaluations());
   writer.SetReport(report);

@@ -39,8 +39,8 @@
 //
 // Integration error (ContinuationOptions::check_integration_error, on by default): the bracket is where
 // the root of the *computed* test function lies. A shooting map is computed with integration error, and
-// a point where the curve is badly conditioned (the SLIP's loop near T = 0: dr has singular values down to
-// 6e-6 next to 0.5) amplifies it in the tangent and so in the test function. After locating, the estimate
+// a point where the curve is badly conditioned (next to another singular point, near a family of
+// solutions) amplifies it in the tangent and so in the test function. After locating, the estimate
 // is evaluated again with the problem's refined copy (ZeroProblem::Refined: integration tolerances × 0.1).
 // With errors proportional to the tolerances, the change Δg of the test function is 0.9 of its error;
 // δs = 2|Δg| / (0.9 |slope|) is how far the exact root may lie along the branch (slope: the flatter of the
@@ -48,15 +48,18 @@
 // errors are only roughly proportional to the tolerances), and twice the refined Newton correction δu/0.9
 // how far the exact curve may lie from u. The interval grows to s ± (δs + |δu|) where that is wider,
 // interval_width to 2(|τ_i| δs + |δu_i|), and the message says so (also when the check could not be
-// made). A turning point at an SB point of the same step (within its interval or 1e-6 of the step) takes
-// the SB point's interval: the tangent is undefined there.
+// made). A turning point at an SB point of the same step (within its interval or 1e-4 of the step) has
+// no meaningful test of its own, the tangent being undefined there: it keeps its bracket and takes the SB
+// point's interval and their distance.
 // Measured on the SLIP (session 6): regular turning and SB points are good to 1e-11..5e-10 in arclength
-// (the bracket alone said 2.5e-12), the loop's turning point near T = 0 to ~3e-4 (it said 2.5e-12); a
-// test explores again at 0.1x the tolerances and finds every point within the two runs' intervals (so do
-// x0.3, x3, x0.03, x0.01 in norm). Points located to the noise level are the exception: their interval
-// (the bracket widened by kNoiseMargin = 4 widths) is an estimate, not a bound; between pairs of
-// tolerances from x3 to x0.01 four of the SLIP's 42 points (the loop's noise-limited turning point, the
-// SB of the crossing cluster near H̄ = 1.6115) moved by up to 2.9x what the two intervals allow.
+// (the bracket alone said 2.5e-12), the SB point where branch 18 passes the zero-duration family to
+// 1.2e-7, the turning point at the closed loop's reflection midpoint (an SB point too) to 3.8e-6 (all
+// said 2.5e-12); a test explores again at 0.1x the tolerances and finds every point within the two runs'
+// intervals (so do x0.3, x3, x0.03, x0.01 in norm). Points located to the noise level are the exception:
+// their interval (the bracket widened by kNoiseMargin = 4 widths) is an estimate, not a bound; between
+// pairs of tolerances from x3 to x0.01 four of the SLIP's 42 points (the loop's noise-limited turning
+// point near T = 0, the SB of the crossing cluster near H̄ = 1.6115) moved by up to 2.9x what the two
+// intervals allow.
 // Problems exact to rounding (algebraic ones) have no refined copy: their precision is the bracket's.
 //
 // Tangent of an SB point: the induced tangent is undefined there and next to it numerically meaningless

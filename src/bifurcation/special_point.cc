@@ -30,7 +30,7 @@ std::string SpecialPoint::BriefReport(const std::vector<std::string>& names) con
     out << u(i);
   }
   out.precision(3);
-  out << "), precision " << precision() << ", |r| = " << residual_norm;
+  out << "), precision " << precision() << " in arclength, |r| = " << residual_norm;
   if (duplicate_of >= 0) out << ", same as #" << duplicate_of;
   if (!message.empty()) out << " [" << message << "]";
   return out.str();

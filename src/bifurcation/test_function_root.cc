@@ -76,6 +76,11 @@ TestFunctionRoot LocateTestFunctionRoot(ZeroProblem* problem, const Vector& u_a,
     root.sigma = sigma;
     value = f;
     if (f == 0.0) {
+      // Exactly on the root: the slope from the bracket just before, as below.
+      for (const auto& [end, end_value] : {std::pair{lo, g_lo}, std::pair{hi, g_hi}}) {
+        const double local = end_value / ((end - sigma) * chord.norm());
+        if (end != sigma && std::abs(local) < std::abs(slope)) slope = local;
+      }
       lo = hi = sigma;
       break;
     }

@@ -347,7 +347,14 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
     out.iterations = it;
     const double g = test(probe);
     if (g == 0) {
+      // Exactly on the root: the slope from the bracket just before (RootLocation::slope), then a
+      // one-point bracket whose test value is that 0.
+      for (const auto& [end, value] : {std::pair{lo, g_lo}, std::pair{hi, g_hi}}) {
+        const double local = value / (end - x);
+        if (end != x && std::abs(local) < std::abs(out.slope)) out.slope = local;
+      }
       lo = hi = x;
+      g_lo = g_hi = 0;
       lo_probe = hi_probe = probe;
       return finish(true);
     }

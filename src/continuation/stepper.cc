@@ -393,6 +393,7 @@ class ContinuationStepper::Impl {
     const ContinuationPoint& a = branch_.points[index];
     const ContinuationPoint& b = branch_.points[index + 1];
     std::vector<SpecialPoint> found;
+    std::vector<SpecialPoint> bracket_only;  // each found point as its root finder left it
     auto locate = [&](SpecialPointType type, int k, const std::function<double(const internal::Segment::Probe&)>& test) {
       internal::Segment segment(&corrector_, &solver_, problem_, a, b, type == SpecialPointType::kSimpleBifurcation);
       const internal::RootLocation root =
@@ -422,10 +423,15 @@ class ContinuationStepper::Impl {
       point.residual_norm = root.estimate.residual;
       point.iterations = root.iterations;
       point.message = root.message;
-      if (options_.check_integration_error) AddIntegrationError(&segment, root, test, &point);
       // An interval wider than the bracket (noise-limited locations widen it, AddIntegrationError may):
       // the components vary over all of it.
-      point.interval_width = point.interval_width.cwiseMax(point.tangent.cwiseAbs() * point.precision());
+      const auto cover = [](SpecialPoint* p) {
+        p->interval_width = p->interval_width.cwiseMax(p->tangent.cwiseAbs() * p->precision());
+      };
+      cover(&point);
+      bracket_only.push_back(point);
+      if (options_.check_integration_error) AddIntegrationError(&segment, root, test, &point);
+      cover(&point);
       branch_.located_iterations += root.iterations;
       found.push_back(std::move(point));
     };
@@ -438,32 +444,40 @@ class ContinuationStepper::Impl {
         locate(SpecialPointType::kTurningPoint, k, [k](const internal::Segment::Probe& p) { return p.tangent(k); });
       }
     }
-    // A turning point inside the interval of an SB point of the same step, or closer to it than
-    // kCoincidence of the step, cannot be told apart from it: the tangent, and so τ_k, is undefined at
-    // the SB point and next to it set by the noise (SLIP: on branch 18, where the branch passes the
-    // zero-duration family, the turning point lands 1.2e-9 before the SB point or on it, depending on the
-    // tolerances, and at rtol 1e-12 the SB's interval is narrower than that). Its interval is widened to
-    // hold the SB point's.
+    // A turning point at an SB point of the same step cannot be told apart from it: the tangent, and so
+    // τ_k, is undefined at the SB point and next to it set by the noise, and so is the turning point's
+    // own integration-error estimate (on the SLIP with w2 = 12 the refined τ flipped and claimed an error
+    // of 2 in arclength). "At" means inside the SB point's interval or closer than kCoincidence of the
+    // step (SLIP: on branch 18, where the branch passes the zero-duration family, the turning point lands
+    // 1.2e-9 before the SB point or on it, depending on the tolerances, and at rtol 1e-12 the SB's
+    // interval is narrower than that; at the closed loop's reflection midpoint the two are 1.9e-6 apart,
+    // 1e-5 of the step, with H̄ equal to 1e-13). Such a turning point keeps its root finder's bracket and
+    // takes the SB point's interval and their distance on both sides instead of its own estimate.
     const double step = b.arclength - a.arclength;
     for (const SpecialPoint& sb : found) {
       if (sb.type != SpecialPointType::kSimpleBifurcation) continue;
-      for (SpecialPoint& tp : found) {
-        const bool inside = tp.arclength >= sb.interval_lo && tp.arclength <= sb.interval_hi;
-        if (tp.type != SpecialPointType::kTurningPoint ||
-            !(inside || std::abs(tp.arclength - sb.arclength) <= kCoincidence * step)) {
-          continue;
-        }
+      for (size_t i = 0; i < found.size(); ++i) {
+        SpecialPoint& tp = found[i];
         const double distance = std::abs(tp.arclength - sb.arclength);
-        tp.interval_lo = std::min({tp.interval_lo, sb.interval_lo, tp.arclength - distance});
-        tp.interval_hi = std::max({tp.interval_hi, sb.interval_hi, tp.arclength + distance});
-        if (tp.interval_width.size() == sb.interval_width.size() && tp.u.size() == sb.u.size()) {
-          tp.interval_width = tp.interval_width.cwiseMax(sb.interval_width + 2 * (tp.u - sb.u).cwiseAbs());
+        const bool inside = tp.arclength >= sb.interval_lo && tp.arclength <= sb.interval_hi;
+        if (tp.type != SpecialPointType::kTurningPoint || !(inside || distance <= kCoincidence * step)) continue;
+        const SpecialPoint& bracket = bracket_only[i];
+        tp.interval_lo = std::min({bracket.interval_lo, sb.interval_lo, tp.arclength - distance});
+        tp.interval_hi = std::max({bracket.interval_hi, sb.interval_hi, tp.arclength + distance});
+        if (bracket.interval_width.size() == sb.interval_width.size() && tp.u.size() == sb.u.size()) {
+          tp.interval_width = bracket.interval_width.cwiseMax(sb.interval_width + 2 * (tp.u - sb.u).cwiseAbs());
         }
-        if (!tp.message.empty()) tp.message += "; ";
         std::ostringstream text;
-        text << "at the simple bifurcation point at s = " << sb.arclength << " (within its interval or "
-             << kCoincidence << " of the step), where the tangent is undefined: located only as well as that point";
-        tp.message += text.str();
+        text.precision(12);
+        text << "at the simple bifurcation point at s = " << sb.arclength << " (";
+        if (inside) {
+          text << "inside its interval";
+        } else {
+          text << "closer than " << kCoincidence << " of the step";
+        }
+        text << "), where the tangent is undefined: located as well as that point, its own integration-error "
+             << "estimate is meaningless there";
+        tp.message = bracket.message.empty() ? text.str() : bracket.message + "; " + text.str();
       }
     }
     std::sort(found.begin(), found.end(),
@@ -551,7 +565,7 @@ class ContinuationStepper::Impl {
   static constexpr double kFailedStepMemory = 4;
   // A turning point this close to an SB point of the same step, relative to the step, is taken to be at
   // it (DetectSpecialPoints).
-  static constexpr double kCoincidence = 1e-6;
+  static constexpr double kCoincidence = 1e-4;
   bool start_singular_ = false;
 };
 
