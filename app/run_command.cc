@@ -224,6 +224,13 @@ std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::ma
                             {"T", layout.Period(root.u)},
                             {"status", root.located ? "located" : "bracketed"},
                             {"precision", root.precision},
+                            // the same fields as the continuation's points: the width in H is bounded by
+                            // the distance in u; an arclength, residual and component they do not have
+                            {"precision_arclength", nullptr},
+                            {"precision_H", root.precision},
+                            {"residual", nullptr},
+                            {"component", ""},
+                            {"duplicate_of", -1},
                             {"message", root.message}};
         j["u"] = std::vector<double>(root.u.data(), root.u.data() + root.u.size());
         special_points->push_back(j);

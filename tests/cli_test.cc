@@ -182,6 +182,11 @@ TEST(Cli, SlipSimpleBifurcationsAreFloquetCrossingsInBothFormulations) {
     const nlohmann::json summary = nlohmann::json::parse(summary_file);
     std::vector<double> sb, bp, pd;
     for (const auto& sp : summary["special_points"]) {
+      // One schema for every kind of special point (continuation's SB/TP/start, Floquet BP/PD).
+      for (const char* key : {"id", "type", "branch", "index", "H", "T", "status", "precision", "precision_arclength",
+                              "precision_H", "residual", "component", "duplicate_of", "message", "u"}) {
+        EXPECT_TRUE(sp.contains(key)) << key << " missing in " << sp.dump();
+      }
       // A branch leaving a bifurcation point does not report that point again (its first interval).
       if (sp["type"] == "BP" || sp["type"] == "PD") {
         EXPECT_TRUE(sp["index"] != 0 || summary["branches"][sp["branch"].get<int>()]["parent"] == -1) << sp.dump();
