@@ -205,15 +205,15 @@ std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::ma
       const auto it = tests->find(b.id);
       if (it == tests->end()) continue;
       const std::vector<double>& values = it->second;
-      const auto test = [&, type = std::string(type)](const Vector& u) {
-        const FloquetResult f = ComputeFloquet(map, u);
+      const auto floquet_test = [type = std::string(type)](TimeBasedShooting& shooting, const Vector& u) {
+        const FloquetResult f = ComputeFloquet(shooting, u);
         return f.ok() ? (type == "BP" ? f.bp_test : f.pd_test) : std::nan("");
       };
+      const auto test = [&](const Vector& u) { return floquet_test(map, u); };
       const auto locate = [&](std::size_t i, const Vector& u_a, const Vector& u_b) {
         TestFunctionRootOptions options;
-        options.refined_test = [type = std::string(type)](ZeroProblem& refined, const Vector& u) {
-          const FloquetResult f = ComputeFloquet(dynamic_cast<TimeBasedShooting&>(refined), u);
-          return f.ok() ? (type == "BP" ? f.bp_test : f.pd_test) : std::nan("");
+        options.refined_test = [&](ZeroProblem& refined, const Vector& u) {
+          return floquet_test(dynamic_cast<TimeBasedShooting&>(refined), u);  // Refined keeps the type
         };
         const TestFunctionRoot root = LocateTestFunctionRoot(&map, u_a, u_b, test, options);
         nlohmann::json j = {{"id", static_cast<int>(special_points->size())},

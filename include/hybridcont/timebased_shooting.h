@@ -118,6 +118,8 @@ class TimeBasedShooting : public ZeroProblem {
   }
 
  private:
+  // A single-threaded copy with the same model and fixed levels and these integrator options.
+  std::unique_ptr<TimeBasedShooting> CopyWith(const IntegratorOptions& options) const;
   EvaluationStatus Integrate(const Vector& u, bool sensitivities);
   // r and the blocks of dr (eq. multishootJacobian) into a sink: dense matrix or triplets.
   template <class Sink>

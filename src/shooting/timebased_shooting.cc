@@ -56,10 +56,15 @@ std::vector<Symmetry> TimeBasedShooting::symmetries() const {
   return SymmetryGroup(generators);
 }
 
+std::unique_ptr<TimeBasedShooting> TimeBasedShooting::CopyWith(const IntegratorOptions& options) const {
+  auto copy = std::make_unique<TimeBasedShooting>(*model_, options);
+  copy->SetFixedLevels(fixed_levels_);
+  copy->set_threads(1);
+  return copy;
+}
+
 std::unique_ptr<ZeroProblem> TimeBasedShooting::Clone() const {
-  auto clone = std::make_unique<TimeBasedShooting>(*model_, options_);
-  clone->SetFixedLevels(fixed_levels_);
-  clone->set_threads(1);
+  auto clone = CopyWith(options_);
   clone->set_jacobian_tolerance(jacobian_tolerance_);  // the same zero set and the same accuracy
   return clone;
 }
@@ -68,10 +73,7 @@ std::unique_ptr<ZeroProblem> TimeBasedShooting::Refined(double factor) const {
   IntegratorOptions options = options_;
   options.rtol *= factor;
   options.atol *= factor;
-  auto clone = std::make_unique<TimeBasedShooting>(*model_, options);
-  clone->SetFixedLevels(fixed_levels_);
-  clone->set_threads(1);
-  return clone;
+  return CopyWith(options);  // exact Jacobian (tolerance 0)
 }
 
 void TimeBasedShooting::AddWorkOf(const ZeroProblem& clone) {
