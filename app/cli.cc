@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "hybridcont/models.h"
+#include "install_paths.h"
 
 namespace hybridcont::app {
 
@@ -14,6 +15,14 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
   CLI::App app{"hybridcont: families of periodic orbits of conservative hybrid systems"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "hybridcont 0.1.0");
+  app.add_flag_callback(
+      "--paths",
+      [&out] {
+        const auto shown = [](const std::filesystem::path& p) { return p.empty() ? "(not found)" : p.string(); };
+        out << "plot script: " << shown(PlotScriptPath()) << "\nmodels: " << shown(ModelsDirectory()) << "\n";
+        throw CLI::Success();  // like --version: print and exit 0, no subcommand needed
+      },
+      "print the figure script and the model folder this executable uses, and exit");
 
   auto* list = app.add_subcommand("list", "list the built-in models with phases, dimensions and parameters");
 

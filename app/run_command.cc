@@ -23,6 +23,7 @@
 #include "hybridcont/test_function_root.h"
 #include "hybridcont/models.h"
 #include "hybridcont/timebased_shooting.h"
+#include "install_paths.h"
 #include "model_exploration.h"
 #include "model_options.h"
 #include "results_writer.h"
@@ -135,15 +136,14 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
 
 // Runs the figure script on dir; returns its exit code (non-zero if python/matplotlib is missing).
 int DrawFigures(const fs::path& dir, std::ostream& err) {
-  std::string script = HYBRIDCONT_SOURCE_PLOT_SCRIPT;
-  if (!fs::exists(script)) script = HYBRIDCONT_INSTALLED_PLOT_SCRIPT;
-  if (!fs::exists(script)) {
-    err << "warning: figure script not found; results are saved, figures skipped\n";
+  const fs::path script = PlotScriptPath();  // install_paths.h: this executable's own script
+  if (script.empty()) {
+    err << "warning: figure script not found (see `hybridcont --paths`); results are saved, figures skipped\n";
     return 1;
   }
   // Debian's python3 carries matplotlib (python3-matplotlib); prefer it over other pythons on PATH.
   const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string command = python + " '" + script + "' '" + dir.string() + "' > '" +
+  const std::string command = python + " '" + script.string() + "' '" + dir.string() + "' > '" +
                               (dir / "plot.log").string() + "' 2>&1";
   const int rc = std::system(command.c_str());
   if (rc != 0) err << "warning: drawing the figures failed (see " << (dir / "plot.log").string() << ")\n";

@@ -1,0 +1,54 @@
+#include "install_paths.h"
+
+#include <system_error>
+
+// Set by CMakeLists.txt for this file alone:
+//   HYBRIDCONT_BIN_TO_DATA   path from the install bin dir to the install data dir of hybridcont
+//   HYBRIDCONT_BUILD_BIN_DIR the directory the build writes the `hybridcont` executable to
+//   HYBRIDCONT_SOURCE_TREE   the source tree (python/, models/)
+#if !defined(HYBRIDCONT_BIN_TO_DATA) || !defined(HYBRIDCONT_BUILD_BIN_DIR) || !defined(HYBRIDCONT_SOURCE_TREE)
+#error "install_paths.cc needs HYBRIDCONT_BIN_TO_DATA, HYBRIDCONT_BUILD_BIN_DIR and HYBRIDCONT_SOURCE_TREE"
+#endif
+
+namespace hybridcont::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct DataLocation {
+  fs::path plot_script;
+  fs::path models;
+};
+
+// The rule of install_paths.h; empty paths if the executable's path cannot be read.
+DataLocation Locate() {
+  std::error_code ec;
+  const fs::path executable = fs::read_symlink("/proc/self/exe", ec);  // symlinks already resolved
+  if (ec || executable.empty()) return {};
+  const fs::path exe_dir = executable.parent_path();
+  // equivalent() is false (with ec set) once the build directory is gone: the executable is then not in it.
+  if (fs::equivalent(exe_dir, fs::path(HYBRIDCONT_BUILD_BIN_DIR), ec)) {
+    const fs::path source = HYBRIDCONT_SOURCE_TREE;
+    return {source / "python" / "hybridcont_plot.py", source / "models"};
+  }
+  const fs::path data = (exe_dir / HYBRIDCONT_BIN_TO_DATA).lexically_normal();
+  return {data / "hybridcont_plot.py", data / "models"};
+}
+
+fs::path IfExists(const fs::path& path) {
+  std::error_code ec;
+  return !path.empty() && fs::exists(path, ec) ? path : fs::path();
+}
+
+}  // namespace
+
+fs::path PlotScriptPath() { return IfExists(Locate().plot_script); }
+
+fs::path ModelsDirectory() {
+  const fs::path models = IfExists(Locate().models);
+  std::error_code ec;
+  return !models.empty() && fs::is_directory(models, ec) ? models : fs::path();
+}
+
+}  // namespace hybridcont::app

@@ -1,0 +1,34 @@
+// Where the hybridcont tool finds its data: the figure script and the folder of model files.
+//
+//   const std::filesystem::path script = PlotScriptPath();  // e.g. /opt/hc/share/hybridcont/hybridcont_plot.py
+//   if (script.empty()) { /* no figures; the results are still written */ }
+//
+// One rule, decided by where the running executable is (/proc/self/exe), never by which files exist:
+//  - the executable in the build tree (in the directory the build writes `hybridcont` to) reads the source
+//    tree, python/hybridcont_plot.py and models/: the build tree holds no copies, and an edited script
+//    takes effect without installing;
+//  - every other executable reads the installation it belongs to, <exe dir>/<bin-to-data>/hybridcont_plot.py
+//    and <exe dir>/<bin-to-data>/models, where bin-to-data is the path from ${CMAKE_INSTALL_BINDIR} to
+//    ${CMAKE_INSTALL_DATADIR}/hybridcont fixed at configure time (usually ../share/hybridcont). Relative, so
+//    it holds for a prefix chosen at install time (`cmake --install build --prefix P`) and for an
+//    installation moved as a whole.
+// So an installed executable never reads the source tree it was built from, even while that still exists.
+// `hybridcont --paths` prints both paths.
+#ifndef HYBRIDCONT_APP_INSTALL_PATHS_H_
+#define HYBRIDCONT_APP_INSTALL_PATHS_H_
+
+#include <filesystem>
+
+namespace hybridcont::app {
+
+// The figure script (python/hybridcont_plot.py) the rule above selects; empty if that file does not exist
+// or the executable's own path cannot be read.
+std::filesystem::path PlotScriptPath();
+
+// The folder of model files (models/) the rule above selects; empty if it does not exist or the
+// executable's own path cannot be read.
+std::filesystem::path ModelsDirectory();
+
+}  // namespace hybridcont::app
+
+#endif  // HYBRIDCONT_APP_INSTALL_PATHS_H_
