@@ -365,8 +365,8 @@ class AutoDiffAnchor final : public Anchor {
 template <class P>
 class TypedParameterBlock final : public ParameterBlock {
  public:
-  void Add(std::string name, double P::*member, std::string description) {
-    infos_.push_back({std::move(name), values_.*member, std::move(description)});
+  void Add(std::string name, double P::*member, std::string description, ParameterRange range) {
+    infos_.push_back({std::move(name), values_.*member, std::move(description), range});
     members_.push_back(member);
   }
   const std::vector<ParameterInfo>& infos() const override { return infos_; }

@@ -41,11 +41,13 @@
 #define HYBRIDCONT_MODEL_H_
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "hybridcont/model_setup.h"
 #include "hybridcont/types.h"
 
 namespace hybridcont {
@@ -117,10 +119,30 @@ class Anchor {
   virtual double Evaluate(const Eigen::Ref<const Vector>& x, RowVector* da) const = 0;
 };
 
+// The values a parameter may take: an interval with open or closed ends (default: every finite value).
+// A value outside is refused by HybridModel::SetParameter with a message naming the parameter, the value
+// and the interval, so that `--set k=-40` says that k must be positive instead of failing deep inside a run.
+struct ParameterRange {
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+  bool lower_closed = false;
+  bool upper_closed = false;
+  bool Contains(double v) const {
+    return (lower_closed ? v >= lower : v > lower) && (upper_closed ? v <= upper : v < upper);
+  }
+  // "(0, inf)", "[0, 1]", "(-inf, inf)".
+  std::string ToString() const;
+  static ParameterRange Positive() { return {0.0, std::numeric_limits<double>::infinity(), false, false}; }
+  static ParameterRange NonNegative() { return {0.0, std::numeric_limits<double>::infinity(), true, false}; }
+  static ParameterRange Open(double lower, double upper) { return {lower, upper, false, false}; }
+  static ParameterRange Closed(double lower, double upper) { return {lower, upper, true, true}; }
+};
+
 struct ParameterInfo {
   std::string name;
   double default_value;
   std::string description;
+  ParameterRange range;
 };
 
 // Named real parameters of a model; the values live in a user struct P (see ModelBuilder).
@@ -168,8 +190,13 @@ class HybridModel {
   const std::vector<ParameterInfo>& parameters() const { return parameters_->infos(); }
   // Value of the named parameter; throws std::invalid_argument naming the parameter if unknown.
   double parameter(const std::string& name) const;
-  // Sets a parameter; throws std::invalid_argument if the name is unknown or the value is not finite.
+  // Sets a parameter; throws std::invalid_argument if the name is unknown, the value is not finite or it
+  // lies outside the parameter's range (the message names the parameter, the value and the range).
   void SetParameter(const std::string& name, double value);
+
+  // The model's default run and presentation (model_setup.h).
+  const ModelSetup& setup() const { return setup_; }
+  void SetSetup(ModelSetup setup) { setup_ = std::move(setup); }
 
   // Declared symmetries (generators; see ModelSymmetry).
   const std::vector<ModelSymmetry>& symmetries() const { return symmetries_; }
@@ -186,6 +213,7 @@ class HybridModel {
   std::vector<std::unique_ptr<Phase>> phases_;
   std::unique_ptr<Anchor> anchor_;
   std::vector<ModelSymmetry> symmetries_;
+  ModelSetup setup_;
 };
 
 }  // namespace hybridcont
@@ -203,8 +231,16 @@ class ModelBuilder {
         parameters_(std::make_unique<internal::TypedParameterBlock<P>>()) {}
 
   // Registers a named parameter stored in member `member` of P; its default is the member's initializer.
-  ModelBuilder& Parameter(std::string name, double P::*member, std::string description) {
-    parameters_->Add(std::move(name), member, std::move(description));
+  // range: the values it may take (default: every finite value); the default must lie inside.
+  ModelBuilder& Parameter(std::string name, double P::*member, std::string description,
+                          ParameterRange range = {}) {
+    parameters_->Add(std::move(name), member, std::move(description), range);
+    return *this;
+  }
+
+  // The model's default run and presentation (model_setup.h).
+  ModelBuilder& Setup(ModelSetup setup) {
+    setup_ = std::move(setup);
     return *this;
   }
 
@@ -271,6 +307,7 @@ class ModelBuilder {
     internal::ValidatePhaseSizes(name_, phases);
     HybridModel model(name_, description_, std::move(parameters_), std::move(phases), anchor_factory_(params));
     for (ModelSymmetry& symmetry : symmetries_) model.AddSymmetry(std::move(symmetry));
+    model.SetSetup(std::move(setup_));
     return model;
   }
 
@@ -288,6 +325,7 @@ class ModelBuilder {
   std::map<int, std::unique_ptr<Phase>> ready_;
   std::function<std::unique_ptr<Anchor>(const P*)> anchor_factory_;
   std::vector<ModelSymmetry> symmetries_;
+  ModelSetup setup_;
 };
 
 }  // namespace hybridcont

@@ -1,9 +1,23 @@
 #include "hybridcont/model.h"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 
 namespace hybridcont {
+
+namespace {
+// Shortest decimal form that reads back to the same double ("40", "0.1", "1e-12").
+std::string FormatNumber(double v) {
+  char buffer[32];
+  for (int precision = 1; precision <= 17; ++precision) {
+    std::snprintf(buffer, sizeof buffer, "%.*g", precision, v);
+    if (std::strtod(buffer, nullptr) == v) break;
+  }
+  return buffer;
+}
+}  // namespace
 
 Phase::Phase(std::string name, std::vector<std::string> state_names, int next_dim, int num_first_integrals,
              Vector typical_state)
@@ -40,7 +54,14 @@ HybridModel::HybridModel(std::string name, std::string description, std::unique_
       description_(std::move(description)),
       parameters_(std::move(parameters)),
       phases_(std::move(phases)),
-      anchor_(std::move(anchor)) {}
+      anchor_(std::move(anchor)) {
+  for (const ParameterInfo& p : parameters_->infos()) {
+    if (!p.range.Contains(p.default_value)) {
+      throw std::invalid_argument("model '" + name_ + "': the default of parameter '" + p.name + "', " +
+                                  FormatNumber(p.default_value) + ", is outside its range " + p.range.ToString());
+    }
+  }
+}
 
 void HybridModel::AddSymmetry(ModelSymmetry symmetry) {
   const std::string where = "model '" + name_ + "', symmetry '" + symmetry.name + "'";
@@ -90,7 +111,20 @@ void HybridModel::SetParameter(const std::string& name, double value) {
     throw std::invalid_argument("parameter '" + name + "' of model '" + name_ + "' must be finite, got " +
                                 std::to_string(value));
   }
+  const ParameterRange& range = parameters_->infos()[index].range;
+  if (!range.Contains(value)) {
+    throw std::invalid_argument("parameter '" + name + "' of model '" + name_ + "' = " + FormatNumber(value) +
+                                " is outside its range " + range.ToString() + " (" +
+                                parameters_->infos()[index].description + ")");
+  }
   parameters_->Set(index, value);
+}
+
+std::string ParameterRange::ToString() const {
+  const auto end = [](double v) {
+    return std::isinf(v) ? std::string(v < 0 ? "-inf" : "inf") : FormatNumber(v);
+  };
+  return std::string(lower_closed ? "[" : "(") + end(lower) + ", " + end(upper) + (upper_closed ? "]" : ")");
 }
 
 namespace internal {

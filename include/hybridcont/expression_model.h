@@ -1,0 +1,141 @@
+// A hybrid model whose phase functions are compiled expressions (expression.h), as a model file gives them.
+//
+//   ExpressionModelSpec spec;                 // filled by the model-file reader (model_file.h)
+//   HybridModel model = BuildExpressionModel(std::move(spec));
+//
+// Each phase is an AutoDiffPhase (autodiff_phase.h) over functions that run an ExpressionProgram, so its
+// derivatives are the same forward-mode automatic differentiation as a built-in model's: df, dH, ∇²H, de
+// and dΔ are exact, never finite differences. Two ways to run a program:
+//   - interpreted: ExpressionProgram::Evaluate<T>, one instruction at a time over the scalar type T;
+//   - compiled: straight-line C++ generated from the same instructions (model_codegen.h), compiled by the
+//     system compiler and loaded; CompiledPrograms holds its entry points. It computes the same operations
+//     in the same order, so both give the same numbers.
+#ifndef HYBRIDCONT_EXPRESSION_MODEL_H_
+#define HYBRIDCONT_EXPRESSION_MODEL_H_
+
+#include <array>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "hybridcont/expression.h"
+#include "hybridcont/model.h"
+
+namespace hybridcont {
+
+// The programs of one phase. Inputs of every program: the phase's states, in order.
+struct ExpressionPhaseSpec {
+  std::string name;
+  std::vector<std::string> state_names;
+  Vector typical_state;
+  ExpressionProgram vector_field;  // n outputs
+  ExpressionProgram integrals;     // k outputs (the first integrals H_1..H_k)
+  ExpressionProgram event;         // 1 output
+  ExpressionProgram reset;         // outputs: the next phase's states
+};
+
+struct ExpressionModelSpec {
+  std::string name;
+  std::string description;
+  std::vector<ParameterInfo> parameters;  // values start at the defaults
+  std::vector<ExpressionPhaseSpec> phases;
+  ExpressionProgram anchor;  // over the first phase's states
+  std::vector<ModelSymmetry> symmetries;
+  ModelSetup setup;
+};
+
+// The programs of a model, in the order phase 0 (vector field, integrals, event, reset), phase 1, ...,
+// then the anchor.
+enum class ProgramKind { kVectorField = 0, kIntegrals = 1, kEvent = 2, kReset = 3, kAnchor = 4 };
+
+// Scalar types a program runs over: double, the fixed-size first-order jet of the phase's dimension,
+// the fixed-size second-order jet (HessianJet), and the bounded-dynamic jets used above kMaxFixedJetDim.
+enum class ScalarKind { kDouble = 0, kFixedJet = 1, kHessianJet = 2, kDynamicJet = 3, kDynamicJet2 = 4 };
+inline constexpr int kNumScalarKinds = 5;
+
+namespace internal {
+template <class T> struct IsHessianJet : std::false_type {};
+template <int N> struct IsHessianJet<HessianJet<N>> : std::true_type {};
+
+template <class T>
+constexpr ScalarKind KindOf() {
+  if constexpr (std::is_same_v<T, double>) return ScalarKind::kDouble;
+  else if constexpr (IsHessianJet<T>::value) return ScalarKind::kHessianJet;
+  else if constexpr (std::is_same_v<T, Jet>) return ScalarKind::kDynamicJet;
+  else if constexpr (std::is_same_v<T, Jet2>) return ScalarKind::kDynamicJet2;
+  else return ScalarKind::kFixedJet;
+}
+}  // namespace internal
+
+// Entry points of compiled programs: fn(x, p, out) with x, out arrays of the scalar type. A null entry
+// runs the interpreter.
+using CompiledProgramFn = void (*)(const void* x, const double* p, void* out);
+struct CompiledPrograms {
+  // [phase * 5 + ProgramKind][ScalarKind]; the anchor at [num_phases * 5 + kAnchor].
+  std::vector<std::array<CompiledProgramFn, kNumScalarKinds>> entries;
+  std::shared_ptr<void> library;  // keeps the loaded code alive
+};
+
+namespace internal {
+
+// What one phase's functions read: its programs, the parameter values, the compiled entry points.
+struct ExpressionPhaseData {
+  const ExpressionProgram* programs[5] = {};
+  const double* parameters = nullptr;
+  const std::array<CompiledProgramFn, kNumScalarKinds>* compiled[5] = {};
+
+  template <class T>
+  void Run(ProgramKind kind, const T* x, T* out) const {
+    const int k = static_cast<int>(kind);
+    if (compiled[k] != nullptr) {
+      if (CompiledProgramFn fn = (*compiled[k])[static_cast<int>(KindOf<T>())]) {
+        fn(x, parameters, out);
+        return;
+      }
+    }
+    programs[k]->Evaluate(x, parameters, out);
+  }
+};
+
+// The functor AutoDiffPhase instantiates (model.h's interface, with the data as its "parameters").
+struct ExpressionFunctions {
+  template <class T>
+  static StateVector<T> VectorField(const StateVector<T>& x, const ExpressionPhaseData& d) {
+    return Outputs(ProgramKind::kVectorField, x, d);
+  }
+  template <class T>
+  static StateVector<T> FirstIntegrals(const StateVector<T>& x, const ExpressionPhaseData& d) {
+    return Outputs(ProgramKind::kIntegrals, x, d);
+  }
+  template <class T>
+  static T Event(const StateVector<T>& x, const ExpressionPhaseData& d) {
+    return Outputs(ProgramKind::kEvent, x, d)(0);
+  }
+  template <class T>
+  static StateVector<T> Reset(const StateVector<T>& x, const ExpressionPhaseData& d) {
+    return Outputs(ProgramKind::kReset, x, d);
+  }
+  template <class T>
+  static T Anchor(const StateVector<T>& x, const ExpressionPhaseData& d) {
+    return Outputs(ProgramKind::kAnchor, x, d)(0);
+  }
+
+ private:
+  template <class T>
+  static StateVector<T> Outputs(ProgramKind kind, const StateVector<T>& x, const ExpressionPhaseData& d) {
+    StateVector<T> out(d.programs[static_cast<int>(kind)]->num_outputs());
+    d.Run(kind, x.data(), out.data());
+    return out;
+  }
+};
+
+}  // namespace internal
+
+// Builds the model; compiled (may be null) supplies compiled entry points for the spec's programs.
+// Throws std::invalid_argument for inconsistent sizes (ValidatePhaseSizes' messages).
+HybridModel BuildExpressionModel(ExpressionModelSpec spec, std::shared_ptr<const CompiledPrograms> compiled = nullptr);
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_EXPRESSION_MODEL_H_

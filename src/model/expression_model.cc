@@ -1,0 +1,87 @@
+#include "hybridcont/expression_model.h"
+
+#include <stdexcept>
+
+namespace hybridcont {
+namespace {
+
+// Everything the phases of an expression model point into; owned by the model's parameter block, which
+// the model destroys after its phases.
+struct ExpressionModelData {
+  std::vector<ParameterInfo> infos;
+  std::vector<double> values;  // never resized after construction: phases hold its data pointer
+  std::vector<ExpressionPhaseSpec> phases;
+  ExpressionProgram anchor;
+  std::shared_ptr<const CompiledPrograms> compiled;
+  std::vector<internal::ExpressionPhaseData> phase_data;  // one per phase, the anchor's last
+};
+
+class ExpressionParameterBlock final : public ParameterBlock {
+ public:
+  explicit ExpressionParameterBlock(std::unique_ptr<ExpressionModelData> data) : data_(std::move(data)) {}
+  const std::vector<ParameterInfo>& infos() const override { return data_->infos; }
+  double Get(int index) const override { return data_->values[index]; }
+  void Set(int index, double value) override { data_->values[index] = value; }
+
+ private:
+  std::unique_ptr<ExpressionModelData> data_;
+};
+
+}  // namespace
+
+HybridModel BuildExpressionModel(ExpressionModelSpec spec, std::shared_ptr<const CompiledPrograms> compiled) {
+  const int m = static_cast<int>(spec.phases.size());
+  if (m == 0) throw std::invalid_argument("model '" + spec.name + "': no phases");
+  auto data = std::make_unique<ExpressionModelData>();
+  data->infos = spec.parameters;
+  for (const ParameterInfo& p : data->infos) data->values.push_back(p.default_value);
+  data->phases = std::move(spec.phases);
+  data->anchor = std::move(spec.anchor);
+  data->compiled = std::move(compiled);
+  const int expected_entries = 5 * m + 5;
+  if (data->compiled && static_cast<int>(data->compiled->entries.size()) != expected_entries) {
+    throw std::invalid_argument("model '" + spec.name + "': compiled code does not match the model");
+  }
+  const auto entry = [&](int phase, ProgramKind kind) -> const std::array<CompiledProgramFn, kNumScalarKinds>* {
+    if (!data->compiled) return nullptr;
+    return &data->compiled->entries[5 * phase + static_cast<int>(kind)];
+  };
+  data->phase_data.resize(m + 1);
+  for (int i = 0; i < m; ++i) {
+    internal::ExpressionPhaseData& d = data->phase_data[i];
+    ExpressionPhaseSpec& p = data->phases[i];
+    d.programs[0] = &p.vector_field;
+    d.programs[1] = &p.integrals;
+    d.programs[2] = &p.event;
+    d.programs[3] = &p.reset;
+    d.parameters = data->values.data();
+    for (int k = 0; k < 4; ++k) d.compiled[k] = entry(i, static_cast<ProgramKind>(k));
+  }
+  internal::ExpressionPhaseData& anchor = data->phase_data[m];
+  anchor.programs[static_cast<int>(ProgramKind::kAnchor)] = &data->anchor;
+  anchor.parameters = data->values.data();
+  anchor.compiled[static_cast<int>(ProgramKind::kAnchor)] = entry(m, ProgramKind::kAnchor);
+
+  std::vector<std::unique_ptr<Phase>> phases;
+  for (int i = 0; i < m; ++i) {
+    const ExpressionPhaseSpec& p = data->phases[i];
+    const int n = static_cast<int>(p.state_names.size());
+    if (n < 1 || n > kMaxPhaseDim) {
+      throw std::invalid_argument("model '" + spec.name + "', phase '" + p.name + "': " + std::to_string(n) +
+                                  " states, outside [1, " + std::to_string(kMaxPhaseDim) + "]");
+    }
+    const int next_dim = static_cast<int>(data->phases[(i + 1) % m].state_names.size());
+    phases.push_back(std::make_unique<internal::AutoDiffPhase<internal::ExpressionFunctions, internal::ExpressionPhaseData>>(
+        p.name, p.state_names, next_dim, p.typical_state, &data->phase_data[i]));
+  }
+  internal::ValidatePhaseSizes(spec.name, phases);
+  auto anchor_fn = std::make_unique<internal::AutoDiffAnchor<internal::ExpressionFunctions, internal::ExpressionPhaseData>>(
+      &data->phase_data[m]);
+  HybridModel model(spec.name, spec.description, std::make_unique<ExpressionParameterBlock>(std::move(data)),
+                    std::move(phases), std::move(anchor_fn));
+  for (ModelSymmetry& s : spec.symmetries) model.AddSymmetry(std::move(s));
+  model.SetSetup(std::move(spec.setup));
+  return model;
+}
+
+}  // namespace hybridcont

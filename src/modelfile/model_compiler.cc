@@ -1,0 +1,262 @@
+#include "model_compiler.h"
+
+#include <dlfcn.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace hybridcont::internal {
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* OpName(ExprOp op) {
+  switch (op) {
+    case ExprOp::kNeg: return "kNeg";
+    case ExprOp::kNot: return "kNot";
+    case ExprOp::kAdd: return "kAdd";
+    case ExprOp::kSub: return "kSub";
+    case ExprOp::kMul: return "kMul";
+    case ExprOp::kDiv: return "kDiv";
+    case ExprOp::kPow: return "kPow";
+    case ExprOp::kLess: return "kLess";
+    case ExprOp::kLessEqual: return "kLessEqual";
+    case ExprOp::kGreater: return "kGreater";
+    case ExprOp::kGreaterEqual: return "kGreaterEqual";
+    case ExprOp::kEqual: return "kEqual";
+    case ExprOp::kNotEqual: return "kNotEqual";
+    case ExprOp::kAnd: return "kAnd";
+    case ExprOp::kOr: return "kOr";
+    case ExprOp::kSin: return "kSin";
+    case ExprOp::kCos: return "kCos";
+    case ExprOp::kTan: return "kTan";
+    case ExprOp::kAsin: return "kAsin";
+    case ExprOp::kAcos: return "kAcos";
+    case ExprOp::kAtan: return "kAtan";
+    case ExprOp::kSinh: return "kSinh";
+    case ExprOp::kCosh: return "kCosh";
+    case ExprOp::kTanh: return "kTanh";
+    case ExprOp::kExp: return "kExp";
+    case ExprOp::kLog: return "kLog";
+    case ExprOp::kSqrt: return "kSqrt";
+    case ExprOp::kAbs: return "kAbs";
+    case ExprOp::kAtan2: return "kAtan2";
+    case ExprOp::kMin: return "kMin";
+    case ExprOp::kMax: return "kMax";
+    default: return "kConstant";
+  }
+}
+
+std::string Operand(const ExpressionProgram::Operand& o) {
+  return std::string(1, o.kind) + std::to_string(o.index);
+}
+
+// One program as a function template `P<id>(x, p, out)`.
+void EmitProgram(std::ostringstream& s, const std::string& id, const ExpressionProgram& program) {
+  s << "template <class T>\nvoid P" << id << "(const T* x, const double* p, T* out) {\n";
+  s << "  (void)x; (void)p;\n";
+  for (const auto& in : program.constant_code()) {
+    s << "  const double c" << in.dst << " = ";
+    if (in.op == ExprOp::kParameter) {
+      s << "p[" << in.a.index << "];\n";
+    } else if (in.op == ExprOp::kConstant) {
+      char buffer[64];
+      std::snprintf(buffer, sizeof buffer, "%a", in.value);
+      s << buffer << ";\n";
+    } else {
+      s << "ApplyDouble(ExprOp::" << OpName(in.op) << ", " << Operand(in.a) << ", "
+        << (in.b.index >= 0 ? Operand(in.b) : std::string("0.0")) << ");\n";
+    }
+  }
+  for (const auto& in : program.code()) {
+    s << "  const T r" << in.dst << " = ";
+    if (in.op == ExprOp::kInput) {
+      s << "x[" << in.a.index << "];\n";
+    } else if (in.b.index >= 0) {
+      s << "ApplyBinary<T>(ExprOp::" << OpName(in.op) << ", " << Operand(in.a) << ", " << Operand(in.b) << ");\n";
+    } else {
+      s << "ApplyUnary(ExprOp::" << OpName(in.op) << ", " << Operand(in.a) << ");\n";
+    }
+  }
+  for (int i = 0; i < program.num_outputs(); ++i) {
+    const auto& o = program.outputs()[i];
+    s << "  out[" << i << "] = " << (o.kind == 'r' ? Operand(o) : "T(" + Operand(o) + ")") << ";\n";
+  }
+  s << "}\n";
+}
+
+// Scalar types per kind for a phase of dimension n (expression_model.h, ScalarKind).
+std::vector<std::pair<int, std::string>> ScalarTypes(int n, bool second_order) {
+  std::vector<std::pair<int, std::string>> types = {{0, "double"}};
+  if (n <= kMaxFixedJetDim) {
+    types.push_back({1, "JetTypes<" + std::to_string(n) + ">::J"});
+    if (second_order) types.push_back({2, "HessianJet<" + std::to_string(n) + ">"});
+  } else {
+    types.push_back({3, "Jet"});
+    if (second_order) types.push_back({4, "Jet2"});
+  }
+  return types;
+}
+
+std::string EntryName(int slot, int kind) { return "hybridcont_model_" + std::to_string(slot) + "_" + std::to_string(kind); }
+
+// FNV-1a, 64 bits: a stable name for the cache (not a security measure; the cache is the user's own).
+std::string Hash(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+  char buffer[17];
+  std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(h));
+  return buffer;
+}
+
+fs::path CacheDirectory(const ModelFileOptions& options) {
+  if (!options.cache_dir.empty()) return options.cache_dir;
+  if (const char* d = std::getenv("HYBRIDCONT_CACHE"); d && *d) return d;
+  if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d) return fs::path(d) / "hybridcont";
+  if (const char* d = std::getenv("HOME"); d && *d) return fs::path(d) / ".cache" / "hybridcont";
+  return fs::temp_directory_path() / "hybridcont-cache";
+}
+
+// The folder holding hybridcont/model.h for the generated code: $HYBRIDCONT_INCLUDE_DIR, the installed
+// headers next to the running program (<prefix>/bin/.. /include), the configured install location, or the
+// source tree this library was built from.
+fs::path HeaderDirectory() {
+  std::vector<fs::path> candidates;
+  if (const char* d = std::getenv("HYBRIDCONT_INCLUDE_DIR"); d && *d) candidates.push_back(d);
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) candidates.push_back(exe.parent_path().parent_path() / "include");
+  candidates.push_back(HYBRIDCONT_INSTALL_INCLUDE_DIR);
+  candidates.push_back(HYBRIDCONT_SOURCE_INCLUDE_DIR);
+  for (const fs::path& c : candidates) {
+    if (fs::exists(c / "hybridcont" / "model.h", ec)) return c;
+  }
+  return {};
+}
+
+std::string Quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string FindCompiler() {
+  std::vector<std::string> candidates;
+  if (const char* cxx = std::getenv("CXX"); cxx && *cxx) candidates.push_back(cxx);
+  candidates.push_back(HYBRIDCONT_CXX_COMPILER);
+  candidates.push_back("/usr/bin/c++");
+  candidates.push_back("/usr/bin/g++");
+  for (const std::string& c : candidates) {
+    if (!c.empty() && access(c.c_str(), X_OK) == 0) return c;
+  }
+  return {};
+}
+
+}  // namespace
+
+std::string GenerateModelSource(const ExpressionModelSpec& spec) {
+  std::ostringstream s;
+  s << "// Generated by hybridcont from the model's parsed expressions; do not edit.\n"
+    << "#include \"hybridcont/expression.h\"\n#include \"hybridcont/model.h\"\n"
+    << "namespace {\nusing namespace hybridcont;\nusing namespace hybridcont::internal;\n";
+  const int m = static_cast<int>(spec.phases.size());
+  std::ostringstream entries;
+  entries << "extern \"C\" {\n";
+  const auto emit = [&](int slot, int n, const ExpressionProgram& program, bool second_order) {
+    const std::string id = std::to_string(slot);
+    EmitProgram(s, id, program);
+    for (const auto& [kind, type] : ScalarTypes(n, second_order)) {
+      entries << "void " << EntryName(slot, kind) << "(const void* x, const double* p, void* out) { P" << id << "<"
+              << type << ">(static_cast<const " << type << "*>(x), p, static_cast<" << type << "*>(out)); }\n";
+    }
+  };
+  for (int i = 0; i < m; ++i) {
+    const ExpressionPhaseSpec& p = spec.phases[i];
+    const int n = static_cast<int>(p.state_names.size());
+    emit(5 * i + 0, n, p.vector_field, false);
+    emit(5 * i + 1, n, p.integrals, true);
+    emit(5 * i + 2, n, p.event, false);
+    emit(5 * i + 3, n, p.reset, false);
+  }
+  emit(5 * m + 4, static_cast<int>(spec.phases[0].state_names.size()), spec.anchor, false);
+  entries << "}\n";
+  s << "}  // namespace\n" << entries.str();
+  return s.str();
+}
+
+std::shared_ptr<const CompiledPrograms> CompileModel(const ExpressionModelSpec& spec, const ModelFileOptions& options) {
+  const auto note = [&](const std::string& why) {
+    if (options.log) *options.log << "note: model '" << spec.name << "' runs interpreted (slower): " << why << "\n";
+    return nullptr;
+  };
+  const std::string compiler = FindCompiler();
+  if (compiler.empty()) return note("no C++ compiler found (set CXX)");
+  const fs::path include = HeaderDirectory();
+  if (include.empty()) return note("the hybridcont headers were not found (set HYBRIDCONT_INCLUDE_DIR)");
+  const std::string source = GenerateModelSource(spec);
+  std::string flags = "-std=c++20 -O3 -DNDEBUG -fPIC -shared -w -I" + Quote(include.string());
+  for (const std::string& dir : {std::string(HYBRIDCONT_EIGEN_INCLUDE_DIR)}) {
+    if (!dir.empty() && dir != include.string()) flags += " -I" + Quote(dir);
+  }
+  const std::string key = Hash(source + "\n" + compiler + " " + flags + "\n" + HYBRIDCONT_VERSION_STRING);
+  const fs::path cache = CacheDirectory(options);
+  const fs::path library = cache / ("model-" + key + ".so");
+  std::error_code ec;
+  if (!fs::exists(library, ec)) {
+    fs::create_directories(cache, ec);
+    if (ec) return note("cannot create the cache folder " + cache.string() + " (" + ec.message() + ")");
+    const std::string stem = "model-" + key + "." + std::to_string(getpid());
+    const fs::path src = cache / (stem + ".cc"), tmp = cache / (stem + ".so"), log = cache / ("model-" + key + ".log");
+    {
+      std::ofstream f(src);
+      f << source;
+      if (!f) return note("cannot write to the cache folder " + cache.string());
+    }
+    if (options.log) {
+      *options.log << "compiling model '" << spec.name << "' (first use of this model; cached in " << cache.string()
+                   << ")..." << std::flush;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const std::string command =
+        Quote(compiler) + " " + flags + " -o " + Quote(tmp.string()) + " " + Quote(src.string()) + " > " +
+        Quote(log.string()) + " 2>&1";
+    const int rc = std::system(command.c_str());
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    fs::remove(src, ec);
+    if (rc != 0) {
+      if (options.log) *options.log << " failed\n";
+      fs::remove(tmp, ec);
+      return note("compiling the generated code failed (compiler output in " + log.string() + ")");
+    }
+    fs::rename(tmp, library, ec);
+    if (ec) return note("cannot move the compiled model into " + library.string());
+    fs::remove(log, ec);
+    if (options.log) {
+      char buffer[64];
+      std::snprintf(buffer, sizeof buffer, " %.1f s\n", seconds);
+      *options.log << buffer;
+    }
+  }
+  void* handle = dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (handle == nullptr) return note("loading " + library.string() + " failed: " + dlerror());
+  auto compiled = std::make_shared<CompiledPrograms>();
+  compiled->library = std::shared_ptr<void>(handle, [](void*) {
+    // Never unloaded: phases of models built from it may outlive this object in a user's program.
+  });
+  const int m = static_cast<int>(spec.phases.size());
+  compiled->entries.resize(5 * m + 5);
+  for (int slot = 0; slot < 5 * m + 5; ++slot) {
+    for (int kind = 0; kind < kNumScalarKinds; ++kind) {
+      compiled->entries[slot][kind] = reinterpret_cast<CompiledProgramFn>(dlsym(handle, EntryName(slot, kind).c_str()));
+    }
+  }
+  return compiled;
+}
+
+}  // namespace hybridcont::internal
