@@ -9,9 +9,9 @@
 
 namespace hybridcont::app {
 
-int ListCommand(std::ostream& out) {
-  for (const std::string& name : BuiltinModelNames()) {
-    const HybridModel model = MakeBuiltinModel(name);
+int ListCommand(const std::vector<std::string>& models, std::ostream& out, std::ostream& err) {
+  for (const std::string& name : models.empty() ? BuiltinModelNames() : models) {
+    const HybridModel model = MakeModelWithOverrides(name, {}, &err);
     const ShootingLayout layout(model);
     out << fmt::format("{}: {}\n", name, model.description());
     out << fmt::format("  phases (m = {}, N = {} equations in the time-based map):\n", model.num_phases(),
@@ -24,14 +24,15 @@ int ListCommand(std::ostream& out) {
     }
     out << "  parameters:\n";
     for (const auto& info : model.parameters()) {
-      out << fmt::format("    {:<6} = {:<8g} {}\n", info.name, info.default_value, info.description);
+      out << fmt::format("    {:<6} = {:<8g} in {:<12} {}\n", info.name, info.default_value, info.range.ToString(),
+                         info.description);
     }
   }
   return 0;
 }
 
-int CheckCommand(const CheckArguments& args, std::ostream& out, std::ostream&) {
-  const HybridModel model = MakeModelWithOverrides(args.model, args.assignments);
+int CheckCommand(const CheckArguments& args, std::ostream& out, std::ostream& err) {
+  const HybridModel model = MakeModelWithOverrides(args.model, args.assignments, &err);
   DerivativeCheckOptions options;
   options.num_points = args.points;
   options.seed = args.seed;

@@ -24,17 +24,19 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
       },
       "print the figure script and the model folder this executable uses, and exit");
 
-  auto* list = app.add_subcommand("list", "list the built-in models with phases, dimensions and parameters");
+  std::vector<std::string> list_models;
+  auto* list = app.add_subcommand("list", "list models (default: the built-in ones) with phases, dimensions and parameters");
+  list->add_option("models", list_models, "built-in model names or model files (.toml)");
 
   CheckArguments check_args;
   auto* check = app.add_subcommand("check", "compare every derivative of a model with finite differences");
-  check->add_option("model", check_args.model, "built-in model name")->required();
+  check->add_option("model", check_args.model, "built-in model name or model file (.toml)")->required();
   check->add_option("--set", check_args.assignments, "override a parameter, NAME=VALUE (repeatable)");
   check->add_option("--points", check_args.points, "random points per phase")->check(CLI::PositiveNumber);
   check->add_option("--seed", check_args.seed, "seed of the random points");
 
   RunArguments run_args;
-  auto* run = app.add_subcommand("run", "compute the bifurcation diagram of a built-in model");
+  auto* run = app.add_subcommand("run", "compute the bifurcation diagram of a built-in model or a model file");
   AddRunOptions(run, &run_args);
 
   std::string plot_dir;
@@ -52,7 +54,7 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
     return code;
   }
   try {
-    if (*list) return ListCommand(out);
+    if (*list) return ListCommand(list_models, out, err);
     if (*check) return CheckCommand(check_args, out, err);
     if (*run) return RunCommand(run_args, out, err);
     if (*plot) return PlotCommand(plot_dir, out, err);

@@ -13,7 +13,8 @@ class App;
 
 namespace hybridcont::app {
 
-int ListCommand(std::ostream& out);
+// Built-in models, or the given ones (names or model files).
+int ListCommand(const std::vector<std::string>& models, std::ostream& out, std::ostream& err);
 
 struct CheckArguments {
   std::string model;
@@ -27,6 +28,7 @@ struct RunArguments {
   std::string model;
   std::vector<std::string> assignments;
   std::vector<std::string> until;
+  std::vector<std::string> bounds;     // NAME=LOWER:UPPER, replacing the model's bound on NAME
   std::string out_dir;
   std::optional<double> rtol;          // unset: library default
   std::optional<double> atol;

@@ -1,8 +1,10 @@
 #include "model_options.h"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
+#include "hybridcont/model_file.h"
 #include "hybridcont/models.h"
 
 namespace hybridcont::app {
@@ -33,8 +35,29 @@ std::pair<std::string, double> ParseAssignment(const std::string& option, const 
   return {name, ParseFinite(option + " '" + text + "'", text.substr(eq + 1))};
 }
 
-HybridModel MakeModelWithOverrides(const std::string& name, const std::vector<std::string>& assignments) {
-  HybridModel model = MakeBuiltinModel(name);
+BoundAssignment ParseBound(const std::string& option, const std::string& text) {
+  const std::size_t eq = text.find('=');
+  const std::size_t colon = text.find(':', eq == std::string::npos ? 0 : eq);
+  if (eq == std::string::npos || eq == 0 || colon == std::string::npos) {
+    throw std::invalid_argument(option + " '" + text + "': expected NAME=LOWER:UPPER (e.g. H=0:2.7; an empty end is unbounded)");
+  }
+  BoundAssignment b{text.substr(0, eq), -std::numeric_limits<double>::infinity(),
+                    std::numeric_limits<double>::infinity()};
+  const std::string lower = text.substr(eq + 1, colon - eq - 1), upper = text.substr(colon + 1);
+  if (!lower.empty()) b.lower = ParseFinite(option + " '" + text + "' (lower end)", lower);
+  if (!upper.empty()) b.upper = ParseFinite(option + " '" + text + "' (upper end)", upper);
+  if (!(b.lower < b.upper)) throw std::invalid_argument(option + " '" + text + "': the lower end must be below the upper end");
+  return b;
+}
+
+HybridModel MakeModelWithOverrides(const std::string& name, const std::vector<std::string>& assignments,
+                                   std::ostream* log) {
+  HybridModel model = [&] {
+    if (!IsModelFilePath(name)) return MakeBuiltinModel(name);
+    ModelFileOptions options;
+    options.log = log;
+    return LoadModelFile(name, options);
+  }();
   for (const std::string& a : assignments) {
     const auto [parameter, value] = ParseAssignment("--set", a);
     model.SetParameter(parameter, value);

@@ -2,6 +2,7 @@
 #ifndef HYBRIDCONT_APP_MODEL_OPTIONS_H_
 #define HYBRIDCONT_APP_MODEL_OPTIONS_H_
 
+#include <iosfwd>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,9 +15,20 @@ namespace hybridcont::app {
 // the offending text, e.g. "--set 'k=abc': value 'abc' is not a number".
 std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text);
 
-// Builds the named built-in model and applies the overrides; throws std::invalid_argument on an unknown
-// model or parameter.
-HybridModel MakeModelWithOverrides(const std::string& name, const std::vector<std::string>& assignments);
+// Builds the model — a built-in model by name, or a model file (a path ending in .toml, model_file.h) —
+// and applies the overrides; throws std::invalid_argument on an unknown model, a bad model file (file,
+// line and field in the message) or an unknown parameter or a value outside its range. Notes on compiling
+// a model file (first use, interpreted fall-back) go to `log`.
+HybridModel MakeModelWithOverrides(const std::string& name, const std::vector<std::string>& assignments,
+                                   std::ostream* log = nullptr);
+
+// Parses "NAME=LOWER:UPPER" (either end may be empty for an unbounded side). Throws std::invalid_argument
+// naming the option and the text.
+struct BoundAssignment {
+  std::string name;
+  double lower, upper;
+};
+BoundAssignment ParseBound(const std::string& option, const std::string& text);
 
 // Parses a real number that must be finite; names the option in the error.
 double ParseFinite(const std::string& option, const std::string& text);

@@ -34,11 +34,14 @@ namespace hybridcont::app {
 namespace fs = std::filesystem;
 
 void AddRunOptions(CLI::App* run, RunArguments* args) {
-  run->add_option("model", args->model, "built-in model name (see `hybridcont list`)")->required();
+  run->add_option("model", args->model, "built-in model name (see `hybridcont list`) or model file (.toml)")->required();
   run->add_option("--set", args->assignments, "override a model parameter, NAME=VALUE (repeatable)");
   run->add_option("--until", args->until,
                   "end every branch exactly where a component of u reaches a value, NAME=VALUE, e.g. H=2 "
                   "(repeatable)");
+  run->add_option("--bound", args->bounds,
+                  "replace the model's bound on an unknown, NAME=LOWER:UPPER (e.g. H=0:2.7; 'period' is the sum of "
+                  "the durations; an empty end is unbounded) (repeatable)");
   run->add_option("--out", args->out_dir, "results folder (default results/MODEL)");
   run->add_option("--rtol", args->rtol, "integrator relative tolerance (default 1e-10)");
   run->add_option("--atol", args->atol, "integrator absolute tolerance (default 1e-10)");
@@ -274,7 +277,7 @@ std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::ma
 
 int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   // ---- 1. validate all input before anything is written
-  HybridModel model = MakeModelWithOverrides(args.model, args.assignments);
+  HybridModel model = MakeModelWithOverrides(args.model, args.assignments, &err);
   Formulation formulation;
   if (!FromString(args.formulation, &formulation)) {
     throw std::invalid_argument("--formulation '" + args.formulation + "': expected 'time' or 'state'");
@@ -293,6 +296,29 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     const auto [name, value] = ParseAssignment("--until", u);
     c.targets.push_back({name, value});
   }
+  for (const std::string& text : args.bounds) {
+    const BoundAssignment b = ParseBound("--bound", text);
+    if (b.name == "period") {
+      std::vector<std::string> durations;
+      for (int i = 0; i <= model.num_phases(); ++i) durations.push_back("t" + std::to_string(i + 1));
+      c.sum_bounds.assign(1, SumBound{durations, b.lower, b.upper});
+    } else {
+      std::erase_if(c.bounds, [&](const ComponentBound& x) { return x.component == b.name; });
+      c.bounds.push_back({b.name, b.lower, b.upper});
+    }
+  }
+  // A target beyond the model's default bound on the same unknown widens that bound to the target: the
+  // user asked to reach it (an explicit --bound on that unknown is kept as given).
+  for (const ComponentTarget& t : c.targets) {
+    const bool explicit_bound = std::any_of(args.bounds.begin(), args.bounds.end(), [&](const std::string& text) {
+      return text.rfind(t.component + "=", 0) == 0;
+    });
+    for (ComponentBound& b : c.bounds) {
+      if (b.component != t.component || explicit_bound) continue;
+      b.lower = std::min(b.lower, t.value);
+      b.upper = std::max(b.upper, t.value);
+    }
+  }
   if (args.max_branches) {
     if (*args.max_branches < 1) {
       throw std::invalid_argument("--max-branches " + std::to_string(*args.max_branches) + ": must be >= 1");
@@ -310,7 +336,8 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   try {
     exploration = std::make_unique<ModelExploration>(model, sc, setup.integrator, setup.exploration, formulation);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(std::string(args.until.empty() ? "" : "--until: ") + e.what());
+    throw std::invalid_argument(std::string(args.until.empty() && args.bounds.empty() ? "" : "--until/--bound: ") +
+                                e.what());
   }
   const ShootingLayout& layout = exploration->shooting().layout();
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / model.name() : fs::path(args.out_dir);

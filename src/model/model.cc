@@ -1,8 +1,7 @@
 #include "hybridcont/model.h"
 
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
+#include <charconv>
 #include <stdexcept>
 
 namespace hybridcont {
@@ -11,11 +10,8 @@ namespace {
 // Shortest decimal form that reads back to the same double ("40", "0.1", "1e-12").
 std::string FormatNumber(double v) {
   char buffer[32];
-  for (int precision = 1; precision <= 17; ++precision) {
-    std::snprintf(buffer, sizeof buffer, "%.*g", precision, v);
-    if (std::strtod(buffer, nullptr) == v) break;
-  }
-  return buffer;
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, v);
+  return ec == std::errc() ? std::string(buffer, end) : std::to_string(v);
 }
 }  // namespace
 
