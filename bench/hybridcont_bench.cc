@@ -12,7 +12,10 @@
 #include <cmath>
 #include <map>
 
+#include <filesystem>
+
 #include "hybridcont/corrector.h"
+#include "hybridcont/model_file.h"
 #include "hybridcont/models.h"
 #include "model_exploration.h"
 
@@ -92,15 +95,15 @@ void BM_CorrectorSolve(benchmark::State& state) {
 }
 BENCHMARK(BM_CorrectorSolve)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
 
-void BM_FullRun(benchmark::State& state) {
-  const std::string name = kModels[state.range(0)];
-  const HybridModel model = MakeBuiltinModel(name);
+// The full exploration of a model's default scenario on `threads` threads, with the counters above.
+void FullRun(benchmark::State& state, const HybridModel& model, int threads) {
+  const std::string name = model.name();
   const Scenario scenario = DefaultScenario(model);
   long points = 0, traced_points = 0, newton = 0, rejected = 0, rhs = 0, branches = 0;
   double floor_rhs = 0, traced_floor_rhs = 0;
   BifurcationDiagram diagram;
   ExplorationOptions options = ScenarioExplorationOptions(scenario);
-  options.threads = static_cast<int>(state.range(1));
+  options.threads = threads;
   for (auto _ : state) {
     ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
     const BifurcationDiagram d = exploration.Run();
@@ -143,10 +146,51 @@ void BM_FullRun(benchmark::State& state) {
   state.counters["rhs_over_floor"] = static_cast<double>(rhs) / floor_rhs;
   state.counters["rhs_over_traced_floor"] = static_cast<double>(rhs) / traced_floor_rhs;
 }
+void BM_FullRun(benchmark::State& state) {
+  const HybridModel model = MakeBuiltinModel(kModels[state.range(0)]);
+  FullRun(state, model, static_cast<int>(state.range(1)));
+}
 // BM_FullRun/<model>/<threads>. Wall time: the exploration and the shooting map may run on several threads
 // (ExplorationOptions::threads); on one thread the RHS count is the algorithm's work alone, on two it also
 // counts the traces that the merge drops.
 BENCHMARK(BM_FullRun)->ArgsProduct({{0, 1, 2, 3}, {1, 2}})->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
+
+// The same model written as a model file (models/<name>.toml), in the same run as BM_FullRun:
+// BM_ModelFileFullRun/<model>/<variant>, variant 0 the built-in C++ model, 1 the file compiled (generated
+// code, cache warm), 2 the file interpreted. One thread, so that the times compare the model functions.
+void BM_ModelFileFullRun(benchmark::State& state) {
+  const std::string name = kModels[state.range(0)];
+  const int variant = static_cast<int>(state.range(1));
+  ModelFileOptions options;
+  options.compile = variant == 1;
+  options.cache_dir = std::filesystem::temp_directory_path() / "hybridcont-bench-cache";
+  const HybridModel model =
+      variant == 0 ? MakeBuiltinModel(name)
+                   : LoadModelFile(std::filesystem::path(HYBRIDCONT_SOURCE_DIR) / "models" / (name + ".toml"), options);
+  FullRun(state, model, 1);
+  state.SetLabel(name + (variant == 0 ? " built-in" : variant == 1 ? " file, compiled" : " file, interpreted"));
+}
+BENCHMARK(BM_ModelFileFullRun)->ArgsProduct({{0, 1, 2, 3}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
+
+// What the first use of a model file costs: parse, generate, compile with the system compiler and load,
+// into an empty cache (later uses load the cached library: BM_ModelFileLoad).
+void ModelFileLoad(benchmark::State& state, bool cold) {
+  const std::string name = kModels[state.range(0)];
+  const std::filesystem::path cache = std::filesystem::temp_directory_path() / "hybridcont-bench-first-run";
+  for (auto _ : state) {
+    if (cold) std::filesystem::remove_all(cache);
+    ModelFileOptions options;
+    options.cache_dir = cache;
+    const HybridModel model =
+        LoadModelFile(std::filesystem::path(HYBRIDCONT_SOURCE_DIR) / "models" / (name + ".toml"), options);
+    benchmark::DoNotOptimize(&model);
+  }
+  state.SetLabel(name);
+}
+void BM_ModelFileFirstLoad(benchmark::State& state) { ModelFileLoad(state, true); }
+BENCHMARK(BM_ModelFileFirstLoad)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+void BM_ModelFileLoad(benchmark::State& state) { ModelFileLoad(state, false); }
+BENCHMARK(BM_ModelFileLoad)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace hybridcont::app
