@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "hybridcont/models.h"
+#include "hybridcont/version.h"
 #include "install_paths.h"
 
 namespace hybridcont::app {
@@ -14,7 +15,7 @@ namespace hybridcont::app {
 int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{"hybridcont: families of periodic orbits of conservative hybrid systems"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "hybridcont 0.1.0");
+  app.set_version_flag("--version", "hybridcont " HYBRIDCONT_VERSION);
   app.add_flag_callback(
       "--paths",
       [&out] {

@@ -1,5 +1,7 @@
 #include "model_compiler.h"
 
+#include "hybridcont/version.h"
+
 #include <dlfcn.h>
 #include <unistd.h>
 
@@ -124,16 +126,17 @@ fs::path CacheDirectory(const ModelFileOptions& options) {
 }
 
 // The folder holding hybridcont/model.h for the generated code: $HYBRIDCONT_INCLUDE_DIR, the installed
-// headers next to the running program (<prefix>/bin/.. /include), the configured install location, or the
-// source tree this library was built from.
+// headers next to the running program (<prefix>/bin/../include: an installed, possibly moved, prefix), the
+// source tree this library was built from (a build-tree program), or the configured install location (a
+// program of the user's own linked to the installed library).
 fs::path HeaderDirectory() {
   std::vector<fs::path> candidates;
   if (const char* d = std::getenv("HYBRIDCONT_INCLUDE_DIR"); d && *d) candidates.push_back(d);
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) candidates.push_back(exe.parent_path().parent_path() / "include");
-  candidates.push_back(HYBRIDCONT_INSTALL_INCLUDE_DIR);
   candidates.push_back(HYBRIDCONT_SOURCE_INCLUDE_DIR);
+  candidates.push_back(HYBRIDCONT_INSTALL_INCLUDE_DIR);
   for (const fs::path& c : candidates) {
     if (fs::exists(c / "hybridcont" / "model.h", ec)) return c;
   }
@@ -204,7 +207,7 @@ std::shared_ptr<const CompiledPrograms> CompileModel(const ExpressionModelSpec& 
   for (const std::string& dir : {std::string(HYBRIDCONT_EIGEN_INCLUDE_DIR)}) {
     if (!dir.empty() && dir != include.string()) flags += " -I" + Quote(dir);
   }
-  const std::string key = Hash(source + "\n" + compiler + " " + flags + "\n" + HYBRIDCONT_VERSION_STRING);
+  const std::string key = Hash(source + "\n" + compiler + " " + flags + "\n" + HYBRIDCONT_VERSION);
   const fs::path cache = CacheDirectory(options);
   const fs::path library = cache / ("model-" + key + ".so");
   std::error_code ec;
