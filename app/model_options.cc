@@ -1,10 +1,12 @@
 #include "model_options.h"
 
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <stdexcept>
 
 #include "hybridcont/model_file.h"
+#include "install_paths.h"
 #include "hybridcont/models.h"
 
 namespace hybridcont::app {
@@ -56,7 +58,15 @@ HybridModel MakeModelWithOverrides(const std::string& name, const std::vector<st
     if (!IsModelFilePath(name)) return MakeBuiltinModel(name);
     ModelFileOptions options;
     options.log = log;
-    return LoadModelFile(name, options);
+    // A relative path that does not exist here names one of the shipped models: `hybridcont run
+    // stiffening-slip.toml` finds <models folder>/stiffening-slip.toml of this installation.
+    std::filesystem::path path = name;
+    std::error_code ec;
+    if (path.is_relative() && !std::filesystem::exists(path, ec)) {
+      const std::filesystem::path shipped = ModelsDirectory() / path.filename();
+      if (!ModelsDirectory().empty() && std::filesystem::exists(shipped, ec)) path = shipped;
+    }
+    return LoadModelFile(path, options);
   }();
   for (const std::string& a : assignments) {
     const auto [parameter, value] = ParseAssignment("--set", a);

@@ -15,7 +15,8 @@ namespace hybridcont::app {
 // the offending text, e.g. "--set 'k=abc': value 'abc' is not a number".
 std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text);
 
-// Builds the model — a built-in model by name, or a model file (a path ending in .toml, model_file.h) —
+// Builds the model — a built-in model by name, or a model file (a path ending in .toml, model_file.h; a
+// relative path that does not exist is looked up in the installation's models folder, install_paths.h) —
 // and applies the overrides; throws std::invalid_argument on an unknown model, a bad model file (file,
 // line and field in the message) or an unknown parameter or a value outside its range. Notes on compiling
 // a model file (first use, interpreted fall-back) go to `log`.
