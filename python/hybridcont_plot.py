@@ -1,6 +1,5 @@
 #!/usr/bin/env python3
-"""Figures for the results of ``hybridcont run`` (paper §4: Figs. HoverT, bouncingrod, rodKeyFrame, slip,
-slipKeyFrame, ballrockFrame).
+"""Figures for the results of ``hybridcont run`` (paper §4: bifurcation diagrams and key frames).
 
 Usage::
 
@@ -8,48 +7,59 @@ Usage::
 
 Reads RESULTS_DIR/summary.json and the CSV files it names, writes the figures into RESULTS_DIR as PNG
 (150 dpi; with ``--svg`` also as SVG) and prints the paths of the files written, one per line.
-Exits with status 2 and a one-line message on stderr when the folder or summary.json is missing or
-malformed, with status 1 when some figure could not be drawn (the others are still written).
-Only the standard library and matplotlib (Agg backend) are used.
+Exits with status 2 and a one-line message on stderr (naming the file and the field) when the folder or
+summary.json is missing or malformed, with status 1 when some figure could not be drawn (the others are
+still written).  Only the standard library and matplotlib (Agg backend) are used.
+
+The script knows no model.  Everything model-specific -- the title, the extra figures, how the mechanism
+is drawn -- comes from the results folder, where the writer put the model's presentation
+(include/hybridcont/model_setup.h), so a model file gets the same figures as a built-in model.
 
 Data contract (fields are looked up by name; unknown fields and columns are ignored)
 -----------------------------------------------------------------------------------
 summary.json
-    model           "bouncing-ball" | "rocking-block" | "bouncing-rod" | "slip" | any other name
-    parameters      {name: value}; used: l0 (length scale, default 1), beta (block slenderness, default 0.3)
+    model           the model's name (the title when the presentation has none)
+    parameters      {name: value}; listed in the titles
     phases          [{"name": str, "states": [str, ...]}, ...]; m = number of phases
     unknowns        names of the components of u (used to read special points' "u")
     branches        [{"id", "file", "parent" (special point id or -1), "points", "termination", "direction"}]
     special_points  [{"id", "type" (SB|TP|BP|PD|start|...), "branch", "index", "H", "T",
                       "status" (located|bracketed), "precision", "u"}]
-    orbits          [{"file", "branch", "index", "H", "T", "label"}]   (optional)
+    orbits          [{"file", "branch", "index", "H", "T", "label" (the orbit's family name)}]   (optional)
+    presentation    (optional: folders written before it existed get the generic figures only)
+        title       str, used in every figure title
+        quantities  [column name, ...]: per-point quantities written as columns of the branch files
+        families    [family name, ...]
+        figures     [{"file": "NAME.png", "title": str, "x": column, "y": [column, ...], "zoom": bool}]
+        drawing     {"ground": bool, "mass_radius": float,
+                     "phases": {phase name: {"lines": [[point, point, ...], ...], "masses": [point, ...]}}}
 branch-<id>.csv
     header row, then one row per point.  Used columns: H, T, xi (or xi1), t1..t<m+1>, x<i>_<state>, physical (1/0),
-    classification (word), index (to find special points without "u"), stable (1/0/empty, optional).
-    Segment i = 1..m+1 uses phase (i-1) mod m.  Empty or non-numeric cells are read as NaN.
+    classification (word), index (to find special points without "u"), stable (1/0/empty, optional), and
+    any column a figure names (e.g. a quantity).  Empty or non-numeric cells are read as NaN.
 orbit-<k>.csv
-    columns t, segment, "<phase>.<state>" ...; each row fills only the columns of its segment's phase;
-    t runs from 0 to T over one period.
+    columns t, segment, phase (the sample's phase name), "<phase>.<state>" ..., and draw.<point>.x,
+    draw.<point>.y for every drawing point, empty where the sample's phase does not draw the point.
+    t runs from 0 to T over one period.  The points are in the model's length unit and already contain
+    the mechanism's own horizontal motion.
 
 Figures
 -------
-H_T.png          H-bar over T for every branch (Fig. HoverT / slip a).  Physical points (physical == 1)
+H_T.png          H-bar over T for every branch (paper Fig. HoverT).  Physical points (physical == 1)
                  solid, the rest dashed; a branch is split into runs of equal flag that share their
                  boundary point, so the line stays continuous.  One colour per branch.  Special points:
                  SB filled dot, TP open circle, BP square, PD diamond, start star; points only bracketed
                  (not located) have a grey edge.  With a "stable" column, stable physical parts are thicker.
                  A branch whose projection collapses to one point is drawn as a marker.
 H_T_xi.png       (only when some xi != 0) the same in three dimensions T, xi, H-bar, showing the
-                 branches that differ only in xi (e.g. the ball at rest).
-slip_durations.png  (slip) stance durations t1 (lines) and t3 (open markers) over flight time t2 (Fig. slip b).
-slip_speed.png   (slip) period T and forward speed dx in flight over H-bar (Fig. slip a).
-rod_t2.png       (bouncing-rod) H-bar over t2, and the asymmetry t2 - (t1 + t3) over T (Fig. bouncingrod b).
-rod_zoom.png     (bouncing-rod, if special points exist) H-bar over T around the special points
-                 (Fig. bouncingrod a).
+                 branches that differ only in xi (e.g. an equilibrium family).
+<figures[i].file>  the presentation's figures: the y columns over the x column in one axes, drawn like
+                 H_T.png; the first y column as lines, each further one with open markers of its own
+                 shape.  With "zoom", the axis limits enclose the special points instead of all branches.
 keyframes.png    key frames of up to 6 orbits of summary["orbits"] (one row each, equally spaced instants
-                 from t = 0 to T, placed left to right), drawing the ball, the block, the rod or the hopper
-                 (Figs. ballrockFrame, rodKeyFrame, slipKeyFrame).  The hopper's horizontal position is
-                 reconstructed from its velocity (trapezoidal rule) with the foot fixed during stance.
+                 from t = 0 to T, placed left to right): each sample's phase draws its lines (polylines
+                 through the named points, one colour per phase) and masses (discs), above the ground
+                 line y = 0 when the drawing has one; the masses' paths are dotted.
 """
 
 import argparse
@@ -64,7 +74,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.patches import Circle, Polygon  # noqa: E402
+from matplotlib.patches import Circle  # noqa: E402
 
 
 class PlotError(Exception):
@@ -137,6 +147,14 @@ def warn(message):
     print("hybridcont_plot: warning: " + message, file=sys.stderr)
 
 
+def is_number(value):
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def malformed(path, field, problem):
+    return PlotError("%s is malformed: '%s' %s" % (path, field, problem))
+
+
 def load_summary(results_dir):
     if not os.path.exists(results_dir):
         raise PlotError("results folder '%s' does not exist" % results_dir)
@@ -154,16 +172,119 @@ def load_summary(results_dir):
         raise PlotError("%s is malformed: expected a JSON object" % path)
     for key in ("branches", "special_points", "orbits", "phases", "unknowns"):
         if key in summary and summary[key] is not None and not isinstance(summary[key], list):
-            raise PlotError("%s is malformed: '%s' must be a list" % (path, key))
+            raise malformed(path, key, "must be a list")
     if "branches" not in summary:
         raise PlotError("%s is malformed: no 'branches' list" % path)
     for key in ("branches", "special_points", "orbits"):
-        items = summary.get(key) or []
-        if not all(isinstance(b, dict) for b in items):
-            raise PlotError("%s is malformed: entries of '%s' must be objects" % (path, key))
+        for i, item in enumerate(summary.get(key) or []):
+            if not isinstance(item, dict):
+                raise malformed(path, "%s[%d]" % (key, i), "must be an object")
+            # ids and row indices are compared and used as dict keys: numbers only
+            for field in ("id", "branch", "parent", "index"):
+                if item.get(field) is not None and not is_number(item[field]):
+                    raise malformed(path, "%s[%d].%s" % (key, i, field), "must be a number")
+            if key != "special_points" and item.get("file") is not None and not (
+                    isinstance(item["file"], str) and item["file"].strip()):
+                raise malformed(path, "%s[%d].file" % (key, i), "must be a file name")
     if not isinstance(summary.get("parameters", {}) or {}, dict):
-        raise PlotError("%s is malformed: 'parameters' must be an object" % path)
-    return summary
+        raise malformed(path, "parameters", "must be an object")
+    if summary.get("model") is not None and not isinstance(summary["model"], str):
+        raise malformed(path, "model", "must be a string")
+    return summary, path
+
+
+def read_names(obj, key, path, field, required=False):
+    """obj[key] as a list of non-empty strings ([] when absent and not required)."""
+    if key not in obj or obj[key] is None:
+        if required:
+            raise PlotError("%s is malformed: no '%s'" % (path, field))
+        return []
+    value = obj[key]
+    if isinstance(value, str):  # a single name written without the list
+        value = [value]
+    if not isinstance(value, list) or not all(isinstance(v, str) and v.strip() for v in value):
+        raise malformed(path, field, "must be a list of names")
+    return [v.strip() for v in value]
+
+
+def read_presentation(summary, path):
+    """The model's presentation as plain dicts, or None when summary.json has none (an older writer).
+
+    Every field is checked here, so that a bad folder fails once with a message naming the field instead
+    of half-way through a figure."""
+    p = summary.get("presentation")
+    if p is None:
+        return None
+    if not isinstance(p, dict):
+        raise malformed(path, "presentation", "must be an object")
+    title = p.get("title")
+    if title is not None and not isinstance(title, str):
+        raise malformed(path, "presentation.title", "must be a string")
+    out = {"title": (title or "").strip(),
+           "quantities": read_names(p, "quantities", path, "presentation.quantities"),
+           "families": read_names(p, "families", path, "presentation.families"),
+           "figures": [], "drawing": None}
+
+    figures = p.get("figures") or []
+    if not isinstance(figures, list):
+        raise malformed(path, "presentation.figures", "must be a list")
+    for i, f in enumerate(figures):
+        field = "presentation.figures[%d]" % i
+        if not isinstance(f, dict):
+            raise malformed(path, field, "must be an object")
+        name = f.get("file")
+        if not isinstance(name, str) or not name.strip():
+            raise PlotError("%s is malformed: no '%s.file'" % (path, field))
+        name = name.strip()
+        if os.path.basename(name) != name or name in (".", ".."):
+            raise malformed(path, field + ".file", "must be a file name without a folder, got '%s'" % name)
+        stem, ext = os.path.splitext(name)
+        if ext.lower() not in ("", ".png"):
+            raise malformed(path, field + ".file", "must end in .png, got '%s'" % name)
+        ftitle = f.get("title")
+        if ftitle is not None and not isinstance(ftitle, str):
+            raise malformed(path, field + ".title", "must be a string")
+        x = f.get("x")
+        if not isinstance(x, str) or not x.strip():
+            raise PlotError("%s is malformed: no '%s.x' (a column name)" % (path, field))
+        ys = read_names(f, "y", path, field + ".y", required=True)
+        if not ys:
+            raise malformed(path, field + ".y", "must name at least one column")
+        zoom = f.get("zoom", False)
+        if zoom is None:
+            zoom = False
+        if not isinstance(zoom, bool):
+            raise malformed(path, field + ".zoom", "must be true or false")
+        out["figures"].append({"name": stem, "file": stem + ".png", "title": (ftitle or "").strip(),
+                               "x": x.strip(), "y": ys, "zoom": zoom})
+
+    d = p.get("drawing")
+    if d is not None:
+        if not isinstance(d, dict):
+            raise malformed(path, "presentation.drawing", "must be an object")
+        ground = d.get("ground", True)
+        if not isinstance(ground, bool):
+            raise malformed(path, "presentation.drawing.ground", "must be true or false")
+        radius = d.get("mass_radius", 0.05)
+        if not is_number(radius) or not math.isfinite(radius) or radius < 0:
+            raise malformed(path, "presentation.drawing.mass_radius", "must be a number >= 0")
+        phases = d.get("phases") or {}
+        if not isinstance(phases, dict):
+            raise malformed(path, "presentation.drawing.phases", "must be an object {phase name: drawing}")
+        drawing = {"ground": ground, "mass_radius": float(radius), "phases": {}}
+        for name, ph in phases.items():
+            field = "presentation.drawing.phases.%s" % name
+            if not isinstance(ph, dict):
+                raise malformed(path, field, "must be an object")
+            lines = ph.get("lines") or []
+            if not isinstance(lines, list):
+                raise malformed(path, field + ".lines", "must be a list of point lists")
+            drawing["phases"][name] = {
+                "lines": [read_names({"l": line}, "l", path, "%s.lines[%d]" % (field, j))
+                          for j, line in enumerate(lines)],
+                "masses": read_names(ph, "masses", path, field + ".masses")}
+        out["drawing"] = drawing
+    return out
 
 
 def phases_of(summary):
@@ -212,14 +333,31 @@ def axis_label(name):
         "H": r"energy $\bar{H}\ \ [m_\mathrm{o} g\, l_\mathrm{o}]$",
         "T": r"period $T\ \ [\sqrt{l_\mathrm{o}/g}]$",
         "xi": r"$\xi$",
-        "speed": r"forward speed $\dot{x}$ in flight $[\sqrt{g\, l_\mathrm{o}}]$",
-        "asym": r"$t_2-(t_1+t_3)\ \ [\sqrt{l_\mathrm{o}/g}]$",
     }
     if name in labels:
         return labels[name]
     if name.startswith("t") and name[1:].isdigit():
         return r"$t_{%s}\ \ [\sqrt{l_\mathrm{o}/g}]$" % name[1:]
     return name
+
+
+def column_symbol(name):
+    """Short name of a column for legends: the symbol of H, T, xi and the durations, else the name."""
+    symbols = {"H": r"$\bar{H}$", "T": r"$T$", "xi": r"$\xi$"}
+    if name in symbols:
+        return symbols[name]
+    if name.startswith("t") and name[1:].isdigit():
+        return r"$t_{%s}$" % name[1:]
+    return name
+
+
+def axis_label_of(names):
+    """Label of an axis showing several columns: durations share their unit, other names are listed."""
+    if len(names) == 1:
+        return axis_label(names[0])
+    if all(n.startswith("t") and n[1:].isdigit() for n in names):
+        return "durations " + ", ".join(column_symbol(n) for n in names) + r"$\ \ [\sqrt{l_\mathrm{o}/g}]$"
+    return ", ".join(names)
 
 
 def special_point_style(kind, bracketed):
@@ -333,7 +471,8 @@ class Results:
 
     def __init__(self, results_dir):
         self.dir = results_dir
-        self.summary = load_summary(results_dir)
+        self.summary, self.summary_path = load_summary(results_dir)
+        self.presentation = read_presentation(self.summary, self.summary_path)
         self.model = str(self.summary.get("model") or "unknown")
         self.parameters = {k: to_float(v) for k, v in (self.summary.get("parameters") or {}).items()}
         self.phases = phases_of(self.summary)
@@ -346,36 +485,24 @@ class Results:
             b["label"] = branch_label(b, self.special_points)
         self.by_id = {b["id"]: b for b in self.branches}
 
-    def parameter(self, name, default):
-        v = self.parameters.get(name, math.nan)
-        return v if finite(v) else default
-
     def has_stable(self):
         return any(b["table"] is not None and b["table"].num("stable") is not None
                    and any(s == 1 for s in b["table"].num("stable")) for b in self.branches)
 
     def column(self, branch, name):
-        """Branch column by name; "asym" = t2 - (t1 + t3); None when absent."""
+        """Branch column by name; None when absent."""
         t = branch["table"]
         if t is None:
             return None
-        if name == "asym":
-            t1, t2, t3 = t.num("t1"), t.num("t2"), t.num("t3")
-            if t1 is None or t2 is None or t3 is None:
-                return None
-            return [b - (a + c) for a, b, c in zip(t1, t2, t3)]
         if name == "xi" and not t.has("xi") and t.has("xi1"):  # several first integrals: xi1..xik
             return t.num("xi1")
         return t.num(name)
 
     def sp_value(self, sp, name):
-        """Coordinate `name` of a special point: from its own field, from "u", or from its branch row."""
+        """Coordinate `name` of a special point: from its own field, from "u", or from its branch rows."""
         if name in ("H", "T") and finite(to_float(sp.get(name))):
             return to_float(sp.get(name))
         u = sp.get("u")
-        if name == "asym":
-            vals = [self.sp_value(sp, c) for c in ("t1", "t2", "t3")]
-            return vals[1] - (vals[0] + vals[2]) if finite(*vals) else math.nan
         key = "xi1" if name == "xi" and "xi" not in self.unknowns else name
         if isinstance(u, list) and len(u) == len(self.unknowns) and key in self.unknowns:
             v = to_float(u[self.unknowns.index(key)])
@@ -389,8 +516,8 @@ class Results:
         if branch is None or branch["table"] is None:
             return math.nan
         col = self.column(branch, name)
-        index = sp.get("index")
-        if col is None or not isinstance(index, (int, float)):
+        index = to_float(sp.get("index"))
+        if col is None or not finite(index):
             return math.nan
         idx_col = branch["table"].num("index")
         row = None
@@ -401,7 +528,30 @@ class Results:
                     break
         if row is None and 0 <= int(index) < len(col):
             row = int(index)
-        return col[row] if row is not None else math.nan
+        if row is None:
+            return math.nan
+        w = self._weight_after(branch, row, u)
+        if w > 0 and row + 1 < len(col) and finite(col[row], col[row + 1]):
+            return col[row] + w * (col[row + 1] - col[row])
+        return col[row]
+
+    def _weight_after(self, branch, row, u):
+        """Where a special point found "after point `row`" lies towards the next row, in [0, 1].
+
+        A column that is no unknown (a quantity) is known at the branch points only; the weight comes from
+        the unknowns, which the point carries in "u", by least squares along the chord to the next row."""
+        if not isinstance(u, list) or len(u) != len(self.unknowns) or row + 1 >= branch["table"].n:
+            return 0.0
+        num = den = 0.0
+        for name, value in zip(self.unknowns, u):
+            col = self.column(branch, name)
+            v = to_float(value)
+            if col is None or not finite(v, col[row], col[row + 1]):
+                continue
+            d = col[row + 1] - col[row]
+            num += (v - col[row]) * d
+            den += d * d
+        return min(1.0, max(0.0, num / den)) if den > 0 else 0.0
 
 
 # ----------------------------------------------------------------------------------------------------
@@ -475,9 +625,8 @@ def projection(ax, res, xname, yname, sp=True, annotate=True, sp_filter=None):
 
 
 def model_title(res):
-    names = {"bouncing-ball": "bouncing ball", "rocking-block": "rocking block", "bouncing-rod": "bouncing rod",
-             "slip": "SLIP hopper"}
-    title = names.get(res.model, res.model)
+    """The presentation's title (the model's name for older folders) with the parameters."""
+    title = (res.presentation or {}).get("title") or res.model
     pars = ", ".join("%s=%g" % (k, v) for k, v in sorted(res.parameters.items()) if finite(v))
     return title + (" (%s)" % pars if pars else "")
 
@@ -496,17 +645,10 @@ def save(fig, res, name, svg, written):
 def figure_h_t(res, svg, written):
     fig, ax = plt.subplots(figsize=(7.0, 4.8))
     drawn, sp_styles = projection(ax, res, "T", "H")
-    extra = []
-    if res.model == "rocking-block":  # energy bound of the homoclinic orbit (paper Fig. HoverT b)
-        h_max = res.parameter("m", 1.0) * res.parameter("g", 1.0) * res.parameter("l0", 1.0) * (
-            1.0 - math.cos(res.parameter("beta", 0.3)))
-        ax.axhline(h_max, color="0.45", lw=0.9, ls=":", zorder=1)
-        extra.append(Line2D([], [], color="0.45", lw=0.9, ls=":",
-                            label=r"$\bar{H}_\mathrm{max}=m_\mathrm{o} g l_\mathrm{o}(1-\cos\beta)$"))
     if not drawn:
         ax.text(0.5, 0.5, "no branch points", transform=ax.transAxes, ha="center", va="center", color="0.4")
     ax.set_title(r"$\bar{H}$ over $T$: " + model_title(res), fontsize=10)
-    place_legend(fig, ax, legend_handles(res, drawn, sp_styles, res.has_stable(), extra))
+    place_legend(fig, ax, legend_handles(res, drawn, sp_styles, res.has_stable()))
     save(fig, res, "H_T", svg, written)
 
 
@@ -543,72 +685,6 @@ def figure_h_t_xi(res, svg, written):
     save(fig, res, "H_T_xi", svg, written)
 
 
-def flight_speed_column(res):
-    """x<i>_dx of the first segment whose phase has a state "dx" (x2_dx for the SLIP)."""
-    for i in range(1, res.m + 2):
-        if "dx" in res.phases[(i - 1) % res.m]["states"]:
-            return "x%d_dx" % i
-    return "x2_dx"
-
-
-def figure_slip_durations(res, svg, written):
-    fig, ax = plt.subplots(figsize=(7.0, 4.8))
-    drawn, sp_styles = projection(ax, res, "t2", "t1", annotate=True)
-    stable = res.has_stable()
-    for b in res.branches:
-        xs, ys = res.column(b, "t2"), res.column(b, "t3")
-        if xs is None or ys is None:
-            continue
-        t = b["table"]
-        plot_runs(ax, xs, ys, t.num("physical"), t.num("stable") if stable else None, b["colour"])
-        pts = [(x, y) for x, y in zip(xs, ys) if finite(x, y)]
-        every = max(1, len(pts) // 12)
-        if pts:
-            ax.plot(*zip(*pts[::every]), ls="none", marker="o", ms=4.5, mfc="white", mec=b["colour"], mew=1.1,
-                    zorder=4)
-    draw_special_points(ax, res, "t2", "t3", annotate=False)
-    ax.set_ylabel(r"stance durations $t_1$, $t_3\ \ [\sqrt{l_\mathrm{o}/g}]$")
-    ax.set_xlabel(r"flight time $t_2\ \ [\sqrt{l_\mathrm{o}/g}]$")
-    ax.axvline(0.0, color="0.6", lw=0.8, zorder=1)
-    ax.set_title(r"stance durations over flight time: " + model_title(res), fontsize=10)
-    extra = [Line2D([], [], color="0.2", lw=1.8, label=r"$t_1$ (line)"),
-             Line2D([], [], color="0.2", lw=1.8, marker="o", mfc="white", ms=4.5, label=r"$t_3$ (open markers)")]
-    place_legend(fig, ax, legend_handles(res, drawn, sp_styles, stable, extra))
-    save(fig, res, "slip_durations", svg, written)
-
-
-def figure_slip_speed(res, svg, written):
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 6.4), sharex=True)
-    drawn, sp_styles = projection(ax1, res, "H", "T")
-    dx = flight_speed_column(res)
-    projection(ax2, res, "H", dx)
-    ax1.set_xlabel("")
-    ax2.set_ylabel(axis_label("speed"))
-    ax2.axhline(0.0, color="0.6", lw=0.8, zorder=1)
-    ax1.set_title(r"period and forward speed over $\bar{H}$: " + model_title(res), fontsize=10)
-    # layout first: an outside legend placed before tight_layout squeezes the axes (savefig's
-    # bbox_inches="tight" keeps the legend in the image)
-    fig.tight_layout()
-    place_legend(fig, ax1, legend_handles(res, drawn, sp_styles, res.has_stable()))
-    save(fig, res, "slip_speed", svg, written)
-
-
-def figure_rod_t2(res, svg, written):
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10.5, 4.4))
-    drawn, sp_styles = projection(ax1, res, "t2", "H")
-    projection(ax2, res, "T", "asym")
-    ax2.axhline(0.0, color="0.6", lw=0.8, zorder=1)
-    ax1.set_xlabel(r"second flight time $t_2\ \ [\sqrt{l_\mathrm{o}/g}]$")
-    ax1.set_title(r"(a) $\bar{H}$ over $t_2$", fontsize=10)
-    ax2.set_title(r"(b) asymmetry $t_2-(t_1+t_3)$ over $T$ (0: symmetric orbits)", fontsize=10)
-    fig.suptitle(model_title(res), fontsize=10)
-    # layout first: an outside legend placed before tight_layout squeezes the axes (savefig's
-    # bbox_inches="tight" keeps the legend in the image)
-    fig.tight_layout()
-    place_legend(fig, ax2, legend_handles(res, drawn, sp_styles, res.has_stable()))
-    save(fig, res, "rod_t2", svg, written)
-
-
 def data_range(res, name):
     vals = []
     for b in res.branches:
@@ -618,27 +694,101 @@ def data_range(res, name):
     return (min(vals), max(vals)) if vals else (0.0, 1.0)
 
 
-def figure_rod_zoom(res, svg, written):
-    interesting = [sp for sp in res.special_points if sp.get("type") != "start"
-                   and finite(res.sp_value(sp, "T"), res.sp_value(sp, "H"))]
-    if not interesting:
-        return
-    ids = set(id(sp) for sp in interesting)
-    fig, ax = plt.subplots(figsize=(7.0, 4.8))
-    drawn, sp_styles = projection(ax, res, "T", "H", sp_filter=lambda sp: id(sp) in ids)
+# Open markers that tell the second, third, ... y column of a figure apart from the first (drawn as lines).
+SERIES_MARKERS = [("o", "open circles"), ("s", "open squares"), ("^", "open triangles"), ("D", "open diamonds"),
+                  ("v", "open down-triangles")]
+
+
+def zoom_limits(res, points, xname, ynames):
+    """Axis limits enclosing the special points, padded by 30 % of their spread (at least 5 % of the data)."""
     limits = []
-    for name in ("T", "H"):
-        vals = [res.sp_value(sp, name) for sp in interesting]
+    for names in ([xname], ynames):
+        vals = [v for sp in points for v in (res.sp_value(sp, n) for n in names) if finite(v)]
         lo, hi = min(vals), max(vals)
-        full_lo, full_hi = data_range(res, name)
+        full_lo, full_hi = min(data_range(res, n)[0] for n in names), max(data_range(res, n)[1] for n in names)
         full = max(full_hi - full_lo, 1e-9)
         pad = max(0.3 * (hi - lo), 0.05 * full)
         limits.append((lo - pad, hi + pad))
-    ax.set_xlim(*limits[0])
-    ax.set_ylim(*limits[1])
-    ax.set_title(r"zoom on the special points: $\bar{H}$ over $T$, " + model_title(res), fontsize=10)
-    place_legend(fig, ax, legend_handles(res, drawn, sp_styles, res.has_stable()))
-    save(fig, res, "rod_zoom", svg, written)
+    return limits
+
+
+def figure_declared(res, spec, svg, written):
+    """A figure the presentation declares: its y columns over its x column for every branch.
+
+    Drawn like H_T.png (physical parts solid, the rest dashed, special points marked where they have the
+    columns).  All y columns share one axes, so that related columns (the durations of the phases, say)
+    compare directly; the first is drawn as lines, each further one also with open markers of its own
+    shape.  With "zoom" the limits enclose the special points (other than the start), where a diagram's
+    structure is too small to see at full scale; without special points the figure is skipped."""
+    xname = spec["x"]
+
+    def present(name):
+        return any(res.column(b, name) is not None for b in res.branches)
+
+    if not present(xname):
+        warn("%s skipped: no branch file has the column '%s'" % (spec["file"], xname))
+        return
+    missing = [y for y in spec["y"] if not present(y)]
+    ynames = [y for y in spec["y"] if y not in missing]
+    if not ynames:
+        warn("%s skipped: no branch file has the column%s %s" % (
+            spec["file"], "s" if len(missing) > 1 else "", ", ".join("'%s'" % y for y in missing)))
+        return
+    if missing:
+        warn("%s: no branch file has the column%s %s; drawn without" % (
+            spec["file"], "s" if len(missing) > 1 else "", ", ".join("'%s'" % y for y in missing)))
+    sp_filter = None
+    if spec["zoom"]:
+        interesting = [sp for sp in res.special_points if sp.get("type") != "start"
+                       and finite(res.sp_value(sp, xname), res.sp_value(sp, ynames[0]))]
+        if not interesting:
+            warn("%s skipped: no special points to zoom on" % spec["file"])
+            return
+        ids = set(id(sp) for sp in interesting)
+        sp_filter = lambda sp: id(sp) in ids  # noqa: E731
+
+    fig, ax = plt.subplots(figsize=(7.0, 4.8))
+    drawn, sp_styles = projection(ax, res, xname, ynames[0], sp_filter=sp_filter)
+    stable = res.has_stable()
+    extra = []
+    for k, yname in enumerate(ynames[1:]):
+        marker, words = SERIES_MARKERS[k % len(SERIES_MARKERS)]
+        for b in res.branches:
+            xs, ys = res.column(b, xname), res.column(b, yname)
+            if xs is None or ys is None:
+                continue
+            t = b["table"]
+            plot_runs(ax, xs, ys, t.num("physical"), t.num("stable") if stable else None, b["colour"])
+            pts = [(x, y) for x, y in zip(xs, ys) if finite(x, y)]
+            every = max(1, len(pts) // 12)
+            if pts:
+                ax.plot(*zip(*pts[::every]), ls="none", marker=marker, ms=4.5, mfc="white", mec=b["colour"],
+                        mew=1.1, zorder=4)
+        sp_styles.update(draw_special_points(ax, res, xname, yname, annotate=False, only=sp_filter))
+        extra.append(Line2D([], [], color="0.2", lw=1.8, marker=marker, mfc="white", ms=4.5,
+                            label="%s (%s)" % (column_symbol(yname), words)))
+    if extra:
+        extra.insert(0, Line2D([], [], color="0.2", lw=1.8,
+                               label="%s (line)" % column_symbol(ynames[0])))
+    ax.set_xlabel(axis_label(xname))
+    ax.set_ylabel(axis_label_of(ynames))
+    if spec["zoom"]:
+        (x0, x1), (y0, y1) = zoom_limits(res, interesting, xname, ynames)
+        ax.set_xlim(x0, x1)
+        ax.set_ylim(y0, y1)
+    else:
+        # a column through zero (a duration, a velocity) changes its meaning there: mark the zero
+        lo, hi = data_range(res, xname)
+        if lo < 0 < hi:
+            ax.axvline(0.0, color="0.6", lw=0.8, zorder=1)
+        lo = min(data_range(res, y)[0] for y in ynames)
+        hi = max(data_range(res, y)[1] for y in ynames)
+        if lo < 0 < hi:
+            ax.axhline(0.0, color="0.6", lw=0.8, zorder=1)
+    head = spec["title"] or "%s over %s" % (", ".join(ynames), xname)
+    ax.set_title(head + ": " + model_title(res), fontsize=10)
+    place_legend(fig, ax, legend_handles(res, drawn, sp_styles, stable, extra))
+    save(fig, res, spec["name"], svg, written)
 
 
 # ----------------------------------------------------------------------------------------------------
@@ -646,32 +796,35 @@ def figure_rod_zoom(res, svg, written):
 # ----------------------------------------------------------------------------------------------------
 
 def load_orbit(path, phases):
-    """Rows (t, segment, phase name, {state: value}) sorted by t."""
+    """Rows (t, segment, phase name, {point: (x, y)}) in time order: each sample's drawing points.
+
+    A point is in a row when both its coordinates are numbers there (the writer leaves the cells empty
+    where the sample's phase does not draw the point)."""
     table = Table(path)
     ts, segs = table.num("t"), table.num("segment")
     if ts is None or segs is None:
         raise ValueError("no t or segment column")
-    if not phases:  # infer from the column names "<phase>.<state>"
-        names = []
-        for c in table.columns:
-            if "." in c:
-                p, s = c.split(".", 1)
-                if p not in [q["name"] for q in names]:
-                    names.append({"name": p, "states": []})
-                next(q for q in names if q["name"] == p)["states"].append(s)
-        phases = names
-    if not phases:
-        raise ValueError("no phase columns")
-    cols = {p["name"]: {s: table.num("%s.%s" % (p["name"], s)) for s in p["states"]} for p in phases}
+    columns = {}
+    for c in table.columns:
+        if c.startswith("draw.") and c.endswith(".x") and table.has(c[:-2] + ".y"):
+            columns[c[5:-2]] = (table.num(c), table.num(c[:-2] + ".y"))
+    if not columns:
+        raise ValueError("no draw.<point>.x/.y columns (written before drawings were part of the results)")
+    phase_of = table.text("phase")
     rows = []
     for r in range(table.n):
         if not finite(ts[r], segs[r]) or segs[r] < 1:
             continue
         seg = int(round(segs[r]))
-        phase = phases[(seg - 1) % len(phases)]["name"]
-        state = {s: (c[r] if c is not None else math.nan) for s, c in cols[phase].items()}
-        rows.append((ts[r], seg, phase, state))
-    rows.sort(key=lambda row: (row[0], row[1]))
+        if phase_of is not None and phase_of[r]:
+            phase = phase_of[r]
+        else:  # no phase column: segment i runs phase (i-1) mod m
+            phase = phases[(seg - 1) % len(phases)]["name"] if phases else ""
+        points = {name: (xs[r], ys[r]) for name, (xs, ys) in columns.items() if finite(xs[r], ys[r])}
+        rows.append((ts[r], seg, phase, points))
+    # segments follow each other in time; sorting by segment first keeps a switch sample in its own
+    # segment even when rounding puts its time a hair past the next segment's first sample
+    rows.sort(key=lambda row: (row[1], row[0]))
     if len(rows) < 2:
         raise ValueError("fewer than two samples")
     return rows
@@ -694,187 +847,89 @@ def state_at(rows, t):
     if a[1] != b[1]:
         return a if t - a[0] < b[0] - t else b
     w = (t - a[0]) / (b[0] - a[0]) if b[0] > a[0] else 0.0
-    state = {k: a[3][k] + w * (b[3].get(k, math.nan) - a[3][k]) for k in a[3]}
-    return (t, a[1], a[2], state)
+    points = {k: (p[0] + w * (b[3][k][0] - p[0]), p[1] + w * (b[3][k][1] - p[1]))
+              for k, p in a[3].items() if k in b[3]}
+    return (t, a[1], a[2], points)
 
 
-def reconstruct_slip_x(rows):
-    """Adds "_x" (mass) and, in stance, "_foot" to every row's state.
-
-    Horizontal velocity (flight: dx; stance: -dl sin(alpha) - dalpha l cos(alpha)) is integrated with the
-    trapezoidal rule from x = 0; the foot stays where the stance began (geometrically exact in stance)."""
-    out = []
-    x_prev = t_prev = v_prev = None
-    foot, seg_prev = None, None
-    for t, seg, phase, st in rows:
-        st = dict(st)
-        if "l" in st:  # stance
-            a, l, da, dl = st.get("alpha", 0.0), st.get("l", 1.0), st.get("dalpha", 0.0), st.get("dl", 0.0)
-            v = -dl * math.sin(a) - da * l * math.cos(a)
-            if foot is None or seg != seg_prev:
-                x = 0.0 if x_prev is None else x_prev + 0.5 * (v_prev + v) * (t - t_prev)
-                foot = x + l * math.sin(a)
-            x = foot - l * math.sin(a)
-            st["_foot"] = foot
-        else:
-            v = st.get("dx", 0.0)
-            if not finite(v):
-                v = 0.0
-            x = 0.0 if x_prev is None else x_prev + 0.5 * (v_prev + v) * (t - t_prev)
-            foot = None
-        if not finite(x):
-            x = x_prev if x_prev is not None else 0.0
-        if not finite(v):
-            v = 0.0
-        st["_x"] = x
-        st["_vx"] = v
-        out.append((t, seg, phase, st))
-        x_prev, t_prev, v_prev, seg_prev = x, t, v, seg
-    return out
+# Colours of the lines of the drawing's phases, in the order of summary["phases"].
+PHASE_COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf"]
 
 
-def zigzag(p0, p1, coils=5, width=0.06):
-    """Points of a spring drawn from p0 to p1 (straight ends, zigzag in the middle)."""
-    dx, dy = p1[0] - p0[0], p1[1] - p0[1]
-    length = math.hypot(dx, dy)
-    if length < 1e-9:
-        return [p0, p1]
-    ux, uy = dx / length, dy / length
-    nx, ny = -uy, ux
-    pts = [p0]
-    a, b = 0.25, 0.8
-    k = 2 * coils
-    for i in range(k + 1):
-        s = a + (b - a) * i / k
-        off = 0.0 if i in (0, k) else (width if i % 2 else -width)
-        pts.append((p0[0] + ux * s * length + nx * off, p0[1] + uy * s * length + ny * off))
-    pts.append(p1)
-    return pts
+class Drawing:
+    """The presentation's drawing of the mechanism.
 
+    shapes(frame, colour) gives the primitives of one sample in the model's coordinates: the lines of
+    the sample's phase as polylines through its points (broken where a point is missing) in the phase's
+    colour, their other points as small dots, and the masses as discs filled with `colour`."""
 
-class Mechanism:
-    """Draws one model's mechanism.  shapes(state) -> list of primitives in local coordinates."""
+    def __init__(self, spec, phases):
+        self.ground = spec["ground"]
+        self.radius = spec["mass_radius"]
+        self.phases = spec["phases"]
+        known = [p["name"] for p in phases]
+        order = [p for p in known if p in self.phases] + [p for p in self.phases if p not in known]
+        self.colour = {p: PHASE_COLOURS[i % len(PHASE_COLOURS)] for i, p in enumerate(order)}
+        self.order = order
 
-    def __init__(self, res):
-        self.model = res.model
-        self.l0 = res.parameter("l0", 1.0)
-        self.beta = res.parameter("beta", 0.3)
-        self.note = ""
-        if self.model == "rocking-block":
-            self.note = "after the impact the motion is mirrored onto the right corner"
-
-    def supported(self):
-        return self.model in ("bouncing-ball", "rocking-block", "bouncing-rod", "slip")
-
-    def prepare(self, rows):
-        return reconstruct_slip_x(rows) if self.model == "slip" else rows
-
-    def scale(self):
-        return self.l0
-
-    def min_spacing(self):
-        return {"bouncing-ball": 1.25 * self.l0, "rocking-block": 0.0, "bouncing-rod": 1.3 * self.l0,
-                "slip": 0.75 * self.l0}.get(self.model, self.l0)
-
-    def track(self, row):
-        """Point traced over time (centre of mass) in local coordinates."""
-        t, seg, phase, st = row
-        g = lambda k, d=0.0: st.get(k, d) if finite(st.get(k, d)) else d  # noqa: E731
-        if self.model == "bouncing-ball":
-            return (0.0, g("y") + 0.5 * self.l0)
-        if self.model == "bouncing-rod":
-            return (0.0, g("y"))
-        if self.model == "rocking-block":
-            a = g("alpha")
-            w = 2 * self.l0 * math.sin(self.beta)
-            cx, cy = self._rot(0.5 * w, self.l0 * math.cos(self.beta), a)
-            return (w - cx if seg % 2 == 0 else cx, cy)
-        if self.model == "slip":
-            if "l" in st:
-                return (g("_x"), g("l", self.l0) * math.cos(g("alpha")))
-            return (g("_x"), g("y"))
-        return (0.0, 0.0)
-
-    @staticmethod
-    def _rot(x, y, a):
-        return (x * math.cos(a) - y * math.sin(a), x * math.sin(a) + y * math.cos(a))
-
-    def shapes(self, row, colour):
-        t, seg, phase, st = row
-        g = lambda k, d=0.0: st.get(k, d) if finite(st.get(k, d)) else d  # noqa: E731
+    def shapes(self, frame, colour):
+        t, seg, phase, points = frame
+        spec = self.phases.get(phase)
+        if spec is None:
+            return []
         out = []
-        if self.model == "bouncing-ball":
-            r = 0.5 * self.l0
-            cy = g("y") + r
-            out.append(("circle", (0.0, cy), r, dict(fc=colour, ec="black", lw=1.0, alpha=0.85)))
-            out.append(("dot", (0.0, cy), dict(ms=2.5, color="black")))
-        elif self.model == "rocking-block":
-            a = g("alpha")
-            w, h = 2 * self.l0 * math.sin(self.beta), 2 * self.l0 * math.cos(self.beta)
-            corners = [self._rot(x, y, a) for x, y in ((0, 0), (w, 0), (w, h), (0, h))]
-            com = self._rot(0.5 * w, 0.5 * h, a)
-            pivot = (0.0, 0.0)
-            if seg % 2 == 0:  # after the impact: rocking on the right corner (mirror image)
-                corners = [(w - x, y) for x, y in corners]
-                com = (w - com[0], com[1])
-                pivot = (w, 0.0)
-            out.append(("poly", corners, dict(fc=colour, ec="black", lw=1.0, alpha=0.85)))
-            out.append(("line", [pivot, com], dict(color="white", lw=0.8, ls=":")))
-            out.append(("dot", com, dict(ms=3, color="black")))
-            out.append(("dot", pivot, dict(ms=4.5, color="#d62728")))
-        elif self.model == "bouncing-rod":
-            a, y = g("alpha"), g("y")
-            hx, hy = 0.5 * self.l0 * math.cos(a), 0.5 * self.l0 * math.sin(a)
-            left, right = (-hx, y - hy), (hx, y + hy)
-            out.append(("line", [left, right], dict(color=colour, lw=3.0, solid_capstyle="round")))
-            out.append(("dot", left, dict(ms=5.5, color="#d62728", mec="black", mew=0.6)))
-            out.append(("dot", right, dict(ms=5.5, color="white", mec="black", mew=1.0)))
-            out.append(("dot", (0.0, y), dict(ms=2.5, color="black")))
-        elif self.model == "slip":
-            stance = "l" in st
-            x = g("_x")
-            a = g("alpha")
-            if stance:
-                l = g("l", self.l0)
-                foot = (g("_foot", x), 0.0)
-                mass = (foot[0] - l * math.sin(a), l * math.cos(a))
-                vy = g("dl") * math.cos(a) - g("dalpha") * l * math.sin(a)
-                leg_colour = "#d62728"
+        line_colour = self.colour[phase]
+        joints = {}
+        for line in spec["lines"]:
+            run = []
+            for name in line + [None]:
+                p = points.get(name) if name is not None else None
+                if p is not None:
+                    run.append(p)
+                    if name not in spec["masses"]:
+                        joints[name] = p
+                    continue
+                if len(run) >= 2:
+                    out.append(("line", run, dict(color=line_colour, lw=2.0, solid_capstyle="round",
+                                                  solid_joinstyle="round")))
+                run = []
+        for p in joints.values():
+            out.append(("dot", p, dict(ms=3.5, color=line_colour)))
+        for name in spec["masses"]:
+            if name not in points:
+                continue
+            if self.radius > 0:
+                out.append(("circle", points[name], self.radius, dict(fc=colour, ec="black", lw=0.8, zorder=5)))
             else:
-                mass = (x, g("y"))
-                foot = (mass[0] + self.l0 * math.sin(a), mass[1] - self.l0 * math.cos(a))
-                vy = g("dy")
-                leg_colour = "#1f77b4"
-            vx = g("_vx")
-            out.append(("line", zigzag(foot, mass, width=0.045 * self.l0), dict(color=leg_colour, lw=1.3)))
-            out.append(("dot", foot, dict(ms=3.5, color=leg_colour)))
-            k = 0.18 * self.l0
-            if math.hypot(vx, vy) * k > 0.02 * self.l0:
-                out.append(("arrow", mass, (vx * k, vy * k), dict(color="0.35")))
-            out.append(("circle", mass, 0.075 * self.l0, dict(fc="0.15", ec="black", lw=0.8, zorder=5)))
+                out.append(("dot", points[name], dict(ms=6, color=colour, mec="black", mew=0.8)))
         return out
+
+    def masses(self, frame):
+        spec = self.phases.get(frame[2])
+        return [n for n in spec["masses"] if n in frame[3]] if spec else []
+
+    def has_masses(self):
+        return any(spec["masses"] for spec in self.phases.values())
 
 
 def bbox_of(shapes):
+    """(xmin, xmax, ymin, ymax) of the primitives, None when there are none."""
     xs, ys = [], []
     for s in shapes:
         if s[0] == "circle":
             (cx, cy), r = s[1], s[2]
             xs += [cx - r, cx + r]
             ys += [cy - r, cy + r]
-        elif s[0] in ("line", "poly"):
+        elif s[0] == "line":
             xs += [p[0] for p in s[1]]
             ys += [p[1] for p in s[1]]
         elif s[0] == "dot":
             xs.append(s[1][0])
             ys.append(s[1][1])
-        elif s[0] == "arrow":
-            xs += [s[1][0], s[1][0] + s[2][0]]
-            ys += [s[1][1], s[1][1] + s[2][1]]
     xs = [v for v in xs if finite(v)]
     ys = [v for v in ys if finite(v)]
     if not xs or not ys:
-        return (0.0, 0.0, 0.0, 0.0)
+        return None
     return (min(xs), max(xs), min(ys), max(ys))
 
 
@@ -885,10 +940,6 @@ def draw_shapes(ax, shapes, dx):
             (cx, cy), r, kw = s[1], s[2], dict(s[3])
             kw.setdefault("zorder", 4)
             ax.add_patch(Circle((cx + dx, cy), r, **kw))
-        elif kind == "poly":
-            kw = dict(s[2])
-            kw.setdefault("zorder", 3)
-            ax.add_patch(Polygon([(x + dx, y) for x, y in s[1]], closed=True, **kw))
         elif kind == "line":
             kw = dict(s[2])
             kw.setdefault("zorder", 4)
@@ -897,47 +948,80 @@ def draw_shapes(ax, shapes, dx):
             kw = dict(s[2])
             kw.setdefault("zorder", 6)
             ax.plot([s[1][0] + dx], [s[1][1]], marker="o", ls="none", **kw)
-        elif kind == "arrow":
-            kw = s[3]
-            ax.annotate("", xy=(s[1][0] + dx + s[2][0], s[1][1] + s[2][1]), xytext=(s[1][0] + dx, s[1][1]),
-                        arrowprops=dict(arrowstyle="-|>", color=kw.get("color", "0.3"), lw=0.9,
-                                        shrinkA=0, shrinkB=0, mutation_scale=7), zorder=7)
 
 
-def orbit_layout(mech, rows, n_frames):
-    """Frame times, their states, shapes and horizontal offsets, plus the traced path."""
+def drawing_scale(drawing, orbits):
+    """Typical length of the drawing: the largest frame, or half the height the orbits sweep when that
+    is larger (a lone mass is small but travels).  Margins, gaps and the scale bar follow it."""
+    size, height = 0.0, 0.0
+    for rows in orbits:
+        ys = [0.0] if drawing.ground else []
+        for row in rows:
+            box = bbox_of(drawing.shapes(row, "k"))
+            if box is not None:
+                size = max(size, box[1] - box[0], box[3] - box[2])
+                ys += [box[2], box[3]]
+        if ys:
+            height = max(height, max(ys) - min(ys))
+    s = max(size, 0.5 * height)
+    return s if finite(s) and s > 0 else 1.0
+
+
+def orbit_layout(drawing, rows, n_frames, scale):
+    """Frame times, frames, their boxes and horizontal offsets, and the dotted paths of the masses.
+
+    Frames are placed left to right at equal spacing, wide enough that no two frames overlap whatever
+    the mechanism's own horizontal motion (contained in the points) does between them; a path runs
+    through the same spacing continuously in time."""
     t0, t1 = rows[0][0], rows[-1][0]
     period = t1 - t0
     times = [t0 + period * i / (n_frames - 1) for i in range(n_frames)]
-    states = [state_at(rows, t) for t in times]
-    shapes = [mech.shapes(s, "#8fb8de") for s in states]
-    boxes = [bbox_of(s) for s in shapes]
-    widths = [b[1] - b[0] for b in boxes]
-    gap = 0.3 * mech.scale()
-    spacing = max(max(widths) + gap, mech.min_spacing())
-    local_x = [mech.track(s)[0] for s in states]
-    # frames must not overlap, whatever the (physical) horizontal motion does between them
+    frames = [state_at(rows, t) for t in times]
+    boxes = [bbox_of(drawing.shapes(f, "k")) for f in frames]
+    widths = [b[1] - b[0] for b in boxes if b is not None] or [0.0]
+    gap = 0.3 * scale
+    spacing = max(max(widths) + gap, 0.75 * scale)
     for i in range(n_frames - 1):
-        right_i = boxes[i][1]
-        left_next = boxes[i + 1][0]
-        spacing = max(spacing, right_i - left_next + gap)
+        if boxes[i] is not None and boxes[i + 1] is not None:
+            spacing = max(spacing, boxes[i][1] - boxes[i + 1][0] + gap)
     offsets = [spacing * i for i in range(n_frames)]
-    path = []
+    paths = []  # polylines, broken at segment switches (a reset may move a point) and where a mass is absent
+    current = {}
+    seg_prev = None
     for row in rows:
-        x, y = mech.track(row)
+        if row[1] != seg_prev:
+            paths.extend(current.values())
+            current, seg_prev = {}, row[1]
         frac = (row[0] - t0) / period if period > 0 else 0.0
-        path.append((x + spacing * (n_frames - 1) * frac, y))
-    return times, states, offsets, path, local_x
+        names = drawing.masses(row)
+        for name in list(current):
+            if name not in names:
+                paths.append(current.pop(name))
+        for name in names:
+            x, y = row[3][name]
+            current.setdefault(name, []).append((x + spacing * (n_frames - 1) * frac, y))
+    paths.extend(current.values())
+    return times, frames, boxes, offsets, [p for p in paths if len(p) >= 2]
+
+
+def nice_length(s):
+    """The largest 1, 2 or 5 times a power of ten not above s (the scale bar's length)."""
+    unit = 10.0 ** math.floor(math.log10(s))
+    for k in (5.0, 2.0, 1.0):
+        if k * unit <= s * (1 + 1e-9):
+            return k * unit
+    return unit
 
 
 def figure_keyframes(res, svg, written, n_frames=9):
     entries = [o for o in (res.summary.get("orbits") or []) if isinstance(o, dict)]
     if not entries:
         return
-    mech = Mechanism(res)
-    if not mech.supported():
-        warn("no key-frame drawing for model '%s'; keyframes.png skipped" % res.model)
+    spec = res.presentation.get("drawing")
+    if not spec or not spec["phases"]:
+        warn("the presentation has no drawing; keyframes.png skipped")
         return
+    drawing = Drawing(spec, res.phases)
     if len(entries) > 6:
         warn("%d orbits listed; key frames drawn for the first 6" % len(entries))
         entries = entries[:6]
@@ -949,32 +1033,35 @@ def figure_keyframes(res, svg, written, n_frames=9):
             warn("orbit file %s is missing" % fname)
             continue
         try:
-            rows = mech.prepare(load_orbit(path, res.phases))
+            rows = load_orbit(path, res.phases)
         except (OSError, ValueError, csv.Error) as e:
             warn("skipping %s: %s" % (fname, e))
             continue
         if rows[-1][0] <= rows[0][0]:
             warn("skipping %s: zero duration" % fname)
             continue
+        if not any(row[2] in drawing.phases for row in rows):
+            warn("skipping %s: the drawing has none of its phases (%s)" % (
+                fname, ", ".join(sorted(set(row[2] for row in rows)))))
+            continue
         orbits.append((o, rows))
     if not orbits:
         return
 
-    layouts = [orbit_layout(mech, rows, n_frames) for _, rows in orbits]
+    s = drawing_scale(drawing, [rows for _, rows in orbits])
+    layouts = [orbit_layout(drawing, rows, n_frames, s) for _, rows in orbits]
     cmap = plt.get_cmap("Blues")
-    spans = []
-    for (o, rows), (times, states, offsets, path, _) in zip(orbits, layouts):
-        boxes = [bbox_of(mech.shapes(s, "k")) for s in states]
-        xmin = min(b[0] + dx for b, dx in zip(boxes, offsets))
-        xmax = max(b[1] + dx for b, dx in zip(boxes, offsets))
-        ymax = max([b[3] for b in boxes] + [p[1] for p in path if finite(p[1])])
-        ymin = min([b[2] for b in boxes] + [0.0])
-        spans.append((xmin, xmax, ymin, ymax))
-    s = mech.scale()
-    pad = 0.25 * s
     limits = []
-    for xmin, xmax, ymin, ymax in spans:
-        limits.append([xmin - pad, xmax + pad, ymin - 0.3 * s, ymax + 0.25 * s])
+    for times, frames, boxes, offsets, paths in layouts:
+        placed = [(b, dx) for b, dx in zip(boxes, offsets) if b is not None]
+        path_pts = [p for path in paths for p in path]
+        xs = [b[0] + dx for b, dx in placed] + [b[1] + dx for b, dx in placed] + [p[0] for p in path_pts]
+        ys = [b[2] for b, _ in placed] + [b[3] for b, _ in placed] + [p[1] for p in path_pts]
+        if drawing.ground:
+            ys.append(0.0)
+        if not xs:
+            xs, ys = [0.0, offsets[-1]], [0.0, s]
+        limits.append([min(xs) - 0.25 * s, max(xs) + 0.25 * s, min(ys) - 0.3 * s, max(ys) + 0.25 * s])
     # one common scale (inches per unit length) for all rows, so that the orbits compare directly
     width_in, left_in, right_in = 11.0, 0.15, 0.15
     axis_w = width_in - left_in - right_in
@@ -994,25 +1081,26 @@ def figure_keyframes(res, svg, written, n_frames=9):
         w = (l[1] - l[0]) * k
         axes.append(fig.add_axes([left_in / width_in, y_in / height_in, w / width_in, h / height_in]))
         y_in -= gap_in
-    for ax, (o, rows), (times, states, offsets, path, _), span, lim in zip(axes, orbits, layouts, spans,
-                                                                         limits):
-        xmin, xmax, ymin, ymax = span
+    bar = nice_length(s)
+    for ax, (o, rows), (times, frames, boxes, offsets, paths), lim in zip(axes, orbits, layouts, limits):
         ax.set_xlim(lim[0], lim[1])
         ax.set_ylim(lim[2], lim[3])
         ax.set_aspect("equal", adjustable="box", anchor="W")
-        ax.axhline(0.0, color="black", lw=1.2, zorder=1)
-        ax.fill_between([lim[0], lim[1]], -0.08 * s, 0.0, facecolor="none", edgecolor="0.55",
-                        hatch="////", lw=0.0, zorder=0)
-        pts = [p for p in path if finite(*p)]
-        if pts:
-            ax.plot(*zip(*pts), color="0.6", lw=0.8, ls=":", zorder=1)
-        n = len(states)
-        for i, (t, st, dx) in enumerate(zip(times, states, offsets)):
+        if drawing.ground:
+            ax.axhline(0.0, color="black", lw=1.2, zorder=1)
+            ax.fill_between([lim[0], lim[1]], -0.08 * s, 0.0, facecolor="none", edgecolor="0.55",
+                            hatch="////", lw=0.0, zorder=0)
+        for path in paths:
+            ax.plot(*zip(*path), color="0.6", lw=0.8, ls=":", zorder=1)
+        n = len(frames)
+        # time labels under the ground, or under the lowest frame when there is no ground
+        bottoms = [b[2] for b in boxes if b is not None]
+        label_y = (0.0 if drawing.ground or not bottoms else min(bottoms)) - 0.11 * s
+        for i, (t, frame, box, dx) in enumerate(zip(times, frames, boxes, offsets)):
             colour = cmap(0.35 + 0.55 * i / max(n - 1, 1))
-            draw_shapes(ax, mech.shapes(st, colour), dx)
-            cx = bbox_of(mech.shapes(st, colour))
-            ax.text(0.5 * (cx[0] + cx[1]) + dx, -0.11 * s, "t=%.2f" % t, ha="center", va="top", fontsize=7,
-                    color="0.3")
+            draw_shapes(ax, drawing.shapes(frame, colour), dx)
+            cx = 0.5 * (box[0] + box[1]) if box is not None else 0.0
+            ax.text(cx + dx, label_y, "t=%.2f" % t, ha="center", va="top", fontsize=7, color="0.3")
         label = str(o.get("label") or "orbit")
         H, T = to_float(o.get("H")), to_float(o.get("T"))
         if not finite(T):
@@ -1025,27 +1113,22 @@ def figure_keyframes(res, svg, written, n_frames=9):
             title += "  (branch %s)" % o.get("branch")
         ax.set_title(title, fontsize=9.5, loc="left")
         ax.set_axis_off()
-        # scale bar of length l0
-        x0 = lim[1] - 1.05 * s
-        ax.plot([x0, x0 + s], [lim[3] - 0.12 * s] * 2, color="black", lw=1.5)
-        ax.text(x0 + 0.5 * s, lim[3] - 0.1 * s, r"$l_\mathrm{o}$", ha="center", va="bottom", fontsize=8)
-    notes = []
-    if mech.model == "slip":
-        notes = [Line2D([], [], color="#d62728", lw=1.5, label="leg in stance"),
-                 Line2D([], [], color="#1f77b4", lw=1.5, label="leg in flight"),
-                 Line2D([], [], color="0.35", lw=0.9, marker=">", ms=4, label="velocity of the mass")]
-    elif mech.model == "bouncing-rod":
-        notes = [Line2D([], [], marker="o", ls="none", color="#d62728", mec="black", label="left end"),
-                 Line2D([], [], marker="o", ls="none", color="white", mec="black", label="right end")]
-    elif mech.model == "rocking-block":
-        notes = [Line2D([], [], marker="o", ls="none", color="#d62728", label="pivot corner")]
-    notes.append(Line2D([], [], color="0.6", lw=0.8, ls=":", label="centre of mass (time runs left to right)"))
-    fig.legend(handles=notes, loc="lower left", ncol=len(notes), fontsize=8, frameon=False,
-               bbox_to_anchor=(left_in / width_in, 0.0))
-    head = "Key frames, %s" % model_title(res)
-    if mech.note:
-        head += "; " + mech.note
-    fig.suptitle(head, fontsize=10.5, x=left_in / width_in, y=1.0 - 0.12 / height_in, ha="left", va="top")
+        # scale bar: a round length in the model's unit
+        x0 = lim[1] - 0.05 * s - bar
+        ax.plot([x0, x0 + bar], [lim[3] - 0.12 * s] * 2, color="black", lw=1.5)
+        ax.text(x0 + 0.5 * bar, lim[3] - 0.1 * s, "%g" % bar, ha="center", va="bottom", fontsize=8)
+    notes = [Line2D([], [], color=drawing.colour[p], lw=2.0, label=p) for p in drawing.order
+             if drawing.phases[p]["lines"]]
+    if drawing.has_masses():
+        notes.append(Line2D([], [], marker="o", ls="none", ms=6, mfc=cmap(0.6), mec="black", mew=0.8,
+                            label="mass (darker: later)"))
+        notes.append(Line2D([], [], color="0.6", lw=0.8, ls=":",
+                            label="path of the masses (time runs left to right)"))
+    if notes:
+        fig.legend(handles=notes, loc="lower left", ncol=len(notes), fontsize=8, frameon=False,
+                   bbox_to_anchor=(left_in / width_in, 0.0))
+    fig.suptitle("Key frames, %s" % model_title(res), fontsize=10.5, x=left_in / width_in,
+                 y=1.0 - 0.12 / height_in, ha="left", va="top")
     save(fig, res, "keyframes", svg, written)
 
 
@@ -1073,16 +1156,25 @@ def main(argv):
     except PlotError as e:
         print("hybridcont_plot: error: %s" % e, file=sys.stderr)
         return 2
+    except (TypeError, ValueError, AttributeError, KeyError) as e:  # a field of a type no check foresaw
+        print("hybridcont_plot: error: %s is malformed: %s: %s" % (
+            os.path.join(args.results_dir, "summary.json"), type(e).__name__, e), file=sys.stderr)
+        return 2
     jobs = [("H_T", lambda w: figure_h_t(res, args.svg, w))]
     if has_nonzero_xi(res):
         jobs.append(("H_T_xi", lambda w: figure_h_t_xi(res, args.svg, w)))
-    if res.model == "slip":
-        jobs.append(("slip_durations", lambda w: figure_slip_durations(res, args.svg, w)))
-        jobs.append(("slip_speed", lambda w: figure_slip_speed(res, args.svg, w)))
-    if res.model == "bouncing-rod":
-        jobs.append(("rod_t2", lambda w: figure_rod_t2(res, args.svg, w)))
-        jobs.append(("rod_zoom", lambda w: figure_rod_zoom(res, args.svg, w)))
-    jobs.append(("keyframes", lambda w: figure_keyframes(res, args.svg, w, args.frames)))
+    if res.presentation is None:
+        warn("%s has no 'presentation' (written by an older hybridcont): only the generic figures are drawn"
+             % res.summary_path)
+    else:
+        names = set(("H_T", "H_T_xi", "keyframes"))
+        for spec in res.presentation["figures"]:
+            if spec["name"] in names:
+                warn("%s is declared twice or would overwrite a generic figure; skipped" % spec["file"])
+                continue
+            names.add(spec["name"])
+            jobs.append((spec["name"], lambda w, spec=spec: figure_declared(res, spec, args.svg, w)))
+        jobs.append(("keyframes", lambda w: figure_keyframes(res, args.svg, w, args.frames)))
     written, failed = [], []
     for name, job in jobs:
         try:
