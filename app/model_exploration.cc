@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "hybridcont/classification.h"
+#include "hybridcont/corrector.h"
 
 namespace hybridcont::app {
 
@@ -151,6 +152,23 @@ BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {
       const Vector v = Eigen::Map<const Vector>(info.values.data(), static_cast<Eigen::Index>(info.values.size()));
       on_point(info, scaled_->FromScaled(v));
     };
+  }
+  if (!state_ && model_.setup().start.kind == StartSpec::Kind::kGuess) {
+    // An approximate orbit (StartSpec::kGuess): Newton at the guess's level H, then explore from the
+    // corrected orbit, a regular point of its family.
+    Corrector corrector(scaled_.get());
+    const Vector guess = scaled_->ToScaled(start);
+    const int h = scaled_->UnknownIndex("H");
+    Vector corrected;
+    const CorrectorResult result = corrector.CorrectFixedComponent(guess, h, guess(h), &corrected);
+    if (!result.converged()) {
+      BifurcationDiagram failed;
+      failed.status = ExplorationStatus::kStartFailed;
+      failed.message = "the start guess does not converge to an orbit at H = " +
+                       std::to_string(start(shooting_.layout().H_index())) + ": " + result.message;
+      return failed;
+    }
+    start = scaled_->FromScaled(corrected);
   }
   BifurcationDiagram diagram = Explore(scaled_.get(), scaled_->ToScaled(start), options);
   for (Branch& b : diagram.branches) {

@@ -43,7 +43,9 @@ class ModelExploration {
 
   using PointCallback = std::function<void(const ProgressInfo& info, const Vector& u)>;
   // Explores from the start point; on_point sees every accepted point in model units and in the layout of
-  // the formulation's unknowns (ToTimeBased converts state-based points).
+  // the formulation's unknowns (ToTimeBased converts state-based points). A start the model declares as a
+  // guess (StartSpec::Kind::kGuess) is first corrected by Newton at its H; if that fails the diagram's
+  // status is kStartFailed with the corrector's message.
   BifurcationDiagram Run(const PointCallback& on_point = PointCallback());
 
   // The time-based map (also used by the state-based formulation to find its start).
