@@ -24,8 +24,32 @@ void ResultsWriter::PrepareDirectory(const fs::path& dir) {
   fs::remove(probe, ec);
 }
 
+namespace {
+
+// What the figure script needs to know of the model's presentation (model_setup.h).
+nlohmann::json PresentationJson(const HybridModel& model, const OrbitPresentation& presentation) {
+  const ModelSetup& setup = model.setup();
+  nlohmann::json figures = nlohmann::json::array();
+  for (const FigureSpec& f : setup.figures) {
+    figures.push_back({{"file", f.file}, {"title", f.title}, {"x", f.x}, {"y", f.y}, {"zoom", f.zoom_special_points}});
+  }
+  nlohmann::json phases = nlohmann::json::object();
+  for (const DrawingSpec::PhaseDrawing& d : setup.drawing.phases) {
+    if (phases.contains(d.phase)) continue;  // drawings of one phase for other segments look alike
+    phases[d.phase] = {{"lines", d.lines}, {"masses", d.masses}};
+  }
+  return {{"title", setup.title.empty() ? model.name() : setup.title},
+          {"quantities", presentation.quantity_names()},
+          {"families", presentation.family_names()},
+          {"figures", figures},
+          {"drawing",
+           {{"ground", setup.drawing.ground}, {"mass_radius", setup.drawing.mass_radius}, {"phases", phases}}}};
+}
+
+}  // namespace
+
 ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::json options)
-    : dir_(std::move(dir)), model_(model), layout_(model) {
+    : dir_(std::move(dir)), model_(model), layout_(model), presentation_(model) {
   summary_["model"] = model.name();
   summary_["description"] = model.description();
   nlohmann::json params = nlohmann::json::object();
@@ -37,6 +61,7 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
   }
   summary_["phases"] = phases;
   summary_["unknowns"] = layout_.unknown_names();
+  summary_["presentation"] = PresentationJson(model, presentation_);
   summary_["options"] = std::move(options);
   summary_["branches"] = nlohmann::json::array();
   summary_["special_points"] = nlohmann::json::array();
@@ -64,6 +89,7 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
     }
     f << ",physical,classification,residual,newton_iterations,step";
     for (const auto& [name, value] : p.extra) f << "," << name;
+    for (const std::string& name : presentation_.quantity_names()) f << "," << name;
     f << "\n";
   }
   std::ofstream& f = it->second;
@@ -79,6 +105,10 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
   for (const auto& [name, value] : p.extra) {
     if (std::isfinite(value)) f << fmt::format(",{:.10g}", value);
     else f << ",";  // not defined for this point (e.g. Floquet data of a non-physical orbit)
+  }
+  for (const double value : presentation_.Quantities(u)) {
+    if (std::isfinite(value)) f << fmt::format(",{:.17g}", value);
+    else f << ",";
   }
   f << "\n";
   f.flush();
@@ -117,18 +147,29 @@ std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int 
                                     const std::string& label) {
   const std::string name = "orbit-" + std::to_string(summary_["orbits"].size()) + ".csv";
   std::ofstream f(dir_ / name);
-  f << "t,segment";
+  f << "t,segment,phase";
   for (int p = 0; p < model_.num_phases(); ++p) {
     for (const auto& s : model_.phase(p).state_names()) f << "," << model_.phase(p).name() << "." << s;
   }
+  for (const std::string& point : presentation_.point_names()) f << ",draw." << point << ".x,draw." << point << ".y";
   f << "\n";
-  for (const OrbitSample& s : trace.Sample(400)) {
-    f << fmt::format("{:.12g},{}", s.t, s.segment + 1);
+  const std::vector<OrbitSample> samples = trace.Sample(400);
+  const std::vector<Matrix> drawn = presentation_.DrawOrbit(samples);
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const OrbitSample& s = samples[k];
     const int phase = s.segment % model_.num_phases();
+    f << fmt::format("{:.12g},{},{}", s.t, s.segment + 1, model_.phase(phase).name());
     for (int p = 0; p < model_.num_phases(); ++p) {
       for (int c = 0; c < model_.phase(p).dim(); ++c) {
         if (p == phase) f << fmt::format(",{:.12g}", s.x(c));
         else f << ",";
+      }
+    }
+    for (Eigen::Index point = 0; point < drawn[k].cols(); ++point) {
+      for (int c = 0; c < 2; ++c) {
+        const double value = drawn[k](c, point);
+        if (std::isfinite(value)) f << fmt::format(",{:.12g}", value);
+        else f << ",";  // a point that the drawing of this sample's phase does not place
       }
     }
     f << "\n";

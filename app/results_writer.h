@@ -1,7 +1,18 @@
-// Writes a run's results as they are computed (issue 4, item 2):
-//   DIR/summary.json       model, parameters, effective options, branches, special points, orbits
-//   DIR/branch-<id>.csv    one row per point: H, T, xi, t1..t<m+1>, x<i>_<state>..., physical, ...
-//   DIR/orbit-<k>.csv      sampled trajectories of selected physical orbits (key frames)
+// Writes a run's results as they are computed:
+//   DIR/summary.json       model, parameters, effective options, branches, special points, orbits, and the
+//                          model's presentation (title, quantities, families, figures, drawing)
+//   DIR/branch-<id>.csv    one row per point: H, T, xi, t1..t<m+1>, x<i>_<state>..., physical, ..., then
+//                          the model's declared quantities (setup().quantities), one column each
+//   DIR/orbit-<k>.csv      sampled trajectories of selected physical orbits (key frames): t, segment,
+//                          phase (its name), the states of every phase, then draw.<point>.x, draw.<point>.y
+//                          for every point of the model's drawing (empty where the sample's phase does not
+//                          place it; OrbitPresentation::DrawOrbit)
+// The figure script reads these by name; the presentation block is
+//   "presentation": {"title", "quantities": [names], "families": [names],
+//                    "figures": [{"file", "title", "x", "y": [...], "zoom"}],
+//                    "drawing": {"ground", "mass_radius", "phases": {"<phase>": {"lines": [[point, ...]],
+//                                                                               "masses": [point, ...]}}}}
+// and each orbit's "label" is its family name.
 // Every CSV row is flushed when written and summary.json is rewritten atomically (temp + rename) after
 // each branch, so an interrupted run leaves consistent files with everything computed so far.
 #ifndef HYBRIDCONT_APP_RESULTS_WRITER_H_
@@ -18,6 +29,7 @@
 #include "hybridcont/classification.h"
 #include "hybridcont/continuation.h"
 #include "hybridcont/orbit_trace.h"
+#include "hybridcont/setup_evaluation.h"
 #include "hybridcont/shooting_layout.h"
 
 namespace hybridcont::app {
@@ -40,6 +52,7 @@ class ResultsWriter {
   // ("--out 'DIR': ...") otherwise. Call before any computation so that bad input writes nothing.
   static void PrepareDirectory(const std::filesystem::path& dir);
 
+  // Throws ModelInputError for a model whose presentation does not evaluate (OrbitPresentation).
   ResultsWriter(std::filesystem::path dir, const HybridModel& model, nlohmann::json options);
 
   void AddPoint(int branch_id, const PointRecord& point);
@@ -59,6 +72,7 @@ class ResultsWriter {
   std::filesystem::path dir_;
   const HybridModel& model_;
   ShootingLayout layout_;
+  OrbitPresentation presentation_;
   nlohmann::json summary_;
   std::map<int, std::ofstream> branch_files_;
   std::map<int, int> points_per_branch_;

@@ -1,11 +1,12 @@
-// The paper's run of each built-in model: start point, bounds and the orbits drawn as key frames.
+// A model's default run, in numbers: its set-up (model_setup.h, declared with the model) evaluated at the
+// model's current parameters.
 //
-// These are the defaults of `hybridcont run MODEL`; every value can be overridden from the command line
-// (--until, --max-branches, ...). They encode the paper's §4 set-up:
-//   bouncing-ball  u0 = 0 (equilibrium), H <= 1
-//   rocking-block  u0 = 0, up to the homoclinic limit H_max = m g l0 (1 - cos beta), stopping at T = 20
-//   bouncing-rod   u0 = 0 (non-simple: kernel of dimension 3), symmetric direction t2 = t1 + t3, H <= 0.6
-//   slip           the T0 = 2 pi sqrt(m/k) oscillation at H = m g l0, H <= 2
+//   HybridModel block = MakeRockingBlock();
+//   block.SetParameter("beta", 0.2);
+//   Scenario s = DefaultScenario(block);   // H <= m g l0 (1 - cos 0.2), key frames at half of it, ...
+//
+// These are the defaults of `hybridcont run MODEL`; values can be overridden from the command line
+// (--until, --max-branches, ...). No model is named here: everything comes from model.setup().
 #ifndef HYBRIDCONT_APP_SCENARIO_H_
 #define HYBRIDCONT_APP_SCENARIO_H_
 
@@ -46,11 +47,14 @@ struct Scenario {
   std::vector<std::pair<std::string, double>> unknown_scales;
   KeyframeTarget keyframes{"H", 0.5};
   int max_keyframe_orbits = 4;
-  // A short description of a physical orbit u (time-based layout) for figure titles.
+  // A short description of a physical orbit u (time-based layout) for figure titles: its family name
+  // (OrbitPresentation::Family).
   std::function<std::string(const Vector& u)> describe;
 };
 
-// Throws std::invalid_argument for a model without a paper scenario.
+// model.setup() evaluated: bounds (component "period" becomes a SumBound over all durations t1..t<m+1>),
+// scales, steps and limits, the start point and its conditions, the key-frame target. Throws
+// ModelInputError (a std::invalid_argument) naming the field of a value that does not evaluate.
 Scenario DefaultScenario(const HybridModel& model);
 
 }  // namespace hybridcont::app

@@ -9,8 +9,8 @@
 //
 // Values are expressions (expression.h) so that they follow the parameters: the rocking block's energy
 // bound is "m*g*l0*(1 - cos(beta))", the SLIP's start "pi*sqrt(m/k)". They are evaluated when a run is set
-// up (ResolveRunSetup), after `--set` has changed the parameters. Symbols:
-//   set-up values (start, bounds, scales, key frames)   the model's parameters
+// up (setup_evaluation.h), after `--set` has changed the parameters. Symbols:
+//   set-up values (start, bounds, scales, key frames)   the model's parameters and `definitions`
 //   family rules and quantities                          also the unknowns of the time-based layout
 //                                                        (t1.., x<i>_<state>, xi / xi<j>, H) and T (period)
 //   drawing                                              also the phase's states and X (see DrawingSpec)
@@ -115,6 +115,12 @@ struct DrawingSpec {
     std::vector<Point> points;
     std::vector<std::vector<std::string>> lines;
     std::vector<std::string> masses;
+    // The shooting segments (1..m+1) this drawing applies to; empty: every segment of the phase. Drawings
+    // of one phase for different segments have the same points, lines and masses, placed differently: a
+    // model that folds a mirror-image motion onto one phase draws it mirrored where the fold happened (the
+    // rocking block rocks on its right corner in segment 2, after the impact, but its state is written
+    // about the left corner).
+    std::vector<int> segments;
   };
   std::vector<PhaseDrawing> phases;  // empty: no key-frame drawing
   bool ground = true;                // the line y = 0
@@ -129,6 +135,10 @@ struct ModelSetup {
   std::vector<FigureSpec> figures;
   DrawingSpec drawing;
   std::string title;  // for figures ("SLIP hopper"); the model's name if empty
+  // Named values over the parameters and other definitions (a model file's [definitions]) that every
+  // expression above may use, e.g. ("H_max", "m*g*l0*(1 - cos(beta))") for "0.5*H_max". A name is looked
+  // up after the unknowns, states and parameters, so a definition cannot redefine those.
+  std::vector<std::pair<std::string, SetupValue>> definitions;
 };
 
 }  // namespace hybridcont

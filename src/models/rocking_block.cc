@@ -1,6 +1,9 @@
 // Rocking block (paper eq. `HDSblock`): pivoting about the left corner, the symmetric motion about the
 // right corner folded onto it; impact at alpha = 0, anchor at dalpha = 0.
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "hybridcont/models.h"
 
@@ -46,19 +49,75 @@ struct TurningPoint {
   }
 };
 
+// The paper's run (§4.2): from the equilibrium u0 = 0 up to the homoclinic limit
+// H_max = m g l0 (1 - cos beta), the energy of the block balanced on its corner.
+ModelSetup BlockSetup() {
+  const std::string H_max = "m*g*l0*(1 - cos(beta))";
+  ModelSetup setup;
+  setup.title = "rocking block";
+  setup.start.kind = StartSpec::Kind::kSingular;  // u0 = 0: at rest on both corners, zero durations
+  RunSpec& run = setup.run;
+  // |xi| <= 1 ends the at-rest xi-branches through the equilibria (they exist for every xi).
+  run.bounds = {{"xi", "-1", "1"}, {"H", "-1", H_max},
+                // T grows without bound towards the homoclinic orbit at H_max: stop cleanly at |T| = 20,
+                // where H_max - H ~ 1e-9. Beyond T ~ 30 the monodromy grows like e^{lambda T} and Newton's
+                // linear systems lose all accuracy (measured: steps collapse to 1e-6 near T = 33), so
+                // nothing is gained by going on.
+                {"period", "-20", "20"}};
+  run.keyframe_component = "H";
+  run.keyframe_value = "0.5*(" + H_max + ")";
+  // H <= H_max ~ 0.045 and alpha <= beta: scaled to O(1) so that the branch is resolved in H too.
+  run.scales.push_back({"H", H_max});
+  for (const std::string i : {"1", "2"}) {
+    run.scales.push_back({"x" + i + "_alpha", "beta"});
+    run.scales.push_back({"x" + i + "_dalpha", "sqrt(" + H_max + "/m)/l0"});
+  }
+  run.max_step = 0.5;
+  // The block of width 2 l0 sin(beta) and height 2 l0 cos(beta), turned by alpha about its pivot corner.
+  // The motion about the right corner is folded onto the left one (alpha >= 0 throughout): segment 1 rocks
+  // on the left corner into the impact, segment 2 on the right corner after it, drawn mirrored about the
+  // block's axis (x -> w - x).
+  const std::string w = "2*l0*sin(beta)", h = "2*l0*cos(beta)";
+  const auto turned = [&](const std::string& x, const std::string& y) {  // (x, y) turned by alpha
+    return std::pair<std::string, std::string>{"(" + x + ")*cos(alpha) - (" + y + ")*sin(alpha)",
+                                               "(" + x + ")*sin(alpha) + (" + y + ")*cos(alpha)"};
+  };
+  const std::vector<std::pair<std::string, std::pair<std::string, std::string>>> body = {
+      {"pivot", {"0", "0"}},
+      {"corner2", turned(w, "0")},
+      {"corner3", turned(w, h)},
+      {"corner4", turned("0", h)},
+      {"com", turned("0.5*" + w, "0.5*" + h)}};
+  for (const bool mirrored : {false, true}) {
+    DrawingSpec::PhaseDrawing d;
+    d.phase = "rocking";
+    d.segments = {mirrored ? 2 : 1};
+    for (const auto& [name, xy] : body) {
+      d.points.push_back({name, mirrored ? w + " - (" + xy.first + ")" : xy.first, xy.second});
+    }
+    d.lines = {{"pivot", "corner2", "corner3", "corner4", "pivot"}, {"pivot", "com"}};
+    d.masses = {"com"};
+    setup.drawing.phases.push_back(d);
+  }
+  setup.drawing.mass_radius = 0.04;
+  return setup;
+}
+
 }  // namespace
 
 HybridModel MakeRockingBlock() {
   ModelBuilder<BlockParameters> b("rocking-block", "rectangular block rocking on its corners (paper §4.2)");
-  b.Parameter("m", &BlockParameters::m, "mass")
-      .Parameter("l0", &BlockParameters::l0, "half diagonal")
-      .Parameter("g", &BlockParameters::g, "gravity")
-      .Parameter("beta", &BlockParameters::beta, "slenderness angle [rad]");
+  b.Parameter("m", &BlockParameters::m, "mass", ParameterRange::Positive())
+      .Parameter("l0", &BlockParameters::l0, "half diagonal", ParameterRange::Positive())
+      .Parameter("g", &BlockParameters::g, "gravity", ParameterRange::Positive())
+      // beta = 0 is a block without width (it cannot stand), pi/2 one without height.
+      .Parameter("beta", &BlockParameters::beta, "slenderness angle [rad]", ParameterRange::Open(0.0, M_PI / 2));
   Vector typical(2);
   typical << 0.1, 0.2;
   b.AddPhase<Rocking>("rocking", {"alpha", "dalpha"}, typical);
   b.SetAnchor<TurningPoint>();
   b.Symmetry("time-reversal", {Vector(Eigen::Vector2d(1, -1))}, true);  // the impact law is linear in dalpha
+  b.Setup(BlockSetup());
   return b.Build();
 }
 

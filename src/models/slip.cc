@@ -87,15 +87,65 @@ struct Nadir {
   }
 };
 
+// The paper's run (§4.4): from the vertical harmonic oscillation with zero flight time at H = m g l0 up to
+// H = 2.
+ModelSetup SlipSetup() {
+  ModelSetup setup;
+  setup.title = "SLIP hopper";
+  // Vertical harmonic oscillation with zero flight time (paper §4.4): t1 = t3 = T0/2 with
+  // T0 = 2 pi sqrt(m/k), t2 = 0, x̄_1 at nadir l = l0 - 2mg/k, x̄_3 at l = l0 with zero velocity,
+  // H = m g l0: a singular point of r, as in the paper.
+  setup.start.kind = StartSpec::Kind::kSingular;
+  setup.start.values = {{"t1", "pi*sqrt(m/k)"}, {"t2", "0"},  {"t3", "pi*sqrt(m/k)"}, {"x1_l", "l0 - 2*m*g/k"},
+                        {"x2_y", "l0"},         {"x3_l", "l0"}, {"H", "m*g*l0"}};
+  RunSpec& run = setup.run;
+  // |xi| <= 1 ends the at-rest xi-branches through the equilibria (they exist for every xi).
+  run.bounds = {{"xi", "-1", "1"}, {"H", "0", "2"}, {"period", "-20", "20"}};
+  run.keyframe_component = "H";
+  run.keyframe_value = "1.8";
+  // Steps stay at 0.1. Larger steps cost fewer evaluations (0.2: 1661 instead of 1916) and, since the
+  // Floquet pass finds crossing pairs inside one step (FindHiddenRootPair), keep the PD points of
+  // hopping in place. But the cluster of nearly tangent crossings near H = 1.6116 (four images of one
+  // branch) is resolved differently from one step to the next above 0.135 (measured for max_step in
+  // 0.14–0.23: 23 or 31 half-branches, 17 to 23 SB points), while 0.09–0.135 all give the same 23
+  // half-branches and 21 SB points, all located.
+  run.max_step = 0.1;
+  // x2_dx is the forward speed in flight.
+  setup.families = {{"hopping in place", "abs(x2_dx) < 1e-6"},
+                    {"forward hopping", "x2_dx > 0"},
+                    {"backward hopping", "1"}};
+  setup.figures = {{"slip_durations.png", "stance durations t1, t3 over the flight time t2", "t2", {"t1", "t3"}},
+                   {"slip_speed.png", "forward speed in flight over the energy", "H", {"x2_dx"}}};
+  // The body at (X, height) on its massless leg. X advances with the body's horizontal speed: in flight
+  // dx; in stance the time derivative of its position -l sin(alpha) relative to the fixed foot, so the
+  // foot X + l sin(alpha) stays where it touched down (the flight's foot X + l0 sin(alpha) there).
+  DrawingSpec::PhaseDrawing stance, flight;
+  stance.phase = "stance";
+  stance.x_velocity = "-dl*sin(alpha) - dalpha*l*cos(alpha)";
+  stance.points = {{"body", "X", "l*cos(alpha)"}, {"foot", "X + l*sin(alpha)", "0"}};
+  flight.phase = "flight";
+  flight.x_velocity = "dx";
+  flight.points = {{"body", "X", "y"}, {"foot", "X + l0*sin(alpha)", "y - l0*cos(alpha)"}};
+  for (DrawingSpec::PhaseDrawing* d : {&stance, &flight}) {
+    d->lines = {{"foot", "body"}};
+    d->masses = {"body"};
+  }
+  setup.drawing.phases = {stance, flight};
+  setup.drawing.mass_radius = 0.075;
+  return setup;
+}
+
 }  // namespace
 
 HybridModel MakeSlip() {
   ModelBuilder<SlipParameters> b("slip", "spring-loaded inverted pendulum hopper with swing leg (paper §4.4)");
-  b.Parameter("m", &SlipParameters::m, "point mass")
-      .Parameter("l0", &SlipParameters::l0, "natural leg length")
-      .Parameter("g", &SlipParameters::g, "gravity")
-      .Parameter("k", &SlipParameters::k, "leg stiffness")
-      .Parameter("w2", &SlipParameters::w2, "squared swing frequency omega^2 of the leg in flight");
+  b.Parameter("m", &SlipParameters::m, "point mass", ParameterRange::Positive())
+      .Parameter("l0", &SlipParameters::l0, "natural leg length", ParameterRange::Positive())
+      .Parameter("g", &SlipParameters::g, "gravity", ParameterRange::Positive())
+      .Parameter("k", &SlipParameters::k, "leg stiffness", ParameterRange::Positive())
+      // w2 > 0: the leg swings about the vertical in flight (w2 <= 0 would let it fall away from it).
+      .Parameter("w2", &SlipParameters::w2, "squared swing frequency omega^2 of the leg in flight",
+                 ParameterRange::Positive());
   Vector stance(4), flight(5);
   stance << 0.1, 0.9, 0.3, -0.4;
   flight << 0.95, 0.1, 0.3, 0.5, -0.2;
@@ -110,6 +160,7 @@ HybridModel MakeSlip() {
   reverse_flight << 1, 1, -1, -1, -1;
   b.Symmetry("mirror", {mirror_stance, mirror_flight}, false);
   b.Symmetry("time-reversal", {reverse_stance, reverse_flight}, true);
+  b.Setup(SlipSetup());
   return b.Build();
 }
 
