@@ -83,6 +83,10 @@ class Parser {
  private:
   // Nesting deeper than this is refused: it bounds the recursion for hostile input.
   static constexpr int kMaxDepth = 200;
+  // Operations on the longest path of the tree, resolved symbols (definitions, let quantities) included:
+  // compiling and destroying a tree recurse that deep, and a long sum "a+a+...+a" is a chain as deep as
+  // it has terms (50000 overflowed the stack).
+  static constexpr int kMaxTreeDepth = 10000;
 
   [[noreturn]] void Fail(const std::string& what) const {
     throw ModelInputError(where_, "in expression '" + Excerpt() + "' at column " + std::to_string(pos_ + 1) +
@@ -114,14 +118,33 @@ class Parser {
     Parser* p_;
   };
 
+  // The tree depth of e, memoized; trees of resolved symbols were bounded when they were parsed.
+  int TreeDepth(const ExprPtr& e) {
+    if (const auto it = tree_depth_.find(e.get()); it != tree_depth_.end()) return it->second;
+    int depth = 0;
+    for (const ExprPtr& a : e->args) depth = std::max(depth, TreeDepth(a));
+    return tree_depth_[e.get()] = depth + 1;
+  }
+  ExprPtr Node(ExprOp op, std::vector<ExprPtr> args) {
+    int depth = 0;
+    for (const ExprPtr& a : args) depth = std::max(depth, TreeDepth(a));
+    if (depth + 1 > kMaxTreeDepth) {
+      Fail("more than " + std::to_string(kMaxTreeDepth) +
+           " operations deep (counting the definitions and let quantities it uses)");
+    }
+    ExprPtr e = MakeNode(op, std::move(args));
+    tree_depth_[e.get()] = depth + 1;
+    return e;
+  }
+
   ExprPtr Or() {
     ExprPtr e = And();
-    while (Accept("||")) e = MakeNode(ExprOp::kOr, {e, And()});
+    while (Accept("||")) e = Node(ExprOp::kOr, {e, And()});
     return e;
   }
   ExprPtr And() {
     ExprPtr e = Comparison();
-    while (Accept("&&")) e = MakeNode(ExprOp::kAnd, {e, Comparison()});
+    while (Accept("&&")) e = Node(ExprOp::kAnd, {e, Comparison()});
     return e;
   }
   ExprPtr Comparison() {
@@ -130,36 +153,36 @@ class Parser {
         {"<=", ExprOp::kLessEqual}, {">=", ExprOp::kGreaterEqual}, {"==", ExprOp::kEqual},
         {"!=", ExprOp::kNotEqual},  {"<", ExprOp::kLess},          {">", ExprOp::kGreater}};
     for (const auto& [token, op] : kOps) {
-      if (Accept(token)) return MakeNode(op, {e, Sum()});
+      if (Accept(token)) return Node(op, {e, Sum()});
     }
     return e;
   }
   ExprPtr Sum() {
     ExprPtr e = Product();
     for (;;) {
-      if (Accept("+")) e = MakeNode(ExprOp::kAdd, {e, Product()});
-      else if (Accept("-")) e = MakeNode(ExprOp::kSub, {e, Product()});
+      if (Accept("+")) e = Node(ExprOp::kAdd, {e, Product()});
+      else if (Accept("-")) e = Node(ExprOp::kSub, {e, Product()});
       else return e;
     }
   }
   ExprPtr Product() {
     ExprPtr e = Unary();
     for (;;) {
-      if (Accept("*")) e = MakeNode(ExprOp::kMul, {e, Unary()});
-      else if (Accept("/")) e = MakeNode(ExprOp::kDiv, {e, Unary()});
+      if (Accept("*")) e = Node(ExprOp::kMul, {e, Unary()});
+      else if (Accept("/")) e = Node(ExprOp::kDiv, {e, Unary()});
       else return e;
     }
   }
   ExprPtr Unary() {
     DepthGuard guard(this);
-    if (Accept("-")) return MakeNode(ExprOp::kNeg, {Unary()});
+    if (Accept("-")) return Node(ExprOp::kNeg, {Unary()});
     if (Accept("+")) return Unary();
-    if (Accept("!")) return MakeNode(ExprOp::kNot, {Unary()});
+    if (Accept("!")) return Node(ExprOp::kNot, {Unary()});
     return Power();
   }
   ExprPtr Power() {
     ExprPtr base = Primary();
-    if (Accept("^") || Accept("**")) return MakeNode(ExprOp::kPow, {base, Unary()});
+    if (Accept("^") || Accept("**")) return Node(ExprOp::kPow, {base, Unary()});
     return base;
   }
   ExprPtr Primary() {
@@ -237,7 +260,7 @@ class Parser {
       pos_ = start;
       Fail(name + " takes " + std::to_string(it->second.second) + " argument(s), got " + std::to_string(args.size()));
     }
-    return MakeNode(it->second.first, std::move(args));
+    return Node(it->second.first, std::move(args));
   }
 
   const std::string& s_;
@@ -245,6 +268,7 @@ class Parser {
   const SourceLocation& where_;
   std::size_t pos_ = 0;
   int depth_ = 0;
+  std::unordered_map<const ExprNode*, int> tree_depth_;
 };
 
 // Compiles trees into the two instruction lists, sharing identical subtrees (by node identity first, then

@@ -325,7 +325,10 @@ class Reader {
       if (parameter_index_.count(name)) Fail(&node, "definitions." + name, "'" + name + "' is also a parameter");
       definition_sources_[name] = &node;
     }
-    for (const auto& [name, node] : definition_sources_) Definition(name);
+    for (const auto& [name, node] : definition_sources_) {
+      Definition(name);
+      spec_.setup.definitions.push_back({name, AsSetupValue(*node, "definitions." + name)});
+    }
   }
 
   // A symbol name must be an identifier that is not a function or a reserved name.
@@ -430,7 +433,8 @@ class Reader {
     const toml::node* energy = t.get("energy");
     const toml::node* integrals = t.get("integrals");
     if ((energy == nullptr) == (integrals == nullptr)) {
-      Fail(&t, pf + ".energy", "give exactly one of 'energy' (the first integral) or 'integrals' (several)");
+      Fail(integrals ? integrals : &t, pf + ".energy",
+           "give exactly one of 'energy' (the first integral) or 'integrals' (several)");
     }
     std::vector<ExprPtr> h;
     std::vector<SourceLocation> h_where;
@@ -507,6 +511,7 @@ class Reader {
       CheckKeys(t, field, {"name", "reverses_time", "flip"});
       ModelSymmetry s;
       s.name = RequiredString(t, "name", field);
+      if (s.name.empty()) Fail(t.get("name"), field + ".name", "a symmetry needs a name");
       s.reverses_time = OptionalBool(t, "reverses_time", field, false);
       const toml::table* flip = OptionalTable(t, "flip", field);
       for (const ExpressionPhaseSpec& p : spec_.phases) s.state_signs.push_back(Vector::Ones(p.state_names.size()));
@@ -527,6 +532,12 @@ class Reader {
       }
       for (const ModelSymmetry& known : spec_.symmetries) {
         if (known.name == s.name) Fail(t.get("name"), field + ".name", "symmetry '" + s.name + "' declared twice");
+      }
+      const bool flips = std::any_of(s.state_signs.begin(), s.state_signs.end(),
+                                     [](const Vector& signs) { return (signs.array() < 0.0).any(); });
+      if (!flips && !s.reverses_time) {
+        Fail(flip ? static_cast<const toml::node*>(flip) : &t, field + ".flip",
+             "symmetry '" + s.name + "' flips no state and does not reverse time (it is the identity)");
       }
       spec_.symmetries.push_back(std::move(s));
     }
@@ -749,8 +760,14 @@ class Reader {
       pd.phase = k;
       const auto check = [&](const toml::node& n, const std::string& f) {
         SetupValue v = AsSetupValue(n, f);
+        // The symbols OrbitPresentation gives a drawing: the phase's states, X, parameters, definitions
+        // (not the phase's let quantities, which the run would refuse after compiling the model).
+        const std::vector<std::string>& states = spec_.phases[phase].state_names;
         ParseExpression(v.expression,
-                        [&](const std::string& s) -> ExprPtr { return s == "X" ? MakeInput(0) : PhaseSymbol(phase, s); },
+                        [&](const std::string& s) -> ExprPtr {
+                          if (s == "X" || std::find(states.begin(), states.end(), s) != states.end()) return MakeInput(0);
+                          return GlobalSymbol(s);
+                        },
                         v.where);
         return v;
       };
