@@ -1,5 +1,7 @@
 #include "results_writer.h"
 
+#include "hybridcont/version.h"
+
 #include <fmt/format.h>
 
 #include <cmath>
@@ -51,6 +53,7 @@ nlohmann::json PresentationJson(const HybridModel& model, const OrbitPresentatio
 ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::json options)
     : dir_(std::move(dir)), model_(model), layout_(model), presentation_(model) {
   summary_["model"] = model.name();
+  summary_["version"] = HYBRIDCONT_VERSION;
   summary_["description"] = model.description();
   nlohmann::json params = nlohmann::json::object();
   for (const auto& info : model.parameters()) params[info.name] = model.parameter(info.name);
