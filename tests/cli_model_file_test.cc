@@ -8,27 +8,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli.h"
+#include "cli_runner.h"
 
 namespace hybridcont::app {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliResult {
-  int code;
-  std::string out;
-  std::string err;
-};
-
-CliResult Tool(std::vector<std::string> args) {
-  args.insert(args.begin(), "hybridcont");
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  std::ostringstream out, err;
-  const int code = RunCli(static_cast<int>(argv.size()), argv.data(), out, err);
-  return {code, out.str(), err.str()};
-}
 
 fs::path Fresh(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("hybridcont_cli_model_file_" + name);
@@ -59,11 +45,11 @@ double LargestH(const fs::path& dir) {
 TEST(CliModelFile, ParameterOutsideItsRangeIsRefusedAndNothingIsWritten) {
   for (const std::string& model : {std::string("slip"), SlipFile()}) {
     const fs::path out = Fresh("range");
-    const CliResult r = Tool({"run", model, "--set", "k=-40", "--out", out.string(), "--no-plots"});
+    const CliResult r = RunTool({"run", model, "--set", "k=-40", "--out", out.string(), "--no-plots"});
     EXPECT_EQ(r.code, 2) << r.err;
     for (const char* part : {"'k'", "-40", "(0, inf)"}) EXPECT_NE(r.err.find(part), std::string::npos) << part << ": " << r.err;
     EXPECT_FALSE(fs::exists(out));
-    const CliResult m = Tool({"run", model, "--set", "m=0", "--out", out.string(), "--no-plots"});
+    const CliResult m = RunTool({"run", model, "--set", "m=0", "--out", out.string(), "--no-plots"});
     EXPECT_EQ(m.code, 2);
     EXPECT_NE(m.err.find("'m'"), std::string::npos) << m.err;
     EXPECT_FALSE(fs::exists(out));
@@ -73,17 +59,17 @@ TEST(CliModelFile, ParameterOutsideItsRangeIsRefusedAndNothingIsWritten) {
 TEST(CliModelFile, BoundFromTheCommandLineReplacesTheModelsBound) {
   const fs::path out = Fresh("bound");
   const CliResult r =
-      Tool({"run", "slip", "--bound", "H=0:2.7", "--max-branches", "3", "--out", out.string(), "--no-plots", "--quiet"});
+      RunTool({"run", "slip", "--bound", "H=0:2.7", "--max-branches", "3", "--out", out.string(), "--no-plots", "--quiet"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NEAR(LargestH(out), 2.7, 0.1);  // past the model's bound H <= 2
   EXPECT_GT(LargestH(out), 2.6);
   const CliResult until =
-      Tool({"run", "slip", "--until", "H=2.7", "--max-branches", "3", "--out", out.string(), "--no-plots", "--quiet"});
+      RunTool({"run", "slip", "--until", "H=2.7", "--max-branches", "3", "--out", out.string(), "--no-plots", "--quiet"});
   ASSERT_EQ(until.code, 0) << until.err;
   EXPECT_NEAR(LargestH(out), 2.7, 1e-9);  // ends exactly at the target
   for (const char* bad : {"H=2:1", "H", "H=a:2", "H=0:inf", "nosuch=0:1"}) {
     const fs::path none = Fresh("bound_bad");
-    const CliResult b = Tool({"run", "slip", "--bound", bad, "--out", none.string(), "--no-plots"});
+    const CliResult b = RunTool({"run", "slip", "--bound", bad, "--out", none.string(), "--no-plots"});
     EXPECT_EQ(b.code, 2) << bad << ": " << b.err;
     EXPECT_NE(b.err.find("--bound"), std::string::npos) << bad << ": " << b.err;
     EXPECT_FALSE(fs::exists(none)) << bad;
@@ -91,19 +77,19 @@ TEST(CliModelFile, BoundFromTheCommandLineReplacesTheModelsBound) {
 }
 
 TEST(CliModelFile, ListAndCheckTakeModelFiles) {
-  const CliResult list = Tool({"list", SlipFile()});
+  const CliResult list = RunTool({"list", SlipFile()});
   EXPECT_EQ(list.code, 0) << list.err;
   for (const char* s : {"stance", "flight", "n = 5", "(0, inf)", "leg stiffness"}) {
     EXPECT_NE(list.out.find(s), std::string::npos) << s;
   }
-  const CliResult check = Tool({"check", SlipFile(), "--points", "2"});
+  const CliResult check = RunTool({"check", SlipFile(), "--points", "2"});
   EXPECT_EQ(check.code, 0) << check.out << check.err;
   EXPECT_NE(check.out.find("all derivatives agree"), std::string::npos);
 }
 
 TEST(CliModelFile, MissingOrMalformedFileIsBadInput) {
   const fs::path out = Fresh("malformed");
-  const CliResult missing = Tool({"run", "/nonexistent/model.toml", "--out", out.string(), "--no-plots"});
+  const CliResult missing = RunTool({"run", "/nonexistent/model.toml", "--out", out.string(), "--no-plots"});
   EXPECT_EQ(missing.code, 2);
   EXPECT_NE(missing.err.find("/nonexistent/model.toml"), std::string::npos) << missing.err;
   const fs::path bad = fs::temp_directory_path() / "hybridcont_cli_model_file_bad.toml";
@@ -113,7 +99,7 @@ TEST(CliModelFile, MissingOrMalformedFileIsBadInput) {
   std::string s = text.str();
   s.replace(s.find("ode.dl = \""), 10, "ode.dl = \"q + ");  // an unknown symbol in the stance phase
   std::ofstream(bad) << s;
-  const CliResult r = Tool({"run", bad.string(), "--out", out.string(), "--no-plots"});
+  const CliResult r = RunTool({"run", bad.string(), "--out", out.string(), "--no-plots"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find(bad.string() + ":"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("phases.stance.ode.dl"), std::string::npos) << r.err;

@@ -11,27 +11,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli.h"
+#include "cli_runner.h"
 
 namespace hybridcont::app {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliResult {
-  int code;
-  std::string out;
-  std::string err;
-};
-
-CliResult RunTool(std::vector<std::string> args) {
-  args.insert(args.begin(), "hybridcont");
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  std::ostringstream out, err;
-  const int code = RunCli(static_cast<int>(argv.size()), argv.data(), out, err);
-  return {code, out.str(), err.str()};
-}
 
 fs::path TempDir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("hybridcont_cli_test_" + name);
