@@ -12,6 +12,7 @@
 
 #include "hybridcont/continuation.h"
 #include "hybridcont/hybridcont.h"
+#include "hybridcont/model_builder.h"
 
 namespace {
 

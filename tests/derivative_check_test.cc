@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "hybridcont/derivative_check.h"
+#include "hybridcont/model_builder.h"
 #include "hybridcont/models.h"
 
 namespace hybridcont {

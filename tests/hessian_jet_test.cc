@@ -2,6 +2,7 @@
 // apply, and with differenced first-order gradients on the functions only it offers.
 #include <gtest/gtest.h>
 
+#include "hybridcont/internal/autodiff_phase.h"
 #include "hybridcont/model.h"
 
 namespace hybridcont::internal {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "hybridcont/derivative_check.h"
+#include "hybridcont/model_builder.h"
 #include "hybridcont/models.h"
 
 namespace hybridcont {

@@ -21,7 +21,7 @@
 // differentiable and are refused where a derivative is taken (ExpressionProgram with differentiable =
 // true), as are min and max, whose derivative jumps where the arguments cross.
 //
-// Evaluation is exact automatic differentiation when T is a jet (autodiff_phase.h): every instruction is an
+// Evaluation is exact automatic differentiation when T is a jet (internal/autodiff_phase.h): every instruction is an
 // operation of the scalar type, so Evaluate<Jet> gives the value and the exact derivative.
 #ifndef HYBRIDCONT_EXPRESSION_H_
 #define HYBRIDCONT_EXPRESSION_H_

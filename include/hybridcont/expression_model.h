@@ -3,7 +3,7 @@
 //   ExpressionModelSpec spec;                 // filled by the model-file reader (model_file.h)
 //   HybridModel model = BuildExpressionModel(std::move(spec));
 //
-// Each phase is an AutoDiffPhase (autodiff_phase.h) over functions that run an ExpressionProgram, so its
+// Each phase is an AutoDiffPhase (internal/autodiff_phase.h) over functions that run an ExpressionProgram, so its
 // derivatives are the same forward-mode automatic differentiation as a built-in model's: df, dH, ∇²H, de
 // and dΔ are exact, never finite differences. Two ways to run a program:
 //   - interpreted: ExpressionProgram::Evaluate<T>, one instruction at a time over the scalar type T;
@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "hybridcont/expression.h"
+#include "hybridcont/internal/autodiff_phase.h"
 #include "hybridcont/model.h"
 
 namespace hybridcont {

@@ -1,4 +1,5 @@
-// Umbrella header: everything a user of the hybridcont library needs.
+// Umbrella header: everything a user of the core hybridcont library needs (model files: model_file.h,
+// in the hybridcont::modelfile target).
 #ifndef HYBRIDCONT_HYBRIDCONT_H_
 #define HYBRIDCONT_HYBRIDCONT_H_
 
@@ -12,12 +13,15 @@
 #include "hybridcont/floquet.h"
 #include "hybridcont/flow.h"
 #include "hybridcont/model.h"
+#include "hybridcont/model_builder.h"
+#include "hybridcont/model_setup.h"
 #include "hybridcont/models.h"
 #include "hybridcont/orbit_trace.h"
 #include "hybridcont/poincare_map.h"
 #include "hybridcont/replay.h"
 #include "hybridcont/saltation.h"
 #include "hybridcont/scaled_problem.h"
+#include "hybridcont/setup_evaluation.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/special_point.h"
 #include "hybridcont/statebased_shooting.h"

@@ -5,38 +5,15 @@
 // de_i·f_i < 0) and a reset map Delta_i: x_i^- -> x_{i+1}^+ into the next phase (cyclic: m+1 = 1).
 // Phase 1 carries the anchor a, whose downward zero crossing defines the Poincaré section.
 //
-// Users write these functions once, as templates over the scalar type; the library differentiates them
-// by forward-mode automatic differentiation (see autodiff_phase.h and ModelBuilder below):
-//
-//   struct BallParameters { double m = 1.0, g = 1.0; };
-//   struct Fall {
-//     template <class T> static StateVector<T> VectorField(const StateVector<T>& x, const BallParameters& p) {
-//       StateVector<T> f(2); f << x(1), T(-p.g); return f;
-//     }
-//     template <class T> static T FirstIntegral(const StateVector<T>& x, const BallParameters& p) {
-//       return 0.5 * p.m * x(1) * x(1) + p.m * p.g * x(0);
-//     }
-//     template <class T> static T Event(const StateVector<T>& x, const BallParameters&) { return x(0); }
-//     template <class T> static StateVector<T> Reset(const StateVector<T>& x, const BallParameters&) {
-//       StateVector<T> y(2); y << x(0), -x(1); return y;
-//     }
-//   };
-//   struct Apex { template <class T> static T Anchor(const StateVector<T>& x, const BallParameters&) { return x(1); } };
-//
-//   ModelBuilder<BallParameters> b("bouncing-ball", "a ball bouncing elastically on the ground");
-//   b.Parameter("m", &BallParameters::m, "mass").Parameter("g", &BallParameters::g, "gravity");
-//   b.AddPhase<Fall>("flight", {"y", "dy"}, /*typical_state=*/{0.5, 0.0});
-//   b.SetAnchor<Apex>();
-//   HybridModel ball = b.Build();
+// Users write the phase functions once, as templates over the scalar type, and assemble a model with
+// ModelBuilder (model_builder.h), which differentiates them by forward-mode automatic differentiation;
+// a model file (model_file.h) gives the same without C++. A user who wants analytic derivatives
+// implements the `Phase` interface below directly.
 //
 // A model may declare symmetries (ModelBuilder::Symmetry): involutions that map orbits onto orbits, each a
 // sign change of every phase's state, possibly with time reversal (durations and ξ change sign). The
 // exploration then maps a half-branch that is the image of a traced one instead of tracing it
 // (exploration.h, "Symmetries"); `hybridcont check` verifies each declaration on sample points.
-//
-// A phase functor may define `FirstIntegrals` (returning a StateVector<T> of k values) instead of
-// `FirstIntegral` when the system has k > 1 hybrid first integrals (the paper's remark on N_H > 1).
-// A user who wants analytic derivatives implements the `Phase` interface directly instead.
 #ifndef HYBRIDCONT_MODEL_H_
 #define HYBRIDCONT_MODEL_H_
 
@@ -212,118 +189,6 @@ class HybridModel {
   std::unique_ptr<ParameterBlock> parameters_;
   std::vector<std::unique_ptr<Phase>> phases_;
   std::unique_ptr<Anchor> anchor_;
-  std::vector<ModelSymmetry> symmetries_;
-  ModelSetup setup_;
-};
-
-}  // namespace hybridcont
-
-#include "hybridcont/autodiff_phase.h"
-
-namespace hybridcont {
-
-// Assembles a HybridModel from templated functors over a parameter struct P.
-template <class P>
-class ModelBuilder {
- public:
-  ModelBuilder(std::string name, std::string description)
-      : name_(std::move(name)), description_(std::move(description)),
-        parameters_(std::make_unique<internal::TypedParameterBlock<P>>()) {}
-
-  // Registers a named parameter stored in member `member` of P; its default is the member's initializer.
-  // range: the values it may take (default: every finite value); the default must lie inside.
-  ModelBuilder& Parameter(std::string name, double P::*member, std::string description,
-                          ParameterRange range = {}) {
-    parameters_->Add(std::move(name), member, std::move(description), range);
-    return *this;
-  }
-
-  // The model's default run and presentation (model_setup.h).
-  ModelBuilder& Setup(ModelSetup setup) {
-    setup_ = std::move(setup);
-    return *this;
-  }
-
-  // Appends a phase whose functions are the static templates of F (see the header comment).
-  // typical_state: a state where the functions are well defined (sizes the phase; samples checks).
-  template <class F>
-  ModelBuilder& AddPhase(std::string name, std::vector<std::string> state_names, Vector typical_state) {
-    pending_.push_back({std::move(name), std::move(state_names), std::move(typical_state),
-                        [](PendingPhase& pp, int next_dim, const P* params) -> std::unique_ptr<Phase> {
-                          return std::make_unique<internal::AutoDiffPhase<F, P>>(
-                              pp.name, pp.state_names, next_dim, pp.typical_state, params);
-                        }});
-    return *this;
-  }
-  ModelBuilder& AddPhase(std::unique_ptr<Phase> hand_written) {
-    ready_.emplace(static_cast<int>(pending_.size()), std::move(hand_written));
-    pending_.push_back({});
-    return *this;
-  }
-
-  template <class A>
-  ModelBuilder& SetAnchor() {
-    anchor_factory_ = [](const P* params) -> std::unique_ptr<Anchor> {
-      return std::make_unique<internal::AutoDiffAnchor<A, P>>(params);
-    };
-    return *this;
-  }
-
-  // Declares a symmetry (ModelSymmetry): one sign vector per phase, in the order the phases were added.
-  ModelBuilder& Symmetry(std::string name, std::vector<Vector> state_signs, bool reverses_time) {
-    symmetries_.push_back({std::move(name), std::move(state_signs), reverses_time});
-    return *this;
-  }
-
-  // Validates dimensions (reset maps into the next phase, first integrals in every phase) and builds.
-  // Throws std::invalid_argument naming the offending phase.
-  HybridModel Build() {
-    const int m = static_cast<int>(pending_.size());
-    if (m == 0) throw std::invalid_argument("model '" + name_ + "': no phases");
-    if (!anchor_factory_) throw std::invalid_argument("model '" + name_ + "': no anchor set");
-    const P* params = &parameters_->values();
-    std::vector<std::unique_ptr<Phase>> phases(m);
-    std::vector<int> dims(m);
-    for (int i = 0; i < m; ++i) {
-      dims[i] = ready_.count(i) ? ready_.at(i)->dim() : static_cast<int>(pending_[i].state_names.size());
-    }
-    for (int i = 0; i < m; ++i) {
-      if (ready_.count(i)) {
-        phases[i] = std::move(ready_.at(i));
-      } else {
-        if (pending_[i].typical_state.size() != dims[i]) {
-          throw std::invalid_argument("model '" + name_ + "', phase '" + pending_[i].name +
-                                      "': typical_state has " + std::to_string(pending_[i].typical_state.size()) +
-                                      " entries, the phase has " + std::to_string(dims[i]) + " states");
-        }
-        if (dims[i] < 1 || dims[i] > kMaxPhaseDim) {
-          throw std::invalid_argument("model '" + name_ + "', phase '" + pending_[i].name + "': dimension " +
-                                      std::to_string(dims[i]) + " outside [1, kMaxPhaseDim = " +
-                                      std::to_string(kMaxPhaseDim) + "]");
-        }
-        phases[i] = pending_[i].make(pending_[i], dims[(i + 1) % m], params);
-      }
-    }
-    internal::ValidatePhaseSizes(name_, phases);
-    HybridModel model(name_, description_, std::move(parameters_), std::move(phases), anchor_factory_(params));
-    for (ModelSymmetry& symmetry : symmetries_) model.AddSymmetry(std::move(symmetry));
-    model.SetSetup(std::move(setup_));
-    return model;
-  }
-
- private:
-  struct PendingPhase {
-    std::string name;
-    std::vector<std::string> state_names;
-    Vector typical_state;
-    std::function<std::unique_ptr<Phase>(PendingPhase&, int, const P*)> make;
-  };
-  std::string name_;
-  std::string description_;
-  std::unique_ptr<internal::TypedParameterBlock<P>> parameters_;
-  std::vector<PendingPhase> pending_;
-  std::map<int, std::unique_ptr<Phase>> ready_;
-  std::function<std::unique_ptr<Anchor>(const P*)> anchor_factory_;
   std::vector<ModelSymmetry> symmetries_;
   ModelSetup setup_;
 };

@@ -10,6 +10,7 @@
 
 #include <cmath>
 
+#include "hybridcont/internal/autodiff_phase.h"
 #include "hybridcont/model.h"
 
 namespace hybridcont::internal {

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "hybridcont/model_builder.h"
 #include "hybridcont/models.h"
 #include "hybridcont/shooting_layout.h"
 #include "models/ball_flight.h"

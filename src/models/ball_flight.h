@@ -4,6 +4,7 @@
 #define HYBRIDCONT_SRC_MODELS_BALL_FLIGHT_H_
 
 #include "hybridcont/model.h"
+#include "hybridcont/model_builder.h"
 
 namespace hybridcont::internal {
 

@@ -1,4 +1,5 @@
 // Bouncing ball (paper eq. `HDSball`): one flight phase, impact at y = 0, anchor at the apex (dy = 0).
+#include "hybridcont/model_builder.h"
 #include "hybridcont/models.h"
 #include "models/ball_flight.h"
 

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "hybridcont/model_builder.h"
 #include "hybridcont/models.h"
 
 namespace hybridcont {

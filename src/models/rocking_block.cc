@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "hybridcont/model_builder.h"
 #include "hybridcont/models.h"
 
 namespace hybridcont {

@@ -2,6 +2,7 @@
 // (y, alpha, dx, dy, dalpha) -> stance; anchor at nadir (a = -dl).
 #include <cmath>
 
+#include "hybridcont/model_builder.h"
 #include "hybridcont/models.h"
 
 namespace hybridcont {

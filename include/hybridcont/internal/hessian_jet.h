@@ -1,4 +1,4 @@
-// A forward-mode jet with value, gradient and Hessian over N seeds (included by autodiff_phase.h; not used
+// A forward-mode jet with value, gradient and Hessian over N seeds (included by internal/autodiff_phase.h; not used
 // directly). It is the scalar type a model's FirstIntegral(s) see when the library needs d2H:
 //
 //   using J = HessianJet<2>;

@@ -1,11 +1,12 @@
-// Automatic differentiation of user-written phase functions (included by model.h; not used directly).
+// Automatic differentiation of user-written phase functions (included by model_builder.h and
+// expression_model.h; not used directly).
 //
 // A user functor F has static templates VectorField, FirstIntegral(s), Event and Reset over the scalar T.
 // AutoDiffPhase<F, P> instantiates them with
 //   - double                       for values,
 //   - Jet  = AutoDiffScalar<dual>  for first derivatives (df, dH, de, D): one forward sweep over n seeds,
 //   - a second-order jet           for the Hessians of H (needed by A = df~/dx when xi != 0):
-//     HessianJet<n> (hessian_jet.h) for n <= kMaxFixedJetDim, Jet2 = AutoDiffScalar<Jet> above.
+//     HessianJet<n> (internal/hessian_jet.h) for n <= kMaxFixedJetDim, Jet2 = AutoDiffScalar<Jet> above.
 // Derivative vectors are fixed-capacity (kMaxPhaseDim) stack storage, so no evaluation allocates on the
 // heap. Eigen's AutoDiff module is the well-kept library this builds on (STYLE.md practice 4).
 #ifndef HYBRIDCONT_AUTODIFF_PHASE_H_
@@ -20,9 +21,11 @@
 #include <type_traits>
 #include <vector>
 
+#include <Eigen/Core>
 #include <unsupported/Eigen/AutoDiff>
 
-#include "hybridcont/hessian_jet.h"
+#include "hybridcont/internal/hessian_jet.h"
+#include "hybridcont/model.h"
 
 namespace hybridcont::internal {
 
