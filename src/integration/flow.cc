@@ -6,52 +6,46 @@
 #include <boost/numeric/odeint.hpp>
 #include <boost/numeric/odeint/external/eigen/eigen.hpp>
 
+#include "hybridcont/internal/enum_names.h"
+#include "hybridcont/internal/options_check.h"
 #include "integration/augmented_rhs.h"
 
 namespace hybridcont {
 
 namespace odeint = boost::numeric::odeint;
 
-std::string ToString(IntegratorMethod method) {
-  switch (method) {
-    case IntegratorMethod::kDormandPrince54: return "dopri5";
-    case IntegratorMethod::kFehlberg78: return "rkf78";
-  }
-  return "unknown";
-}
+namespace {
+
+constexpr internal::EnumName<IntegratorMethod> kIntegratorMethodNames[] = {
+    {IntegratorMethod::kDormandPrince54, "dopri5"},
+    {IntegratorMethod::kFehlberg78, "rkf78"},
+};
+
+constexpr internal::EnumName<FlowStatus> kFlowStatusNames[] = {
+    {FlowStatus::kSuccess, "success"},
+    {FlowStatus::kNonFinite, "non-finite value"},
+    {FlowStatus::kStepTooSmall, "step size too small"},
+    {FlowStatus::kMaxSteps, "maximum number of steps"},
+};
+
+}  // namespace
+
+std::string ToString(IntegratorMethod method) { return internal::EnumToString(kIntegratorMethodNames, method); }
 
 bool FromString(const std::string& name, IntegratorMethod* method) {
-  if (name == "dopri5") {
-    *method = IntegratorMethod::kDormandPrince54;
-  } else if (name == "rkf78") {
-    *method = IntegratorMethod::kFehlberg78;
-  } else {
-    return false;
-  }
-  return true;
+  return internal::EnumFromString(kIntegratorMethodNames, name, method);
 }
 
-std::string ToString(FlowStatus status) {
-  switch (status) {
-    case FlowStatus::kSuccess: return "success";
-    case FlowStatus::kNonFinite: return "non-finite value";
-    case FlowStatus::kStepTooSmall: return "step size too small";
-    case FlowStatus::kMaxSteps: return "maximum number of steps";
-  }
-  return "unknown";
-}
+std::string ToString(FlowStatus status) { return internal::EnumToString(kFlowStatusNames, status); }
 
 std::string IntegratorOptions::Validate() const {
-  std::ostringstream os;
-  auto positive = [&](const char* field, double v) {
-    if (!(v > 0.0) || !std::isfinite(v)) os << "IntegratorOptions::" << field << " = " << v << " must be finite and > 0";
-  };
-  positive("rtol", rtol);
-  if (os.tellp() == 0) positive("atol", atol);
-  if (os.tellp() == 0) positive("initial_step", initial_step);
-  if (os.tellp() == 0) positive("min_step", min_step);
-  if (os.tellp() == 0 && max_steps < 1) os << "IntegratorOptions::max_steps = " << max_steps << " must be >= 1";
-  return os.str();
+  return internal::OptionsCheck("IntegratorOptions")
+      .Positive("rtol", rtol)
+      .Positive("atol", atol)
+      .Positive("initial_step", initial_step)
+      .Positive("min_step", min_step)
+      .AtLeast("max_steps", max_steps, 1)
+      .message();
 }
 
 namespace {
