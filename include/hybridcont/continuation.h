@@ -93,7 +93,7 @@ enum class PredictorType {
   kHermite,
 };
 std::string ToString(PredictorType type);
-bool StringToPredictorType(const std::string& text, PredictorType* type);
+bool FromString(const std::string& text, PredictorType* type);
 
 enum class StepStatus {
   kContinuing,  // more steps can follow (a point was added)

@@ -69,7 +69,7 @@ enum class CorrectorType {
 };
 std::string ToString(CorrectorType type);
 // Parses "pseudo-arclength" / "moore-penrose"; returns false for anything else.
-bool StringToCorrectorType(const std::string& text, CorrectorType* type);
+bool FromString(const std::string& text, CorrectorType* type);
 
 struct CorrectorOptions {
   // Newton converges quadratically from a good predictor; needing more than a dozen steps means the

@@ -2,20 +2,28 @@
 
 #include <sstream>
 
+#include "hybridcont/internal/enum_names.h"
+
 namespace hybridcont {
 
-std::string ToString(SpecialPointType type) {
-  switch (type) {
-    case SpecialPointType::kSimpleBifurcation: return "simple-bifurcation";
-    case SpecialPointType::kTurningPoint: return "turning-point";
-    case SpecialPointType::kSingularStart: return "singular-start";
-  }
-  return "unknown";
-}
+namespace {
 
-std::string ToString(LocationStatus status) {
-  return status == LocationStatus::kLocated ? "located" : "bracketed";
-}
+constexpr internal::EnumName<SpecialPointType> kSpecialPointTypeNames[] = {
+    {SpecialPointType::kSimpleBifurcation, "simple-bifurcation"},
+    {SpecialPointType::kTurningPoint, "turning-point"},
+    {SpecialPointType::kSingularStart, "singular-start"},
+};
+
+constexpr internal::EnumName<LocationStatus> kLocationStatusNames[] = {
+    {LocationStatus::kLocated, "located"},
+    {LocationStatus::kBracketed, "bracketed"},
+};
+
+}  // namespace
+
+std::string ToString(SpecialPointType type) { return internal::EnumToString(kSpecialPointTypeNames, type); }
+
+std::string ToString(LocationStatus status) { return internal::EnumToString(kLocationStatusNames, status); }
 
 std::string SpecialPoint::BriefReport(const std::vector<std::string>& names) const {
   std::ostringstream out;

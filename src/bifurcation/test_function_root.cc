@@ -6,6 +6,7 @@
 
 #include "hybridcont/continuation.h"
 #include "hybridcont/corrector.h"
+#include "hybridcont/invariant.h"
 
 namespace hybridcont {
 namespace {
@@ -43,6 +44,7 @@ void AddIntegrationError(ZeroProblem* problem, const Vector& chord, double slope
 TestFunctionRoot LocateTestFunctionRoot(ZeroProblem* problem, const Vector& u_a, const Vector& u_b,
                                         const std::function<double(const Vector&)>& test,
                                         const TestFunctionRootOptions& options) {
+  HYBRIDCONT_DEMAND(u_a.size() == problem->num_unknowns() && u_b.size() == u_a.size());
   TestFunctionRoot root;
   const Vector chord = u_b - u_a;
   Corrector corrector(problem);
@@ -125,6 +127,7 @@ std::optional<double> ParabolaDipThroughZero(const std::array<double, 3>& s, con
 HiddenRootPair FindHiddenRootPair(ZeroProblem* problem, const std::array<const Vector*, 3>& u,
                                   const std::array<double, 3>& s, const std::array<double, 3>& g,
                                   const std::function<double(const Vector&)>& test) {
+  HYBRIDCONT_DEMAND(u[0] != nullptr && u[1] != nullptr && u[2] != nullptr);
   HiddenRootPair pair;
   const std::optional<double> x = ParabolaDipThroughZero(s, g);
   if (!x) return pair;

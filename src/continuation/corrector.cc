@@ -8,54 +8,48 @@
 
 #include "continuation/bordered_solver.h"
 #include "continuation/jacobian_tolerance_scope.h"
+#include "hybridcont/internal/enum_names.h"
+#include "hybridcont/internal/options_check.h"
+#include "hybridcont/invariant.h"
 
 namespace hybridcont {
 
-std::string ToString(CorrectorStatus status) {
-  switch (status) {
-    case CorrectorStatus::kConverged: return "converged";
-    case CorrectorStatus::kMaxIterations: return "max-iterations";
-    case CorrectorStatus::kDiverged: return "diverged";
-    case CorrectorStatus::kSingular: return "singular";
-    case CorrectorStatus::kEvaluationFailed: return "evaluation-failed";
-  }
-  return "unknown";
-}
+namespace {
 
-std::string ToString(CorrectorType type) {
-  return type == CorrectorType::kMoorePenrose ? "moore-penrose" : "pseudo-arclength";
-}
+constexpr internal::EnumName<CorrectorStatus> kCorrectorStatusNames[] = {
+    {CorrectorStatus::kConverged, "converged"},
+    {CorrectorStatus::kMaxIterations, "max-iterations"},
+    {CorrectorStatus::kDiverged, "diverged"},
+    {CorrectorStatus::kSingular, "singular"},
+    {CorrectorStatus::kEvaluationFailed, "evaluation-failed"},
+};
 
-bool StringToCorrectorType(const std::string& text, CorrectorType* type) {
-  if (text == "pseudo-arclength") {
-    *type = CorrectorType::kPseudoArclength;
-  } else if (text == "moore-penrose") {
-    *type = CorrectorType::kMoorePenrose;
-  } else {
-    return false;
-  }
-  return true;
+constexpr internal::EnumName<CorrectorType> kCorrectorTypeNames[] = {
+    {CorrectorType::kPseudoArclength, "pseudo-arclength"},
+    {CorrectorType::kMoorePenrose, "moore-penrose"},
+};
+
+}  // namespace
+
+std::string ToString(CorrectorStatus status) { return internal::EnumToString(kCorrectorStatusNames, status); }
+
+std::string ToString(CorrectorType type) { return internal::EnumToString(kCorrectorTypeNames, type); }
+
+bool FromString(const std::string& text, CorrectorType* type) {
+  return internal::EnumFromString(kCorrectorTypeNames, text, type);
 }
 
 std::string CorrectorOptions::Validate() const {
-  std::ostringstream out;
-  if (max_iterations < 1) {
-    out << "CorrectorOptions::max_iterations = " << max_iterations << " must be >= 1";
-  } else if (!(residual_tolerance > 0)) {
-    out << "CorrectorOptions::residual_tolerance = " << residual_tolerance << " must be > 0";
-  } else if (!(step_tolerance > 0)) {
-    out << "CorrectorOptions::step_tolerance = " << step_tolerance << " must be > 0";
-  } else if (!(max_contraction > 0)) {
-    out << "CorrectorOptions::max_contraction = " << max_contraction << " must be > 0";
-  } else if (!(max_distance > 0)) {
-    out << "CorrectorOptions::max_distance = " << max_distance << " must be > 0";
-  } else if (!(predictor_jacobian_tolerance >= 0 && predictor_jacobian_tolerance < 1)) {
-    out << "CorrectorOptions::predictor_jacobian_tolerance = " << predictor_jacobian_tolerance
-        << " must be in [0, 1)";
-  } else if (!(max_jacobian_distance >= 0)) {
-    out << "CorrectorOptions::max_jacobian_distance = " << max_jacobian_distance << " must be >= 0";
-  }
-  return out.str();
+  return internal::OptionsCheck("CorrectorOptions")
+      .AtLeast("max_iterations", max_iterations, 1)
+      .Require(residual_tolerance > 0, "residual_tolerance", residual_tolerance, "must be > 0")
+      .Require(step_tolerance > 0, "step_tolerance", step_tolerance, "must be > 0")
+      .Require(max_contraction > 0, "max_contraction", max_contraction, "must be > 0")
+      .Require(max_distance > 0, "max_distance", max_distance, "must be > 0")
+      .Require(predictor_jacobian_tolerance >= 0 && predictor_jacobian_tolerance < 1, "predictor_jacobian_tolerance",
+               predictor_jacobian_tolerance, "must be in [0, 1)")
+      .Require(max_jacobian_distance >= 0, "max_jacobian_distance", max_jacobian_distance, "must be >= 0")
+      .message();
 }
 
 std::string CorrectorResult::BriefReport() const {
@@ -83,7 +77,7 @@ struct Corrector::Workspace {
 
 Corrector::Corrector(ZeroProblem* problem, const CorrectorOptions& options)
     : problem_(problem), options_(options), workspace_(std::make_unique<Workspace>()) {
-  if (problem_ == nullptr) throw std::invalid_argument("Corrector: problem is null");
+  HYBRIDCONT_DEMAND(problem_ != nullptr);
   const std::string error = options_.Validate();
   if (!error.empty()) throw std::invalid_argument(error);
   const int n = problem_->num_unknowns();
@@ -123,10 +117,7 @@ CorrectorResult Corrector::CorrectWithConstraint(const Vector& u_pred, const Vec
   return Run(Border::kConstraint, u_pred, c, value, u);
 }
 CorrectorResult Corrector::CorrectFixedComponent(const Vector& u_pred, int index, double target, Vector* u) {
-  if (index < 0 || index >= problem_->num_unknowns()) {
-    throw std::invalid_argument("Corrector::CorrectFixedComponent: index " + std::to_string(index) +
-                                " outside [0, " + std::to_string(problem_->num_unknowns()) + ")");
-  }
+  HYBRIDCONT_DEMAND(index >= 0 && index < problem_->num_unknowns());
   return Run(Border::kConstraint, u_pred, Vector::Unit(problem_->num_unknowns(), index), target, u);
 }
 CorrectorResult Corrector::Correct(CorrectorType type, const Vector& u_pred, const Vector& tau, Vector* u) {

@@ -1,6 +1,10 @@
 // Internal: the stops that are level sets of a linear functional cᵀu (ContinuationOptions' targets,
-// bounds and sum bounds), shared by the stepper (which locates them) and the exploration (which names
-// the stop an image of a branch ends on).
+// bounds and sum bounds), shared by the stepper (which locates them, StopLocator) and the exploration
+// (which names the stop an image of a branch ends on).
+//
+//   StopLocator locator(LinearStops(options, problem), &problem, &corrector, &solver, options);
+//   if (!locator.Apply(a, &b, &newton_iterations, &reason, &message)) ...  // the branch ends at a
+//   // otherwise b is the point exactly on the first stop crossed in (a, b], or unchanged
 #ifndef HYBRIDCONT_SRC_CONTINUATION_LINEAR_STOP_H_
 #define HYBRIDCONT_SRC_CONTINUATION_LINEAR_STOP_H_
 
@@ -9,9 +13,12 @@
 #include <vector>
 
 #include "hybridcont/continuation.h"
+#include "hybridcont/corrector.h"
 #include "hybridcont/zero_problem.h"
 
 namespace hybridcont::internal {
+
+class BorderedSolver;
 
 struct LinearStop {
   enum class Kind { kTarget, kLower, kUpper };
@@ -63,6 +70,40 @@ inline std::vector<LinearStop> LinearStops(const ContinuationOptions& options, c
   }
   return stops;
 }
+
+// Locates the stops on the branch: the point exactly on a crossed stop, found by the linear-constraint
+// corrector [r(u); cᵀu − value] = 0 from the cubic Hermite interpolant of the step (the chord where the
+// tangents disagree in orientation), and where that fails by the special points' root finder on
+// cᵀu − value along the step, corrected onto the stop from there.
+class StopLocator {
+ public:
+  // The pointers must outlive the locator; they are the stepper's own.
+  StopLocator(std::vector<LinearStop> stops, ZeroProblem* problem, Corrector* corrector, BorderedSolver* solver,
+              const ContinuationOptions& options);
+
+  const std::vector<LinearStop>& stops() const { return stops_; }
+  // The earliest stop crossed in (a, b]: *b is replaced by the point exactly on it, *reason and the start
+  // of *message name the stop, *newton_iterations counts the corrector's work. Returns false, with *reason
+  // and *message set, if the branch ends at a (a stop crossed right at the start point).
+  bool Apply(const ContinuationPoint& a, ContinuationPoint* b, int* newton_iterations, TerminationReason* reason,
+             std::string* message);
+
+ private:
+  // The stop crossed first in (a, b] and the chord fraction θ where it crosses; nullptr if none is.
+  const LinearStop* FirstCrossed(const ContinuationPoint& a, const ContinuationPoint& b, double* theta) const;
+  // Where the constraint corrector failed: the root of cᵀu − value along the step, then one constraint
+  // correction onto the stop. Appends to *message when the root is only bracketed.
+  void LocateByRootFinder(const ContinuationPoint& a, const ContinuationPoint& b, const LinearStop& stop,
+                          ContinuationPoint* event, std::string* message);
+
+  std::vector<LinearStop> stops_;
+  ZeroProblem* problem_;
+  Corrector* corrector_;
+  BorderedSolver* solver_;
+  double min_step_;
+  double location_tolerance_;
+  int max_location_iterations_;
+};
 
 }  // namespace hybridcont::internal
 

@@ -4,116 +4,96 @@
 #include <sstream>
 
 #include "hybridcont/continuation.h"
+#include "hybridcont/internal/enum_names.h"
+#include "hybridcont/internal/options_check.h"
 
 namespace hybridcont {
 
-std::string ToString(TerminationReason reason) {
-  switch (reason) {
-    case TerminationReason::kNotFinished: return "not-finished";
-    case TerminationReason::kMaxPoints: return "max-points";
-    case TerminationReason::kTargetReached: return "target-reached";
-    case TerminationReason::kBoundReached: return "bound-reached";
-    case TerminationReason::kUserStop: return "user-stop";
-    case TerminationReason::kStepTooSmall: return "step-too-small";
-    case TerminationReason::kClosedLoop: return "closed-loop";
-    case TerminationReason::kKnownBranch: return "known-branch";
-    case TerminationReason::kStartFailed: return "start-failed";
-  }
-  return "unknown";
-}
+namespace {
 
-std::string ToString(PredictorType type) {
-  switch (type) {
-    case PredictorType::kTangent: return "tangent";
-    case PredictorType::kSecant: return "secant";
-    case PredictorType::kHermite: return "hermite";
-  }
-  return "unknown";
-}
+constexpr internal::EnumName<TerminationReason> kTerminationReasonNames[] = {
+    {TerminationReason::kNotFinished, "not-finished"},
+    {TerminationReason::kMaxPoints, "max-points"},
+    {TerminationReason::kTargetReached, "target-reached"},
+    {TerminationReason::kBoundReached, "bound-reached"},
+    {TerminationReason::kUserStop, "user-stop"},
+    {TerminationReason::kStepTooSmall, "step-too-small"},
+    {TerminationReason::kClosedLoop, "closed-loop"},
+    {TerminationReason::kKnownBranch, "known-branch"},
+    {TerminationReason::kStartFailed, "start-failed"},
+};
 
-bool StringToPredictorType(const std::string& text, PredictorType* type) {
-  if (text == "tangent") {
-    *type = PredictorType::kTangent;
-  } else if (text == "secant") {
-    *type = PredictorType::kSecant;
-  } else if (text == "hermite") {
-    *type = PredictorType::kHermite;
-  } else {
-    return false;
-  }
-  return true;
-}
+constexpr internal::EnumName<PredictorType> kPredictorTypeNames[] = {
+    {PredictorType::kTangent, "tangent"},
+    {PredictorType::kSecant, "secant"},
+    {PredictorType::kHermite, "hermite"},
+};
 
-std::string ContinuationOptions::Validate() const {
+// A value as an options message prints it (the default stream format).
+std::string Text(double value) {
   std::ostringstream out;
-  auto positive = [&out](const char* field, double value) {
-    if (!(value > 0) || !std::isfinite(value)) {
-      out << "ContinuationOptions::" << field << " = " << value << " must be finite and > 0";
-      return false;
-    }
-    return true;
-  };
-  if (!positive("initial_step", initial_step) || !positive("min_step", min_step) ||
-      !positive("max_step", max_step) || !positive("nominal_contraction", nominal_contraction) ||
-      !positive("nominal_distance", nominal_distance) || !positive("nominal_angle", nominal_angle) ||
-      !positive("max_corrector_distance", max_corrector_distance) ||
-      !positive("location_tolerance", location_tolerance)) {
-    return out.str();
-  }
-  if (min_step > max_step) {
-    out << "ContinuationOptions::min_step = " << min_step << " must be <= max_step = " << max_step;
-  } else if (initial_step < min_step || initial_step > max_step) {
-    out << "ContinuationOptions::initial_step = " << initial_step << " must lie in [min_step, max_step] = ["
-        << min_step << ", " << max_step << "]";
-  } else if (direction != 1 && direction != -1) {
-    out << "ContinuationOptions::direction = " << direction << " must be +1 or -1";
-  } else if (max_points < 1) {
-    out << "ContinuationOptions::max_points = " << max_points << " must be >= 1";
-  } else if (max_location_iterations < 1) {
-    out << "ContinuationOptions::max_location_iterations = " << max_location_iterations << " must be >= 1";
-  } else if (const std::string corrector_error = corrector.Validate(); !corrector_error.empty()) {
-    out << "ContinuationOptions::corrector: " << corrector_error;
-  } else {
-    for (const ComponentBound& bound : bounds) {
-      if (!(bound.lower < bound.upper)) {
-        out << "ContinuationOptions::bounds[" << bound.component << "]: lower = " << bound.lower
-            << " must be < upper = " << bound.upper;
-        break;
-      }
-    }
-    for (const SumBound& bound : sum_bounds) {
-      if (bound.components.empty()) {
-        out << "ContinuationOptions::sum_bounds: components must not be empty";
-      } else if (!(bound.lower < bound.upper)) {
-        out << "ContinuationOptions::sum_bounds: lower = " << bound.lower << " must be < upper = " << bound.upper;
-      }
-    }
-    for (const ComponentTarget& target : targets) {
-      if (!std::isfinite(target.value)) {
-        out << "ContinuationOptions::targets[" << target.component << "]: value = " << target.value
-            << " must be finite";
-      }
-    }
-  }
+  out << value;
   return out.str();
 }
 
-std::string ContinuationOptions::ValidateFor(const std::vector<std::string>& unknown_names) const {
-  std::string error = Validate();
-  if (!error.empty()) return error;
-  auto check = [&unknown_names, &error](const std::string& field, const std::string& name) {
-    if (error.empty() && std::find(unknown_names.begin(), unknown_names.end(), name) == unknown_names.end()) {
-      error = "ContinuationOptions::" + field + ": \"" + name + "\" is not an unknown of the problem";
-    }
-  };
-  for (const std::string& name : turning_point_components) check("turning_point_components", name);
-  for (const ComponentBound& bound : bounds) check("bounds", bound.component);
-  for (const ComponentTarget& target : targets) check("targets", target.component);
-  for (const SumBound& bound : sum_bounds) {
-    for (const std::string& name : bound.components) check("sum_bounds", name);
+}  // namespace
+
+std::string ToString(TerminationReason reason) { return internal::EnumToString(kTerminationReasonNames, reason); }
+
+std::string ToString(PredictorType type) { return internal::EnumToString(kPredictorTypeNames, type); }
+
+bool FromString(const std::string& text, PredictorType* type) {
+  return internal::EnumFromString(kPredictorTypeNames, text, type);
+}
+
+std::string ContinuationOptions::Validate() const {
+  internal::OptionsCheck check("ContinuationOptions");
+  check.Positive("initial_step", initial_step)
+      .Positive("min_step", min_step)
+      .Positive("max_step", max_step)
+      .Positive("nominal_contraction", nominal_contraction)
+      .Positive("nominal_distance", nominal_distance)
+      .Positive("nominal_angle", nominal_angle)
+      .Positive("max_corrector_distance", max_corrector_distance)
+      .Positive("location_tolerance", location_tolerance)
+      .Require(min_step <= max_step, "min_step", min_step, "must be <= max_step = " + Text(max_step))
+      .Require(initial_step >= min_step && initial_step <= max_step, "initial_step", initial_step,
+               "must lie in [min_step, max_step] = [" + Text(min_step) + ", " + Text(max_step) + "]")
+      .Require(direction == 1 || direction == -1, "direction", direction, "must be +1 or -1")
+      .AtLeast("max_points", max_points, 1)
+      .AtLeast("max_location_iterations", max_location_iterations, 1)
+      .Nested("corrector", corrector.Validate());
+  for (const ComponentBound& bound : bounds) {
+    check.Require(bound.lower < bound.upper, "bounds[" + bound.component + "]: lower = " + Text(bound.lower) +
+                                                 " must be < upper = " + Text(bound.upper));
   }
-  for (const std::string& name : progress_components) check("progress_components", name);
-  return error;
+  for (const SumBound& bound : sum_bounds) {
+    check.Require(!bound.components.empty(), "sum_bounds: components must not be empty")
+        .Require(bound.lower < bound.upper,
+                 "sum_bounds: lower = " + Text(bound.lower) + " must be < upper = " + Text(bound.upper));
+  }
+  for (const ComponentTarget& target : targets) {
+    check.Require(std::isfinite(target.value),
+                  "targets[" + target.component + "]: value = " + Text(target.value) + " must be finite");
+  }
+  return check.message();
+}
+
+std::string ContinuationOptions::ValidateFor(const std::vector<std::string>& unknown_names) const {
+  if (std::string error = Validate(); !error.empty()) return error;
+  internal::OptionsCheck check("ContinuationOptions");
+  auto known = [&unknown_names, &check](const std::string& field, const std::string& name) {
+    const bool found = std::find(unknown_names.begin(), unknown_names.end(), name) != unknown_names.end();
+    check.Require(found, field + ": \"" + name + "\" is not an unknown of the problem");
+  };
+  for (const std::string& name : turning_point_components) known("turning_point_components", name);
+  for (const ComponentBound& bound : bounds) known("bounds", bound.component);
+  for (const ComponentTarget& target : targets) known("targets", target.component);
+  for (const SumBound& bound : sum_bounds) {
+    for (const std::string& name : bound.components) known("sum_bounds", name);
+  }
+  for (const std::string& name : progress_components) known("progress_components", name);
+  return check.message();
 }
 
 std::string Branch::BriefReport() const {

@@ -3,13 +3,12 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "hybridcont/invariant.h"
+
 namespace hybridcont {
 
 ScaledProblem::ScaledProblem(ZeroProblem* problem, Vector scales) : problem_(problem), scales_(std::move(scales)) {
-  if (scales_.size() != problem_->num_unknowns()) {
-    throw std::invalid_argument("ScaledProblem: " + std::to_string(scales_.size()) + " scales for " +
-                                std::to_string(problem_->num_unknowns()) + " unknowns");
-  }
+  HYBRIDCONT_DEMAND(problem_ != nullptr && scales_.size() == problem_->num_unknowns());
   const auto names = problem_->unknown_names();
   for (int k = 0; k < scales_.size(); ++k) {
     if (!(scales_(k) > 0.0) || !std::isfinite(scales_(k))) {
@@ -30,7 +29,9 @@ std::unique_ptr<ZeroProblem> ScaledProblem::Clone() const { return Wrap(problem_
 std::unique_ptr<ZeroProblem> ScaledProblem::Refined(double factor) const { return Wrap(problem_->Refined(factor)); }
 
 void ScaledProblem::AddWorkOf(const ZeroProblem& clone) {
-  problem_->AddWorkOf(*dynamic_cast<const ScaledProblem&>(clone).problem_);
+  const auto* scaled = dynamic_cast<const ScaledProblem*>(&clone);
+  HYBRIDCONT_DEMAND(scaled != nullptr);  // a clone or refined copy of this scaling
+  problem_->AddWorkOf(*scaled->problem_);
 }
 
 EvaluationStatus ScaledProblem::Evaluate(const Vector& v, Vector* r, Matrix* dr) {
