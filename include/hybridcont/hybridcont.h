@@ -23,6 +23,7 @@
 #include "hybridcont/scaled_problem.h"
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/shooting_layout.h"
+#include "hybridcont/shooting_problem.h"
 #include "hybridcont/special_point.h"
 #include "hybridcont/statebased_shooting.h"
 #include "hybridcont/test_function_root.h"

@@ -34,11 +34,11 @@
 
 #include "hybridcont/poincare_map.h"
 #include "hybridcont/shooting_layout.h"
-#include "hybridcont/zero_problem.h"
+#include "hybridcont/shooting_problem.h"
 
 namespace hybridcont {
 
-class StateBasedShooting : public ZeroProblem {
+class StateBasedShooting : public ShootingProblem {
  public:
   // Keeps a reference to model (it must outlive this object). Throws std::invalid_argument if the
   // options are invalid.
@@ -73,18 +73,10 @@ class StateBasedShooting : public ZeroProblem {
   const PoincareMap& map() const { return map_; }
   const HybridModel& model() const { return *model_; }
 
-  // Same model, Poincaré options and fixed levels (zero_problem.h).
-  std::unique_ptr<ZeroProblem> Clone() const override;
-  void AddWorkOf(const ZeroProblem& clone) override;
-  // A clone with the integrators' rtol and atol times factor (event tolerances unchanged).
-  std::unique_ptr<ZeroProblem> Refined(double factor) const override;
+  // Clone, Refined, AddWorkOf, counters(): shooting_problem.h.
 
-  const FlowCounters& counters() const { return counters_; }
-  long num_evaluations() const { return num_evaluations_; }
-  void ResetCounters() {
-    counters_ = FlowCounters();
-    num_evaluations_ = 0;
-  }
+ protected:
+  std::unique_ptr<ShootingProblem> CopyWithTolerances(double tolerance_factor) const override;
 
  private:
   const HybridModel* model_;
@@ -99,8 +91,6 @@ class StateBasedShooting : public ZeroProblem {
   Vector cached_u_;
   bool cached_jacobian_ = false;
   bool cache_valid_ = false;
-  FlowCounters counters_;
-  long num_evaluations_ = 0;
   Vector H_;
   Matrix dH_;
 };

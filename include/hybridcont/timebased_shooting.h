@@ -41,14 +41,14 @@
 
 #include "hybridcont/flow.h"
 #include "hybridcont/shooting_layout.h"
-#include "hybridcont/zero_problem.h"
+#include "hybridcont/shooting_problem.h"
 
 namespace hybridcont {
 namespace internal {
 class WorkerTeam;
 }
 
-class TimeBasedShooting : public ZeroProblem {
+class TimeBasedShooting : public ShootingProblem {
  public:
   // Keeps a reference to model (it must outlive this object).
   TimeBasedShooting(const HybridModel& model, IntegratorOptions options);
@@ -104,22 +104,12 @@ class TimeBasedShooting : public ZeroProblem {
   // The model's symmetries (ModelSymmetry) and their products, on u: states by the phases' signs;
   // durations and ξ change sign under time reversal; H̄ is invariant.
   std::vector<Symmetry> symmetries() const override;
-  std::unique_ptr<ZeroProblem> Clone() const override;
-  void AddWorkOf(const ZeroProblem& clone) override;
-  // A clone with rtol and atol times factor.
-  std::unique_ptr<ZeroProblem> Refined(double factor) const override;
+  // Clone, Refined, AddWorkOf, counters(): shooting_problem.h.
 
-  // Work done by all evaluations so far.
-  const FlowCounters& counters() const { return counters_; }
-  long num_evaluations() const { return num_evaluations_; }
-  void ResetCounters() {
-    counters_ = FlowCounters();
-    num_evaluations_ = 0;
-  }
+ protected:
+  std::unique_ptr<ShootingProblem> CopyWithTolerances(double tolerance_factor) const override;
 
  private:
-  // A single-threaded copy with the same model and fixed levels and these integrator options.
-  std::unique_ptr<TimeBasedShooting> CopyWith(const IntegratorOptions& options) const;
   EvaluationStatus Integrate(const Vector& u, bool sensitivities);
   // r and the blocks of dr (eq. multishootJacobian) into a sink: dense matrix or triplets.
   template <class Sink>
@@ -140,8 +130,6 @@ class TimeBasedShooting : public ZeroProblem {
   double cached_jacobian_tolerance_ = 0.0;
   bool cache_valid_ = false;
   EvaluationStatus cached_status_;
-  FlowCounters counters_;
-  long num_evaluations_ = 0;
   // scratch
   Vector out_, H_;
   Matrix D_, dH_;

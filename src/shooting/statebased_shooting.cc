@@ -34,25 +34,13 @@ std::vector<Symmetry> StateBasedShooting::symmetries() const {
   return SymmetryGroup(generators);
 }
 
-std::unique_ptr<ZeroProblem> StateBasedShooting::Clone() const {
-  auto clone = std::make_unique<StateBasedShooting>(*model_, map_.options());
-  clone->SetFixedLevels(fixed_levels_);
-  return clone;
-}
-
-std::unique_ptr<ZeroProblem> StateBasedShooting::Refined(double factor) const {
+std::unique_ptr<ShootingProblem> StateBasedShooting::CopyWithTolerances(double tolerance_factor) const {
   PoincareOptions options = map_.options();
-  options.event.integrator.rtol *= factor;
-  options.event.integrator.atol *= factor;
-  auto clone = std::make_unique<StateBasedShooting>(*model_, options);
-  clone->SetFixedLevels(fixed_levels_);
-  return clone;
-}
-
-void StateBasedShooting::AddWorkOf(const ZeroProblem& clone) {
-  const auto& other = dynamic_cast<const StateBasedShooting&>(clone);
-  counters_ += other.counters_;
-  num_evaluations_ += other.num_evaluations_;
+  options.event.integrator.rtol *= tolerance_factor;
+  options.event.integrator.atol *= tolerance_factor;
+  auto copy = std::make_unique<StateBasedShooting>(*model_, options);
+  copy->SetFixedLevels(fixed_levels_);
+  return copy;
 }
 
 Vector StateBasedShooting::FromTimeBased(const Vector& u_time) const {
@@ -77,7 +65,7 @@ EvaluationStatus StateBasedShooting::ToTimeBased(const Vector& u_state, Vector* 
   }
   PoincareResult res;
   map_.Evaluate(u_state.head(n1_), u_state.segment(n1_, k_), false, &res);
-  counters_ += res.counters;
+  CountWork(res.counters);
   if (!res.ok()) return EvaluationStatus::Failure("state-based pass: " + res.message);
   Vector& u = *u_time;
   u.setZero(layout_.num_unknowns());
@@ -97,9 +85,9 @@ EvaluationStatus StateBasedShooting::Evaluate(const Vector& u, Vector* r, Matrix
   }
   const bool need_jacobian = dr != nullptr;
   if (!cache_valid_ || (need_jacobian && !cached_jacobian_) || cached_u_ != u) {
-    ++num_evaluations_;
+    CountEvaluation();
     map_.Evaluate(u.head(n1_), u.segment(n1_, k_), need_jacobian, &map_result_);
-    counters_ += map_result_.counters;
+    CountWork(map_result_.counters);
     cached_u_ = u;
     cached_jacobian_ = need_jacobian;
     cache_valid_ = true;

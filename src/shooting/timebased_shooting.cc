@@ -56,30 +56,14 @@ std::vector<Symmetry> TimeBasedShooting::symmetries() const {
   return SymmetryGroup(generators);
 }
 
-std::unique_ptr<TimeBasedShooting> TimeBasedShooting::CopyWith(const IntegratorOptions& options) const {
+std::unique_ptr<ShootingProblem> TimeBasedShooting::CopyWithTolerances(double tolerance_factor) const {
+  IntegratorOptions options = options_;
+  options.rtol *= tolerance_factor;
+  options.atol *= tolerance_factor;
   auto copy = std::make_unique<TimeBasedShooting>(*model_, options);
   copy->SetFixedLevels(fixed_levels_);
   copy->set_threads(1);
   return copy;
-}
-
-std::unique_ptr<ZeroProblem> TimeBasedShooting::Clone() const {
-  auto clone = CopyWith(options_);
-  clone->set_jacobian_tolerance(jacobian_tolerance_);  // the same zero set and the same accuracy
-  return clone;
-}
-
-std::unique_ptr<ZeroProblem> TimeBasedShooting::Refined(double factor) const {
-  IntegratorOptions options = options_;
-  options.rtol *= factor;
-  options.atol *= factor;
-  return CopyWith(options);  // exact Jacobian (tolerance 0)
-}
-
-void TimeBasedShooting::AddWorkOf(const ZeroProblem& clone) {
-  const auto& other = dynamic_cast<const TimeBasedShooting&>(clone);
-  counters_ += other.counters_;
-  num_evaluations_ += other.num_evaluations_;
 }
 
 EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivities) {
@@ -117,7 +101,7 @@ EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivitie
     } else if (errors[i]) {
       std::rethrow_exception(errors[i]);
     }
-    counters_ += flows_[i].counters;
+    CountWork(flows_[i].counters);
     relaxed = relaxed || flows_[i].jacobian_relaxed;
     if (!flows_[i].ok()) {
       status = EvaluationStatus::Failure("segment " + std::to_string(i + 1) + ": " + flows_[i].message);
@@ -201,7 +185,7 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
   const bool need_sensitivities = dr != nullptr;
   if (!cache_valid_ || cached_u_ != u ||
       (need_sensitivities && (!cached_sensitivities_ || cached_jacobian_tolerance_ > jacobian_tolerance_))) {
-    ++num_evaluations_;
+    CountEvaluation();
     Integrate(u, need_sensitivities);
   }
   if (!cached_status_.ok) return cached_status_;
