@@ -1,4 +1,4 @@
-// Benchmarks (issue 6): per built-in model, one evaluation of r and dr, one corrector solve, and the full
+// Benchmarks: per built-in model, one evaluation of r and dr, one corrector solve, and the full
 // exploration of the model's default scenario. Counters: points, Newton iterations per point, rejected
 // steps, right-hand-side (RHS) evaluations and their ratio to the floor — one integration of every phase
 // with sensitivities per accepted point (the RHS count of one r+dr evaluation at each accepted point,
@@ -119,7 +119,7 @@ void FullRun(benchmark::State& state, const HybridModel& model, int threads) {
     diagram = d;
   }
   {
-    // The floor (issue 6): one integration of every phase with sensitivities per accepted point — the
+    // The floor: one integration of every phase with sensitivities per accepted point — the
     // RHS count of one r+dr evaluation at each accepted point itself, summed. Over all points of the
     // diagram, and over the traced ones only (the points of branches mapped through a symmetry cost
     // nothing: rhs_over_traced_floor is the work per point the continuation itself did).
@@ -198,7 +198,7 @@ BENCHMARK(BM_ModelFileLoad)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->Us
 namespace hybridcont::app {
 namespace {
 
-// Scaling in the number of phases (issue 6): one corrector solve on the ball-chain with m phases from a
+// Scaling in the number of phases: one corrector solve on the ball-chain with m phases from a
 // perturbed closed-form orbit; reported per Newton iteration (an r + dr evaluation and a bordered solve).
 void BM_ScalingNewtonStep(benchmark::State& state) {
   const int m = static_cast<int>(state.range(0));

@@ -1,4 +1,4 @@
-// Physical classification of time-based solutions (issue 4, item 3).
+// Physical classification of time-based solutions (paper Table `stateVStime`).
 #include <gtest/gtest.h>
 
 #include "hybridcont/classification.h"

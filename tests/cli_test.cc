@@ -1,4 +1,4 @@
-// The command-line tool as a user meets it: exit codes, messages, files (issues 2 and 4).
+// The command-line tool as a user meets it: exit codes, messages, files.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -132,7 +132,7 @@ std::vector<std::map<std::string, std::string>> ReadCsv(const fs::path& file) {
   return rows;
 }
 
-// Issue 5: the state-based formulation traces the same normal orbits (T(H) of the ball's family).
+// The state-based formulation traces the same normal orbits (T(H) of the ball's family).
 TEST(Cli, StateBasedBallAgreesWithTheClosedForm) {
   const fs::path dir = TempDir("ball_state");
   const CliResult r = RunTool({"run", "bouncing-ball", "--formulation", "state", "--out", dir.string(), "--quiet",
@@ -156,7 +156,7 @@ TEST(Cli, StateBasedBallAgreesWithTheClosedForm) {
   EXPECT_LT(worst_replay, 1e-8);
 }
 
-// Issue 5: the SB points of the hopping-in-place branch are the +1 crossings of the Floquet multipliers,
+// The SB points of the hopping-in-place branch are the +1 crossings of the Floquet multipliers,
 // for both formulations.
 TEST(Cli, SlipSimpleBifurcationsAreFloquetCrossingsInBothFormulations) {
   for (const char* formulation : {"time", "state"}) {
@@ -207,7 +207,7 @@ std::string ReadFile(const fs::path& file) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-// Issue 6: --threads changes nothing but the wall time. The progress lines, the report and every CSV
+// --threads changes nothing but the wall time. The progress lines, the report and every CSV
 // file are those of --threads 1, byte for byte (the report's wall-time line and the folder aside), in both
 // formulations.
 TEST(Cli, RunOnTwoThreadsWritesWhatTheSerialRunWrites) {

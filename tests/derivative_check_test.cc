@@ -1,4 +1,4 @@
-// Every derivative of every built-in model agrees with central finite differences (issue 2, item 6).
+// Every derivative of every built-in model agrees with central finite differences.
 #include <gtest/gtest.h>
 
 #include "hybridcont/derivative_check.h"

@@ -1,6 +1,6 @@
 // Event location when the guard oscillates within one integrator step: a spinning rod's flight is a
 // polynomial the integrator crosses in a few long steps, while its end height y - l0/2 sin(alpha) dips
-// many times. The first downward crossing must still be found (issue 5, replay of the rod's orbits).
+// many times. The first downward crossing must still be found (the replay of the rod's orbits).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -29,7 +29,7 @@ class Counting : public Problem {
 };
 
 // x (λ − 1 − m x)(λ + 1 + m x) = 0 with the symmetry λ -> −λ: the lines x = 0 and λ = ±(1 + m x), which
-// cross x = 0 at (0, ±1) at the angle atan(1/m) (a reviewer's case: 5.7° for m = 10).
+// cross x = 0 at (0, ±1) at the angle atan(1/m) (5.7° for m = 10).
 class NarrowCrossing : public ZeroProblem {
  public:
   explicit NarrowCrossing(double m = 10) : m_(m) {}
@@ -71,7 +71,7 @@ class PartlySymmetric : public ZeroProblem {
 };
 
 // x ((λ − 3)² + x² − 1)((λ + 3)² + x² − 1) = 0 with λ -> −λ: the line x = 0 and two circles, mirror
-// images, each a closed loop from its SB points (a reviewer's case: the last point of a closed loop is its
+// images, each a closed loop from its SB points (the last point of a closed loop is its
 // singular start, which the image check must not take for a failed mapping).
 class TwoCircles : public ZeroProblem {
  public:
@@ -294,7 +294,7 @@ TEST(ExplorationSymmetry, ASelfSymmetricLoopIsCompletedByReflection) {
 }
 
 // The special points at the midpoint (the SB point and the turning point in x, τ_x(M) = 0) are kept
-// once whatever the steps: over 400 maximal steps (a reviewer found two that dropped or doubled the
+// once whatever the steps: over 400 maximal steps (two of them once dropped or doubled the
 // turning point, among them 0.02 + 0.2 · 922/3000), the reflected diagram has the traced one's special points.
 TEST(ExplorationSymmetry, TheMidpointsSpecialPointsDoNotDependOnTheSteps) {
   std::vector<double> steps = {0.02 + 0.2 * 922 / 3000.0, 0.09985, 0.050697032478347948};
@@ -403,7 +403,7 @@ TEST(ExplorationSymmetry, SlipDiagramIsTheTracedOneAtLessWork) {
     return p.type == SpecialPointType::kTurningPoint && std::abs(period(p.u)) < 1e-3;
   };
   ExpectSameDiagram(traced.diagram, mapped.diagram, 1e-9, at_zero_period);
-  // Every SB point located (issue 6): the one in the cluster of nearly tangent crossings near H̄ ≈ 1.6115
+  // Every SB point located: the one in the cluster of nearly tangent crossings near H̄ ≈ 1.6115
   // on the four images of one branch stayed bracketed while the SB interpolant extrapolated from nodes
   // scattered by the noise (Segment::kMaxLebesgue).
   for (const SpecialPoint& p : mapped.diagram.special_points) {

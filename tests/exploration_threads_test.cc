@@ -196,7 +196,7 @@ TEST(ExplorationThreads, HalfBranchesLaunchedAfterADroppedOneAreRenumbered) {
 // The lines x = i and λ = j, i, j = −2…2: 25 SB points, most found again on crossing branches
 // (duplicates the serial run never switches at). The problem throws where the exploring thread asks for
 // dr alone (switching) at a point the serial run did not: a speculative switch group at a duplicate must
-// not turn that into an exception of the run (found by an independent review: 8–12 of 180 runs threw).
+// not turn that into an exception of the run (without that, 8–12 of 180 runs threw).
 // Timing decides whether a run speculates at a duplicate, so the test catches a regression only in some
 // runs (measured without the fix: 1 failing run of 3); it never fails when the code is right.
 class LineGrid : public ZeroProblem {

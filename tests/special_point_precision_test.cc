@@ -64,8 +64,8 @@ TEST(SpecialPointPrecision, CoversTheDiscretizationErrorOfATurningPoint) {
 // A turning point where the test function is much flatter than across the step: x = −(a y² + y⁴) with
 // a = 1e-4 has its turning point in x at (0, 0), and with the perturbation ε·sin(7x + 3y) (ε scaled by
 // Refined) it moves to y ≈ 1.5ε/a, far more than on the circle. τ_x changes ~50x faster across a step of
-// 0.1 than at the root: an error estimate with the step's secant slope alone said 30x too little (an
-// independent review's case); RootLocation::slope takes the flatter final bracket's.
+// 0.1 than at the root: an error estimate with the step's secant slope alone said 30x too little;
+// RootLocation::slope takes the flatter final bracket's.
 class PerturbedQuartic : public ZeroProblem {
  public:
   explicit PerturbedQuartic(double epsilon) : epsilon_(epsilon) {}
@@ -117,7 +117,7 @@ TEST(SpecialPointPrecision, CoversATurningPointWhereTheTestIsFlat) {
 
 // A root finder trial exactly on the root ends the location with a one-point bracket: its test value is
 // that 0 (it was the old bracket end's, −1 here, and the integration error then took it for a change of
-// the test function) and the slope comes from the bracket just before (an independent review's case: the
+// the test function) and the slope comes from the bracket just before (the case of the
 // line y = x from (0, 0) to (2, 2) and the test x − 1, whose first secant trial is exactly x = 1).
 TEST(SpecialPointPrecision, ATrialExactlyOnTheRootReportsATestOfZero) {
   struct Line : ZeroProblem {

@@ -1,4 +1,4 @@
-// Known orbits are zeros of the time-based shooting map; perturbed ones are not (issue 2).
+// Known orbits are zeros of the time-based shooting map; perturbed ones are not.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "hybridcont/invariant.h"
 #include "hybridcont/model_setup.h"
 #include "hybridcont/types.h"
 
@@ -159,8 +160,11 @@ class HybridModel {
   const std::string& description() const { return description_; }
   // m, the number of phases in one cycle.
   int num_phases() const { return static_cast<int>(phases_.size()); }
-  // Phase i, 0-based and cyclic: phase(m) is phase(0).
-  const Phase& phase(int i) const { return *phases_[i % phases_.size()]; }
+  // Phase i, 0-based and cyclic: phase(m) is phase(0) (shooting segment m). i >= 0.
+  const Phase& phase(int i) const {
+    HYBRIDCONT_DEMAND(i >= 0);
+    return *phases_[i % phases_.size()];
+  }
   int num_first_integrals() const { return phases_.front()->num_first_integrals(); }
   const Anchor& anchor() const { return *anchor_; }
 

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "hybridcont/invariant.h"
 #include "hybridcont/model.h"
 
 namespace hybridcont {
@@ -33,20 +34,20 @@ class ShootingLayout {
   // Number of shooting segments, m + 1.
   int num_segments() const { return static_cast<int>(dims_.size()); }
   // State dimension of segment i (0-based; segment m is phase 1 again).
-  int dim(int i) const { return dims_[i]; }
+  int dim(int i) const { return dims_[CheckedSegment(i)]; }
   int num_first_integrals() const { return k_; }
   int num_unknowns() const { return num_unknowns_; }
   int num_equations() const { return num_unknowns_ - 1; }
 
   // Index of t_{i+1} in u (0-based segment i).
-  int time_index(int i) const { return time_index_[i]; }
+  int time_index(int i) const { return time_index_[CheckedSegment(i)]; }
   // Index of the first entry of x̄_{i+1} in u.
-  int state_offset(int i) const { return time_index_[i] + 1; }
+  int state_offset(int i) const { return time_index(i) + 1; }
   int xi_index(int j = 0) const { return xi_index_ + j; }
   int H_index() const { return num_unknowns_ - 1; }
 
   // First row of block i of r (segment i's shooting/periodicity rows followed by its event/anchor row).
-  int block_row(int i) const { return block_row_[i]; }
+  int block_row(int i) const { return block_row_[CheckedSegment(i)]; }
   int first_integral_row() const { return num_equations() - k_; }
 
   const std::vector<std::string>& unknown_names() const { return names_; }
@@ -55,6 +56,11 @@ class ShootingLayout {
   double Period(const Vector& u) const;
 
  private:
+  int CheckedSegment(int i) const {
+    HYBRIDCONT_DEMAND(i >= 0 && i < num_segments());
+    return i;
+  }
+
   std::vector<int> dims_;
   int k_;
   std::vector<int> time_index_;

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "hybridcont/flow.h"
+#include "hybridcont/invariant.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/shooting_problem.h"
 
@@ -72,7 +73,10 @@ class TimeBasedShooting : public ShootingProblem {
   void SetFixedLevels(const Vector& levels);
 
   // Flow of segment i (0-based) at the last evaluated u (x, Phi, Psi when dr was requested).
-  const PhaseFlowResult& segment_flow(int i) const { return flows_[i]; }
+  const PhaseFlowResult& segment_flow(int i) const {
+    HYBRIDCONT_DEMAND(i >= 0 && i < static_cast<int>(flows_.size()));
+    return flows_[i];
+  }
   // Threads integrating the segments of one evaluation, the calling thread included; 1 integrates on the
   // calling thread alone. Only as many as get the minimum number of segments below take part (waking a
   // thread costs more than it saves on fewer). Default: the machine's cores. Throws
@@ -83,20 +87,15 @@ class TimeBasedShooting : public ShootingProblem {
   // its relative size is below it. A cached evaluation serves a later request only if it was at least
   // as exact.
   //
-  // Default kXiHessianTolerance, not 0. Every orbit has ξ* = 0, so at an iterate u the term, ~|ξ|·|∇²H|,
-  // is O(|u − u*|): the order by which dr(u) already differs from dr(u*). Newton without it converges
-  // quadratically all the same, and the dr of an accepted point (at most max_jacobian_distance =
-  // 1e-8·(1 + ||u||) from the solution, corrector.h) errs by ~1e-8 with or without it. Sizable ξ (the
-  // at-rest ξ-branches, derivative checks) keeps it. The SB test functions of the root finder, branch
-  // switching and the analysis of singular starts (finite differences of dr) ask for 0: with 1e-8 in the
-  // SB tests, located SB points of the SLIP moved by up to 4e-12 in H.
-  // Measured on the SLIP's complete diagram: the Hessian jets were 17% of the profile; 232 -> 192 ms.
+  // Default kXiHessianTolerance, not 0: on every orbit ξ* = 0, so the term is O(|u − u*|) at an iterate,
+  // the order by which dr(u) already differs from dr(u*); Newton converges quadratically without it.
+  // Callers that difference dr (SB tests, branch switching) ask for 0. docs/design/shooting.md, "The ξ·∇²H
+  // term".
   static constexpr double kXiHessianTolerance = 1e-8;
   void set_jacobian_tolerance(double tolerance) override { jacobian_tolerance_ = tolerance; }
   double jacobian_tolerance() const override { return jacobian_tolerance_; }
-  // Segments per thread from which a thread pays. Ball-chain on 2 idle cores, 2 threads against 1: r and
-  // dr (a segment ~8 us) x1.19 at 8 segments, x1.34 at 16, x1.67 from 64; r alone (~2 us) x0.72 at 16
-  // segments, x1.09 at 24, x1.65 from 128.
+  // Segments per thread from which a thread pays for its hand-over (docs/design/shooting.md, "Segments per
+  // thread"): fewer with a Jacobian, whose segments cost four times as much.
   static constexpr int kMinSegmentsPerThreadWithJacobian = 4;
   static constexpr int kMinSegmentsPerThread = 12;
 

@@ -34,8 +34,8 @@ using Jet = Eigen::AutoDiffScalar<DerivativeVector>;
 using Jet2 = Eigen::AutoDiffScalar<Eigen::Matrix<Jet, Eigen::Dynamic, 1, 0, kMaxPhaseDim, 1>>;
 
 // AD scalars for a phase of dimension N: fixed-size derivative vectors for small N (unrolled and
-// vectorized by Eigen), bounded-dynamic ones otherwise. Second order: HessianJet for small N (see its header
-// for the measured gain over nested fixed-size AutoDiffScalars), nested bounded-dynamic jets otherwise.
+// vectorized by Eigen), bounded-dynamic ones otherwise. Second order: HessianJet for small N (cheaper than
+// nested fixed-size AutoDiffScalars: docs/design/shooting.md), nested bounded-dynamic jets otherwise.
 template <int N>
 struct JetTypes {
   using J = Eigen::AutoDiffScalar<Eigen::Matrix<double, N, 1>>;

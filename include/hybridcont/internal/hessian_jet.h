@@ -13,13 +13,9 @@
 // It offers the operators and functions of Eigen's AutoDiffScalar (the first-order jet), so a model that
 // compiles for one compiles for the other.
 //
-// Why hand-written (STYLE.md practice 4 prefers a well-kept library): the Hessians were computed with nested
-// Eigen AutoDiffScalars, whose expression templates took ~50% of a SLIP shooting evaluation. Measured
-// (g++ 12 -O3): Phase::UnfoldedVectorField with the Hessian term, SLIP stance (N = 4) 340 -> 210 ns, SLIP
-// flight (N = 5) 510 -> 260 ns; bench ShootingEvaluate/3 (one SLIP r + dr) 340 -> 240 us. Ceres' Jet cannot
-// be nested for this (Jet<Jet<double, N>, N> has no arithmetic with a double constant in Ceres 2.1) and its
-// first-order Jet measured slower than Eigen's (SLIP stance df: 68 vs 42 ns), so Eigen's AutoDiff stays the
-// first-order jet. Plain arrays and loops because fixed-size Eigen storage measured 3-4x slower here.
+// Why hand-written (STYLE.md practice 4 prefers a well-kept library): nested Eigen AutoDiffScalars, the
+// library way, cost about twice as much per SLIP evaluation, and Ceres' Jet cannot be nested for this
+// (docs/design/shooting.md, "A hand-written second-order jet").
 #ifndef HYBRIDCONT_HESSIAN_JET_H_
 #define HYBRIDCONT_HESSIAN_JET_H_
 
