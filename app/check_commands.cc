@@ -1,6 +1,8 @@
 // `hybridcont list` and `hybridcont check`.
 #include <fmt/format.h>
 
+#include <stdexcept>
+
 #include "commands.h"
 #include "hybridcont/derivative_check.h"
 #include "hybridcont/models.h"
@@ -32,6 +34,9 @@ int ListCommand(const std::vector<std::string>& models, std::ostream& out, std::
 }
 
 int CheckCommand(const CheckArguments& args, std::ostream& out, std::ostream& err) {
+  if (args.points < 1 || args.points > 1000) {
+    throw std::invalid_argument("--points " + std::to_string(args.points) + ": must lie in [1, 1000]");
+  }
   const HybridModel model = MakeModelWithOverrides(args.model, args.assignments, &err);
   DerivativeCheckOptions options;
   options.num_points = args.points;

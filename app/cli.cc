@@ -3,6 +3,8 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <sstream>
 #include <stdexcept>
 
 #include "commands.h"
@@ -31,10 +33,10 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
 
   CheckArguments check_args;
   auto* check = app.add_subcommand("check", "compare every derivative of a model with finite differences");
-  check->add_option("model", check_args.model, "built-in model name or model file (.toml)")->required();
-  check->add_option("--set", check_args.assignments, "override a parameter, NAME=VALUE (repeatable)");
-  check->add_option("--points", check_args.points, "random points per phase")->check(CLI::PositiveNumber);
-  check->add_option("--seed", check_args.seed, "seed of the random points");
+  NonEmpty(check->add_option("model", check_args.model, "built-in model name or model file (.toml)")->required());
+  NonEmpty(check->add_option("--set", check_args.assignments, "override a parameter, NAME=VALUE (repeatable)"));
+  NonEmpty(check->add_option("--points", check_args.points, "random points per phase (1 to 1000)"));
+  NonEmpty(check->add_option("--seed", check_args.seed, "seed of the random points"));
 
   RunArguments run_args;
   auto* run = app.add_subcommand("run", "compute the bifurcation diagram of a built-in model or a model file");
@@ -42,17 +44,32 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
 
   std::string plot_dir;
   auto* plot = app.add_subcommand("plot", "draw the figures of saved results");
-  plot->add_option("dir", plot_dir, "results folder written by `hybridcont run`")->required();
+  NonEmpty(plot->add_option("dir", plot_dir, "results folder written by `hybridcont run`")->required());
 
+  // A misspelt command would otherwise be reported as "A subcommand is required".
+  const auto is_command = [&app](const std::string& word) {
+    const auto commands = app.get_subcommands([](const CLI::App*) { return true; });
+    return std::any_of(commands.begin(), commands.end(), [&](const CLI::App* c) { return c->check_name(word); });
+  };
+  if (argc > 1 && argv[1][0] != '-' && !is_command(argv[1])) {
+    err << "error: unknown command '" << argv[1] << "' (expected list, check, run or plot)\n"
+        << "Run with --help for more information.\n";
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // CLI11 formats help/version/usage errors itself
-    std::ostringstream o, e2;
-    const int code = app.exit(e, o, e2);
-    out << o.str();
-    err << e2.str();
-    return code;
+    // --help and --version: CLI11 prints them (exit 0). Any other parse error (an unknown subcommand or
+    // option, a value that does not convert, an option given twice) is bad input: exit code 2.
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) {
+      std::ostringstream o, e2;
+      const int code = app.exit(e, o, e2);
+      out << o.str();
+      err << e2.str();
+      return code;
+    }
+    err << "error: " << e.what() << "\nRun with --help for more information.\n";
+    return 2;
   }
   try {
     if (*list) return ListCommand(list_models, out, err);

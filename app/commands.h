@@ -9,6 +9,7 @@
 
 namespace CLI {
 class App;
+class Option;
 }
 
 namespace hybridcont::app {
@@ -38,8 +39,11 @@ struct RunArguments {
   bool quiet = false;
   bool no_plots = false;
   bool no_symmetry = false;            // trace every half-branch instead of mapping images
+  bool overwrite = false;              // replace another model's results in --out (refused otherwise)
 };
 void AddRunOptions(CLI::App* run, RunArguments* args);
+// Refuses an empty value ("--atol ''"): a mistake, not a request for the default. Returns option.
+CLI::Option* NonEmpty(CLI::Option* option);
 int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err);
 
 int PlotCommand(const std::string& dir, std::ostream& out, std::ostream& err);

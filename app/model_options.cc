@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <set>
 #include <stdexcept>
 
 #include "hybridcont/model_file.h"
@@ -46,6 +47,10 @@ BoundAssignment ParseBound(const std::string& option, const std::string& text) {
   BoundAssignment b{text.substr(0, eq), -std::numeric_limits<double>::infinity(),
                     std::numeric_limits<double>::infinity()};
   const std::string lower = text.substr(eq + 1, colon - eq - 1), upper = text.substr(colon + 1);
+  if (lower.empty() && upper.empty()) {
+    throw std::invalid_argument(option + " '" + text + "': both ends are empty (an unknown without any bound is "
+                                "never reached; give at least one end, e.g. H=0:)");
+  }
   if (!lower.empty()) b.lower = ParseFinite(option + " '" + text + "' (lower end)", lower);
   if (!upper.empty()) b.upper = ParseFinite(option + " '" + text + "' (upper end)", upper);
   if (!(b.lower < b.upper)) throw std::invalid_argument(option + " '" + text + "': the lower end must be below the upper end");
@@ -68,8 +73,12 @@ HybridModel MakeModelWithOverrides(const std::string& name, const std::vector<st
     }
     return LoadModelFile(path, options);
   }();
+  std::set<std::string> assigned;
   for (const std::string& a : assignments) {
     const auto [parameter, value] = ParseAssignment("--set", a);
+    if (!assigned.insert(parameter).second) {
+      throw std::invalid_argument("--set '" + a + "': '" + parameter + "' is given twice");
+    }
     model.SetParameter(parameter, value);
   }
   return model;

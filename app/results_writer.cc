@@ -4,23 +4,49 @@
 
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <set>
 #include <stdexcept>
 
 namespace hybridcont::app {
 
 namespace fs = std::filesystem;
 
-void ResultsWriter::PrepareDirectory(const fs::path& dir) {
+void ResultsWriter::PrepareDirectory(const fs::path& dir, const std::string& model, bool overwrite) {
+  const std::string where = "--out '" + dir.string() + "': ";
   std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) {
+    throw std::invalid_argument(where + "exists and is not a folder");
+  }
+  // Results of another run: the same model's are replaced; another model's (or a summary.json that is not
+  // ours) only with --overwrite, so that a mistyped --out does not wipe a finished diagram.
+  const fs::path summary = dir / "summary.json";
+  if (!model.empty() && !overwrite && fs::exists(summary, ec)) {
+    std::ifstream f(summary);
+    const nlohmann::json old = fs::is_regular_file(summary, ec) ? nlohmann::json::parse(f, nullptr, false)
+                                                                : nlohmann::json(nullptr);
+    const bool readable = old.is_object() && old.contains("model") && old["model"].is_string();
+    if (!readable) {
+      throw std::invalid_argument(where + "holds a summary.json that is not the results of a hybridcont run (or is "
+                                  "damaged); choose another folder or pass --overwrite to replace it");
+    }
+    if (old["model"].get<std::string>() != model) {
+      throw std::invalid_argument(where + "holds the results of model '" + old["model"].get<std::string>() +
+                                  "', not '" + model + "'; choose another folder or pass --overwrite to replace them");
+    }
+  }
   fs::create_directories(dir, ec);
-  if (ec) throw std::invalid_argument("--out '" + dir.string() + "': cannot create the folder (" + ec.message() + ")");
-  if (!fs::is_directory(dir)) throw std::invalid_argument("--out '" + dir.string() + "': not a folder");
+  if (ec) throw std::invalid_argument(where + "cannot create the folder (" + ec.message() + ")");
+  if (!fs::is_directory(dir)) throw std::invalid_argument(where + "not a folder");
   const fs::path probe = dir / ".hybridcont-write-test";
   {
     std::ofstream f(probe);
     if (!f || !(f << "x") || !f.flush()) {
-      throw std::invalid_argument("--out '" + dir.string() + "': folder is not writable");
+      f.close();
+      fs::remove(probe, ec);
+      throw std::invalid_argument(where + "folder is not writable");
     }
   }
   fs::remove(probe, ec);
@@ -69,16 +95,45 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
   summary_["branches"] = nlohmann::json::array();
   summary_["special_points"] = nlohmann::json::array();
   summary_["orbits"] = nlohmann::json::array();
-  // Remove results of an earlier run in the same folder so that the folder describes this run only.
-  for (const auto& entry : fs::directory_iterator(dir_)) {
+  summary_["status"] = "running";
+  // Remove the results of an earlier run in the same folder so that the folder describes this run only:
+  // summary.json first (while the rest is removed the folder claims nothing), then the CSV files, the
+  // figures (the generic ones and those the old summary declared) and the figure script's log.
+  std::set<std::string> figures = {"H_T", "H_T_xi", "keyframes"};
+  std::error_code ec;
+  {
+    std::ifstream f(dir_ / "summary.json");
+    const nlohmann::json old = f ? nlohmann::json::parse(f, nullptr, false) : nlohmann::json(nullptr);
+    if (old.is_object() && old.contains("presentation") && old["presentation"].is_object() &&
+        old["presentation"].contains("figures") && old["presentation"]["figures"].is_array()) {
+      for (const nlohmann::json& figure : old["presentation"]["figures"]) {
+        if (!figure.is_object() || !figure.contains("file") || !figure["file"].is_string()) continue;
+        const fs::path file = figure["file"].get<std::string>();
+        if (file.has_filename() && file == file.filename()) figures.insert(file.stem().string());
+      }
+    }
+  }
+  fs::remove(dir_ / "summary.json", ec);
+  for (const auto& entry : fs::directory_iterator(dir_, ec)) {
     const std::string name = entry.path().filename().string();
-    const bool ours = (name.rfind("branch-", 0) == 0 || name.rfind("orbit-", 0) == 0) && entry.path().extension() == ".csv";
-    if (ours) fs::remove(entry.path());
+    const std::string ext = entry.path().extension().string();
+    const bool ours = ((name.rfind("branch-", 0) == 0 || name.rfind("orbit-", 0) == 0) && ext == ".csv") ||
+                      ((ext == ".png" || ext == ".svg") && figures.count(entry.path().stem().string())) ||
+                      name == "plot.log" || name == "summary.json.tmp";
+    if (ours && entry.is_regular_file(ec)) fs::remove(entry.path(), ec);
   }
   WriteSummary();
 }
 
+bool ResultsWriter::WriteFailed(const fs::path& file) {
+  if (write_error_.empty()) {
+    write_error_ = "writing " + file.string() + " failed (" + (errno ? std::strerror(errno) : "I/O error") + ")";
+  }
+  return false;
+}
+
 void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
+  if (!write_error_.empty()) return;  // a full disk: keep what is there, write nothing more
   auto it = branch_files_.find(branch_id);
   if (it == branch_files_.end()) {
     it = branch_files_.emplace(branch_id, std::ofstream(dir_ / BranchFileName(branch_id))).first;
@@ -114,7 +169,11 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
     else f << ",";
   }
   f << "\n";
-  f.flush();
+  errno = 0;
+  if (!f.flush()) {
+    WriteFailed(dir_ / BranchFileName(branch_id));
+    return;
+  }
   ++points_per_branch_[branch_id];
 }
 
@@ -149,6 +208,8 @@ void ResultsWriter::SetSpecialPoints(nlohmann::json special_points) {
 std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int index, double H, double T,
                                     const std::string& label) {
   const std::string name = "orbit-" + std::to_string(summary_["orbits"].size()) + ".csv";
+  if (!write_error_.empty()) return name;
+  errno = 0;
   std::ofstream f(dir_ / name);
   f << "t,segment,phase";
   for (int p = 0; p < model_.num_phases(); ++p) {
@@ -177,6 +238,10 @@ std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int 
     }
     f << "\n";
   }
+  if (!f.flush()) {
+    WriteFailed(dir_ / name);
+    return name;
+  }
   summary_["orbits"].push_back(
       {{"file", name}, {"branch", branch_id}, {"index", index}, {"H", H}, {"T", T}, {"label", label}});
   return name;
@@ -184,13 +249,37 @@ std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int 
 
 void ResultsWriter::SetReport(const std::string& report) { summary_["report"] = report; }
 
-void ResultsWriter::WriteSummary() {
+bool ResultsWriter::WriteSummary() {
+  if (!write_error_.empty()) return false;
   const fs::path tmp = dir_ / "summary.json.tmp";
+  errno = 0;
+  bool ok = false;
   {
     std::ofstream f(tmp);
     f << summary_.dump(1) << "\n";
+    f.close();
+    ok = !f.fail();
   }
-  fs::rename(tmp, dir_ / "summary.json");
+  std::error_code ec;
+  if (ok) fs::rename(tmp, dir_ / "summary.json", ec);
+  if (!ok || ec) {
+    if (ec) errno = ec.value();
+    WriteFailed(dir_ / "summary.json");
+    fs::remove(tmp, ec);  // never rename a partial summary over the last good one
+    return false;
+  }
+  return true;
+}
+
+bool ResultsWriter::Finish() {
+  summary_["status"] = "complete";
+  return WriteSummary();
+}
+
+void ResultsWriter::Fail(const std::string& message) {
+  summary_["status"] = "failed";
+  summary_["status_message"] = message;
+  if (write_error_.empty()) WriteSummary();
 }
 
 }  // namespace hybridcont::app

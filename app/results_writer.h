@@ -15,6 +15,15 @@
 // and each orbit's "label" is its family name.
 // Every CSV row is flushed when written and summary.json is rewritten atomically (temp + rename) after
 // each branch, so an interrupted run leaves consistent files with everything computed so far.
+//
+// Completeness: summary.json carries "status": "running" from the first write on, "complete" only from
+// Finish(), "failed" (with "status_message") from Fail(). A write that fails (a full disk) is never
+// renamed over the last good summary.json and stops all further writing; the folder then keeps the last
+// summary that could be written, which says "running" (or there is none): it never claims to be complete.
+//
+// Another run's results in the folder: PrepareDirectory refuses a folder whose summary.json belongs to
+// another model (or cannot be read) unless `overwrite`; the constructor then removes every file an earlier
+// run wrote there (summary.json first, so that the folder claims nothing while it is cleaned).
 #ifndef HYBRIDCONT_APP_RESULTS_WRITER_H_
 #define HYBRIDCONT_APP_RESULTS_WRITER_H_
 
@@ -49,8 +58,11 @@ struct PointRecord {
 class ResultsWriter {
  public:
   // Creates dir if needed and checks that a file can be written in it. Throws std::invalid_argument
-  // ("--out 'DIR': ...") otherwise. Call before any computation so that bad input writes nothing.
-  static void PrepareDirectory(const std::filesystem::path& dir);
+  // ("--out 'DIR': ...") otherwise, and when dir holds results of a model other than `model` (or a
+  // summary.json that cannot be read) and `overwrite` is false; an empty `model` skips that check. Call
+  // before any computation so that bad input writes nothing.
+  static void PrepareDirectory(const std::filesystem::path& dir, const std::string& model = "",
+                               bool overwrite = false);
 
   // Throws ModelInputError for a model whose presentation does not evaluate (OrbitPresentation).
   ResultsWriter(std::filesystem::path dir, const HybridModel& model, nlohmann::json options);
@@ -63,7 +75,16 @@ class ResultsWriter {
   std::string AddOrbit(const OrbitTrace& trace, int branch_id, int index, double H, double T,
                        const std::string& label);
   void SetReport(const std::string& report);
-  void WriteSummary();
+  // Rewrites summary.json atomically; false (and write_error() set) when it could not be written.
+  bool WriteSummary();
+  // The final summary: "status": "complete". False when it could not be written.
+  bool Finish();
+  // Records why the run did not complete ("status": "failed") and tries to write the summary.
+  void Fail(const std::string& message);
+
+  // Empty while every file has been written in full; else what failed (file and system message). After a
+  // failure nothing more is written.
+  const std::string& write_error() const { return write_error_; }
 
   const std::filesystem::path& dir() const { return dir_; }
   static std::string BranchFileName(int id) { return "branch-" + std::to_string(id) + ".csv"; }
@@ -76,6 +97,10 @@ class ResultsWriter {
   nlohmann::json summary_;
   std::map<int, std::ofstream> branch_files_;
   std::map<int, int> points_per_branch_;
+  std::string write_error_;
+
+  // Records the first failed write of `file` (errno's message) and returns false.
+  bool WriteFailed(const std::filesystem::path& file);
 };
 
 }  // namespace hybridcont::app

@@ -6,13 +6,21 @@
 // --threads > 1: branch by branch as the exploration merges them, in the order of --threads 1).
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
+#include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "commands.h"
@@ -29,30 +37,47 @@
 #include "results_writer.h"
 #include "scenario.h"
 
+extern char** environ;  // the figure script inherits this process's environment
+
 namespace hybridcont::app {
 
 namespace fs = std::filesystem;
 
+// What the command line accepts beyond the library's own checks (options that are valid for the library
+// but make no sense for a run): see the README, "Bad input".
+constexpr double kMinRtol = 1e-14;   // below, the error control chases rounding noise (eps = 2.2e-16)
+constexpr double kMaxTolerance = 0.1;  // above, no digit of a located point means anything
+constexpr int kMaxThreads = 256;     // each thread holds a copy of the problem; more are never useful
+
+CLI::Option* NonEmpty(CLI::Option* option) {
+  return option->check(CLI::Validator(
+      [](const std::string& text) { return text.empty() ? std::string("an empty value is not allowed") : std::string(); },
+      "", "non-empty"));
+}
+
 void AddRunOptions(CLI::App* run, RunArguments* args) {
-  run->add_option("model", args->model, "built-in model name (see `hybridcont list`) or model file (.toml)")->required();
-  run->add_option("--set", args->assignments, "override a model parameter, NAME=VALUE (repeatable)");
-  run->add_option("--until", args->until,
-                  "end every branch exactly where a component of u reaches a value, NAME=VALUE, e.g. H=2 "
-                  "(repeatable)");
-  run->add_option("--bound", args->bounds,
-                  "replace the model's bound on an unknown, NAME=LOWER:UPPER (e.g. H=0:2.7; 'period' is the sum of "
-                  "the durations; an empty end is unbounded) (repeatable)");
-  run->add_option("--out", args->out_dir, "results folder (default results/MODEL)");
-  run->add_option("--rtol", args->rtol, "integrator relative tolerance (default 1e-10)");
-  run->add_option("--atol", args->atol, "integrator absolute tolerance (default 1e-10)");
-  run->add_option("--max-branches", args->max_branches, "maximum number of half-branches traced");
-  run->add_option("--threads", args->threads,
-                  "threads tracing half-branches concurrently (default: the machine's cores; 1 = one after the "
-                  "other); the results do not depend on it");
-  run->add_option("--formulation", args->formulation,
-                  "time (default: time-based multiple shooting) or state (event-driven Poincare map)");
+  NonEmpty(run->add_option("model", args->model, "built-in model name (see `hybridcont list`) or model file (.toml)")
+               ->required());
+  NonEmpty(run->add_option("--set", args->assignments, "override a model parameter, NAME=VALUE (repeatable)"));
+  NonEmpty(run->add_option("--until", args->until,
+                           "end every branch exactly where a component of u reaches a value, NAME=VALUE, e.g. H=2 "
+                           "(repeatable)"));
+  NonEmpty(run->add_option("--bound", args->bounds,
+                           "replace the model's bound on an unknown, NAME=LOWER:UPPER (e.g. H=0:2.7; 'period' is the "
+                           "sum of the durations; an empty end is unbounded) (repeatable)"));
+  NonEmpty(run->add_option("--out", args->out_dir, "results folder (default results/MODEL)"));
+  NonEmpty(run->add_option("--rtol", args->rtol, "integrator relative tolerance (default 1e-10)"));
+  NonEmpty(run->add_option("--atol", args->atol, "integrator absolute tolerance (default 1e-10)"));
+  NonEmpty(run->add_option("--max-branches", args->max_branches, "maximum number of half-branches traced"));
+  NonEmpty(run->add_option("--threads", args->threads,
+                           "threads tracing half-branches concurrently (default: the machine's cores; 1 = one after "
+                           "the other); the results do not depend on it"));
+  NonEmpty(run->add_option("--formulation", args->formulation,
+                           "time (default: time-based multiple shooting) or state (event-driven Poincare map)"));
   run->add_flag("--no-symmetry", args->no_symmetry,
                "trace every half-branch, also those that are images of traced ones under the model's symmetries");
+  run->add_flag("--overwrite", args->overwrite,
+                "replace the results of another model in --out (without it such a folder is refused)");
   run->add_flag("--quiet", args->quiet, "no progress lines");
   run->add_flag("--no-plots", args->no_plots, "do not draw figures");
 }
@@ -137,22 +162,73 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
   return list;
 }
 
-// Runs the figure script on dir; returns its exit code (non-zero if python/matplotlib is missing).
-int DrawFigures(const fs::path& dir, std::ostream& err) {
+// Runs the figure script on dir (no shell: any folder name is passed as it is) and returns its exit code
+// (2: the script found the results malformed; 127: python could not be started; 128 + n: killed by signal
+// n). Its output goes to dir/plot.log (when the folder is writable); its error lines — and with
+// `all_messages` its warnings too — are repeated on err.
+int DrawFigures(const fs::path& dir, std::ostream& err, bool all_messages) {
   const fs::path script = PlotScriptPath();  // install_paths.h: this executable's own script
   if (script.empty()) {
     err << "warning: figure script not found (see `hybridcont --paths`); results are saved, figures skipped\n";
     return 1;
   }
   // Debian's python3 carries matplotlib (python3-matplotlib); prefer it over other pythons on PATH.
-  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string command = python + " '" + script.string() + "' '" + dir.string() + "' > '" +
-                              (dir / "plot.log").string() + "' 2>&1";
-  const int rc = std::system(command.c_str());
-  if (rc != 0) err << "warning: drawing the figures failed (see " << (dir / "plot.log").string() << ")\n";
+  std::error_code ec;
+  const std::string python = fs::exists("/usr/bin/python3", ec) ? "/usr/bin/python3" : "python3";
+  const std::string script_text = script.string(), dir_text = dir.string();
+  char* const argv[] = {const_cast<char*>(python.c_str()), const_cast<char*>(script_text.c_str()),
+                        const_cast<char*>(dir_text.c_str()), nullptr};
+  int fds[2];
+  if (pipe(fds) != 0) {
+    err << "warning: cannot start the figure script (" << std::strerror(errno) << ")\n";
+    return 1;
+  }
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addclose(&actions, fds[0]);
+  posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
+  posix_spawn_file_actions_adddup2(&actions, fds[1], 2);
+  posix_spawn_file_actions_addclose(&actions, fds[1]);
+  pid_t pid = 0;
+  const int spawned = posix_spawnp(&pid, python.c_str(), &actions, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&actions);
+  close(fds[1]);
+  std::string output;
+  if (spawned == 0) {
+    char buffer[4096];
+    for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) != 0;) {
+      if (n > 0) output.append(buffer, static_cast<std::size_t>(n));
+      else if (errno != EINTR) break;
+    }
+  }
+  close(fds[0]);
+  int rc = 127;
+  if (spawned == 0) {
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  } else {
+    output = "cannot start " + python + ": " + std::strerror(spawned) + "\n";
+  }
+  const fs::path log = dir / "plot.log";
+  bool logged = false;
+  // `plot` on a damaged folder (exit 2) leaves the folder as it was: its messages are on err.
+  if (fs::is_directory(dir, ec) && !(all_messages && rc == 2)) {
+    std::ofstream f(log);
+    logged = static_cast<bool>(f << output) && static_cast<bool>(f.flush());
+  }
+  std::istringstream lines(output);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("hybridcont_plot: error", 0) == 0 || (all_messages && line.rfind("hybridcont_plot:", 0) == 0)) {
+      err << line << "\n";
+    }
+  }
+  if (rc != 0) {
+    err << "warning: drawing the figures failed" << (logged ? " (see " + log.string() + ")" : std::string()) << "\n";
+  }
   return rc;
 }
-
 
 // Extra CSV columns (order fixed: every row of a branch has the same header).
 constexpr int kBpColumn = 5;
@@ -273,6 +349,10 @@ std::string LocateFloquetPoints(const BifurcationDiagram& diagram, const std::ma
   return report;
 }
 
+int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulation formulation,
+                    const RunSetup& setup, ModelExploration& exploration, ResultsWriter& writer, std::ostream& out,
+                    std::ostream& err);
+
 }  // namespace
 
 int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
@@ -288,6 +368,24 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   if (const std::string why = setup.integrator.Validate(); !why.empty()) {
     throw std::invalid_argument("--rtol/--atol: " + why);
   }
+  if (args.rtol && !(*args.rtol >= kMinRtol && *args.rtol <= kMaxTolerance)) {
+    throw std::invalid_argument(fmt::format("--rtol {:g}: must lie in [{:g}, {:g}]", *args.rtol, kMinRtol, kMaxTolerance));
+  }
+  if (args.atol && !(*args.atol <= kMaxTolerance)) {
+    throw std::invalid_argument(fmt::format("--atol {:g}: must lie in (0, {:g}]", *args.atol, kMaxTolerance));
+  }
+  // One value per name: a repeated --set, --until or --bound is a mistake, not an override.
+  const auto refuse_repeats = [](const std::string& option, const std::vector<std::string>& texts) {
+    std::set<std::string> seen;
+    for (const std::string& text : texts) {
+      const std::string name = text.substr(0, text.find('='));
+      if (!seen.insert(name).second) {
+        throw std::invalid_argument(option + " '" + text + "': '" + name + "' is given twice");
+      }
+    }
+  };
+  refuse_repeats("--until", args.until);
+  refuse_repeats("--bound", args.bounds);
   setup.scenario = DefaultScenario(model);
   const Scenario& sc = setup.scenario;
   setup.exploration = ScenarioExplorationOptions(sc);
@@ -298,6 +396,12 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   }
   for (const std::string& text : args.bounds) {
     const BoundAssignment b = ParseBound("--bound", text);
+    for (const ComponentTarget& t : c.targets) {
+      if (t.component == b.name && !(t.value >= b.lower && t.value <= b.upper)) {
+        throw std::invalid_argument(fmt::format("--until '{}={:g}' lies outside --bound '{}': no branch could reach it",
+                                                t.component, t.value, text));
+      }
+    }
     if (b.name == "period") {
       std::vector<std::string> durations;
       for (int i = 0; i <= model.num_phases(); ++i) durations.push_back("t" + std::to_string(i + 1));
@@ -327,6 +431,9 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   }
   if (args.threads) {
     if (*args.threads < 1) throw std::invalid_argument("--threads " + std::to_string(*args.threads) + ": must be >= 1");
+    if (*args.threads > kMaxThreads) {
+      throw std::invalid_argument(fmt::format("--threads {}: must be <= {}", *args.threads, kMaxThreads));
+    }
     setup.exploration.threads = *args.threads;
   }
   if (args.no_symmetry) setup.exploration.use_symmetries = false;
@@ -339,12 +446,30 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     throw std::invalid_argument(std::string(args.until.empty() && args.bounds.empty() ? "" : "--until/--bound: ") +
                                 e.what());
   }
-  const ShootingLayout& layout = exploration->shooting().layout();
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / model.name() : fs::path(args.out_dir);
-  ResultsWriter::PrepareDirectory(dir);
+  ResultsWriter::PrepareDirectory(dir, model.name(), args.overwrite);
 
   // ---- 2. compute, streaming every accepted point
   ResultsWriter writer(dir, model, options_json);
+  try {
+    return ComputeAndWrite(args, model, formulation, setup, *exploration, writer, out, err);
+  } catch (const std::exception& e) {
+    // The folder must not look complete: the summary says "failed" (or, if it cannot be written, the last
+    // one written says "running").
+    writer.Fail(e.what());
+    throw;
+  }
+}
+
+namespace {
+
+int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulation formulation,
+                    const RunSetup& setup, ModelExploration& exploration_ref, ResultsWriter& writer,
+                    std::ostream& out, std::ostream& err) {
+  const Scenario& sc = setup.scenario;
+  ModelExploration* const exploration = &exploration_ref;
+  const ShootingLayout& layout = exploration->shooting().layout();
+  const fs::path& dir = writer.dir();
   // One map for residuals and Floquet data, separate from the engine's (whose cache stays intact).
   TimeBasedShooting floquet_map(model, setup.integrator);
   ReplayOptions replay_options;
@@ -454,20 +579,32 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
                   seconds, exploration->counters().rhs_evaluations, exploration->num_evaluations(),
                   floquet_map.counters().rhs_evaluations, floquet_map.num_evaluations());
   writer.SetReport(report);
-  writer.WriteSummary();
   out << report;
+  if (!writer.Finish()) {
+    // A full disk (or a folder removed under us): what could be written stays, marked as not complete.
+    const std::string why = writer.write_error();
+    writer.Fail(why);
+    err << "error: " << why << "; the results in " << dir.string()
+        << "/ are incomplete (summary.json, if present, says status 'running' or 'failed')\n";
+    return 1;
+  }
   out << fmt::format("results written to {}/ (summary.json, branch-*.csv, orbit-*.csv)\n", dir.string());
-  if (!args.no_plots && DrawFigures(dir, err) == 0) out << fmt::format("figures written to {}/\n", dir.string());
+  if (!args.no_plots && DrawFigures(dir, err, false) == 0) out << fmt::format("figures written to {}/\n", dir.string());
   return diagram.status == ExplorationStatus::kStartFailed ? 1 : 0;
 }
 
+}  // namespace
+
 int PlotCommand(const std::string& dir, std::ostream& out, std::ostream& err) {
-  if (!fs::exists(fs::path(dir) / "summary.json")) {
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) throw std::invalid_argument("plot '" + dir + "': no such folder");
+  if (!fs::is_directory(dir, ec)) throw std::invalid_argument("plot '" + dir + "': not a folder");
+  if (!fs::exists(fs::path(dir) / "summary.json", ec)) {
     throw std::invalid_argument("plot '" + dir + "': no summary.json (run `hybridcont run MODEL --out " + dir + "` first)");
   }
-  const int rc = DrawFigures(dir, err);
+  const int rc = DrawFigures(dir, err, true);
   if (rc == 0) out << "figures written to " << dir << "/\n";
-  return rc == 0 ? 0 : 1;
+  return rc == 0 ? 0 : rc == 2 ? 2 : 1;  // 2: the script found the results malformed (bad input)
 }
 
 }  // namespace hybridcont::app

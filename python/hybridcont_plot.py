@@ -69,12 +69,20 @@ import math
 import os
 import sys
 
-import matplotlib
+plt = Line2D = Circle = None  # matplotlib, imported once the results have been read (import_matplotlib)
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.patches import Circle  # noqa: E402
+
+def import_matplotlib():
+    """matplotlib takes half a second to import: a damaged folder or a bad argument is reported first."""
+    global plt, Line2D, Circle
+    if plt is None:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as pyplot
+        from matplotlib.lines import Line2D as line_2d
+        from matplotlib.patches import Circle as circle
+        plt, Line2D, Circle = pyplot, line_2d, circle
+
 
 
 class PlotError(Exception):
@@ -116,12 +124,18 @@ class Table:
     """A CSV file with a header row; columns are looked up by name."""
 
     def __init__(self, path):
+        rows, self.lines = [], []
         with open(path, newline="") as f:
-            rows = [r for r in csv.reader(f) if r and any(c.strip() for c in r)]
+            reader = csv.reader(f)
+            for r in reader:
+                if r and any(c.strip() for c in r):
+                    rows.append(r)
+                    self.lines.append(reader.line_num)
         if not rows:
             raise ValueError("empty file (no header)")
         self.columns = [c.strip() for c in rows[0]]
         self.rows = rows[1:]
+        self.lines = self.lines[1:]  # the file's line number of each row, for messages
         self.n = len(self.rows)
         self._cache = {}
 
@@ -167,7 +181,9 @@ def load_summary(results_dir):
         with open(path) as f:
             summary = json.load(f)
     except (OSError, ValueError) as e:
-        raise PlotError("cannot read %s: %s" % (path, str(e).splitlines()[0]))
+        raise PlotError("cannot read %s: %s" % (path, (str(e).splitlines() or [type(e).__name__])[0]))
+    except RecursionError:
+        raise PlotError("cannot read %s: nested too deeply" % path)
     if not isinstance(summary, dict):
         raise PlotError("%s is malformed: expected a JSON object" % path)
     for key in ("branches", "special_points", "orbits", "phases", "unknowns"):
@@ -181,15 +197,27 @@ def load_summary(results_dir):
                 raise malformed(path, "%s[%d]" % (key, i), "must be an object")
             # ids and row indices are compared and used as dict keys: numbers only
             for field in ("id", "branch", "parent", "index"):
-                if item.get(field) is not None and not is_number(item[field]):
+                if item.get(field) is not None and not (is_number(item[field]) and math.isfinite(item[field])):
                     raise malformed(path, "%s[%d].%s" % (key, i, field), "must be a number")
             if key != "special_points" and item.get("file") is not None and not (
                     isinstance(item["file"], str) and item["file"].strip()):
                 raise malformed(path, "%s[%d].file" % (key, i), "must be a file name")
+            # a file of this folder: never a path that reads elsewhere
+            name = item.get("file")
+            if key != "special_points" and isinstance(name, str) and (
+                    os.path.basename(name) != name or name in (".", "..") or "\0" in name):
+                raise malformed(path, "%s[%d].file" % (key, i), "must be a file name without a folder, got '%s'" % name)
     if not isinstance(summary.get("parameters", {}) or {}, dict):
         raise malformed(path, "parameters", "must be an object")
     if summary.get("model") is not None and not isinstance(summary["model"], str):
         raise malformed(path, "model", "must be a string")
+    status = summary.get("status", "complete")  # folders written before the status existed are complete
+    if not isinstance(status, str):
+        raise malformed(path, "status", "must be a string")
+    if status != "complete":
+        why = summary.get("status_message")
+        warn("%s says the run is %s%s: drawing what it holds" % (
+            path, "incomplete ('%s')" % status, ": %s" % why if isinstance(why, str) and why else ""))
     return summary, path
 
 
@@ -296,6 +324,21 @@ def phases_of(summary):
     return phases
 
 
+def check_rows(table, path):
+    """Every row as wide as the header, with a number in index, H and T (the columns the figures need)."""
+    width = len(table.columns)
+    numeric = [table.columns.index(c) for c in ("index", "H", "T") if c in table.columns]
+    for row, line in zip(table.rows, table.lines):
+        if len(row) != width:
+            raise PlotError("%s:%d: %d cells, the header has %d (a garbage or truncated row)"
+                            % (path, line, len(row), width))
+        for j in numeric:
+            try:
+                float(row[j])
+            except ValueError:
+                raise PlotError("%s:%d: %s = '%s' is not a number" % (path, line, table.columns[j], row[j][:40]))
+
+
 def load_branches(results_dir, summary):
     """List of dicts: id, entry (summary), table (Table or None)."""
     out = []
@@ -303,17 +346,17 @@ def load_branches(results_dir, summary):
         bid = entry.get("id", k)
         fname = entry.get("file") or "branch-%s.csv" % bid
         path = os.path.join(results_dir, fname)
-        table = None
-        if os.path.isfile(path):
-            try:
-                table = Table(path)
-            except (OSError, ValueError, csv.Error) as e:
-                warn("skipping %s: %s" % (fname, e))
-        else:
-            warn("branch file %s is missing" % fname)
-        if table is not None and (table.num("H") is None or table.num("T") is None):
-            warn("skipping %s: no H or T column" % fname)
-            table = None
+        # A branch file that summary.json names is part of the results: missing, unreadable or with
+        # garbage rows, the folder is damaged (exit 2, the file and line named), not drawn in part.
+        if not os.path.isfile(path):
+            raise PlotError("%s names %s, which is missing" % (os.path.join(results_dir, "summary.json"), path))
+        try:
+            table = Table(path)
+        except (OSError, ValueError, csv.Error) as e:
+            raise PlotError("cannot read %s: %s" % (path, e))
+        if table.num("H") is None or table.num("T") is None:
+            raise PlotError("%s has no H or T column" % path)
+        check_rows(table, path)
         out.append({"id": bid, "entry": entry, "table": table})
     return out
 
@@ -480,6 +523,10 @@ class Results:
         self.unknowns = [u for u in (self.summary.get("unknowns") or []) if isinstance(u, str)]
         self.special_points = [sp for sp in (self.summary.get("special_points") or []) if isinstance(sp, dict)]
         self.branches = load_branches(results_dir, self.summary)
+        for o in self.summary.get("orbits") or []:  # checked before anything is drawn
+            path = os.path.join(results_dir, o["file"]) if isinstance(o.get("file"), str) else None
+            if path is not None and not os.path.isfile(path):
+                raise PlotError("%s names %s, which is missing" % (self.summary_path, path))
         for pos, b in enumerate(self.branches):
             b["colour"] = branch_colour(pos)
             b["label"] = branch_label(b, self.special_points)
@@ -1160,6 +1207,7 @@ def main(argv):
         print("hybridcont_plot: error: %s is malformed: %s: %s" % (
             os.path.join(args.results_dir, "summary.json"), type(e).__name__, e), file=sys.stderr)
         return 2
+    import_matplotlib()
     jobs = [("H_T", lambda w: figure_h_t(res, args.svg, w))]
     if has_nonzero_xi(res):
         jobs.append(("H_T_xi", lambda w: figure_h_t_xi(res, args.svg, w)))
@@ -1190,3 +1238,5 @@ def main(argv):
 
 if __name__ == "__main__":
     sys.exit(main(sys.argv[1:]))
+else:
+    import_matplotlib()  # imported as a module (tests): its drawing helpers are ready to use
