@@ -3,57 +3,30 @@
 // A branch is traced from a point u⁰ by repeating (eqs. IVP, predictor, corrector):
 //
 //   tangent     τⁱ  with dr(uⁱ)τⁱ = 0, ||τⁱ|| = 1, oriented continuously: τⁱ⁺¹·τⁱ > 0   (eq. tangentvector)
-//   predictor   u_pred = uⁱ + h·pⁱ,    pⁱ = τⁱ (tangent) or (uⁱ − uⁱ⁻¹)/||·|| (secant)     (eq. predictor)
-//               or the cubic Hermite extrapolation of (uⁱ⁻¹, τⁱ⁻¹, uⁱ, τⁱ) (PredictorType::kHermite)
+//   predictor   u_pred = uⁱ + h·pⁱ, pⁱ = τⁱ or the secant (eq. predictor), or the cubic Hermite
+//               extrapolation of (uⁱ⁻¹, τⁱ⁻¹, uⁱ, τⁱ)
 //   corrector   uⁱ⁺¹ = Newton on [r(u); pⁱᵀ(u − u_pred)] = 0 (or Moore–Penrose)         (eq. corrector)
-//   step size   Allgower–Georg ch. 6: with κ the Newton contraction ||Δ₁||/||Δ₀||, δ = ||uⁱ⁺¹ − u_pred||
-//               and α = ∠(τⁱ, τⁱ⁺¹), the deceleration factor
-//                   f = max( sqrt(κ/κ̃), sqrt(δ/δ̃), α/α̃ )        (κ̃, δ̃, α̃ the nominal values)
-//               rejects the step when f > 2 (retry with h/2) and otherwise sets h ← h / max(f, 1/2),
-//               clamped to [min_step, max_step]. A failed corrector also halves h; below min_step the
-//               branch ends with kStepTooSmall and keeps its points. κ is the smaller of the step and the
-//               residual contraction (corrector.h; 0 when the predictor's residual is already at the
-//               corrector's tolerance), and h does not grow on the step after a rejection, nor beyond
-//               0.75× the smallest step at which the corrector failed recently (released by 1.1× per
-//               accepted point, forgotten four failed steps further along the branch).
+//   step size   Allgower–Georg ch. 6: f = max(sqrt(κ/κ̃), sqrt(δ/δ̃), α/α̃) with κ the Newton contraction,
+//               δ = ||uⁱ⁺¹ − u_pred||, α = ∠(τⁱ, τⁱ⁺¹); f > 2 rejects (h/f, at least h/4), otherwise
+//               h ← h / max(f, 1/2) in [min_step, max_step], not growing after a rejection or back to a
+//               step at which the corrector recently failed. Below min_step: kStepTooSmall.
 //
-// The tangent is the solution of the bordered system [dr(uⁱ⁺¹); τⁱᵀ] v = e_{N+1}, normalized: its last
-// equation τⁱᵀv = 1 is the continuous orientation, so the curve passes straight through simple
-// bifurcation points (where the paper's det > 0 convention would flip τ; the sign flip of
-// det([dr; τᵀ]) is kept as the SB test function instead). At the start the kernel comes from a QR of drᵀ
-// and is oriented so that det([dr; τᵀ]) > 0, then multiplied by `direction` d ∈ {−1, +1} (eq. IVP).
-//
-// Stops, each located exactly where it is a level set: a target u_k = value and a bound on u_k or on a
-// sum Σ u_k (e.g. the period t1 + t2 + t3 <= T_max) end the branch on the point with that value, found
-// by the linear-constraint corrector [r(u); cᵀu − value] = 0 from the secant interpolant. A user predicate,
-// max_points and a closed loop (the branch returns to its start point) end it at a branch point.
-//
-// Tiny example (the unit circle; see zero_problem.h):
+// τ solves [dr(uⁱ⁺¹); τⁱᵀ] v = e_{N+1}: the continuous orientation, so the curve passes straight through
+// simple bifurcation points, whose sign flip of det([dr; τᵀ]) is the SB test (special_point.h). At the
+// start τ comes from a QR of drᵀ, oriented so that det([dr; τᵀ]) > 0, times d = `direction` (eq. IVP).
+// Stops that are level sets (u_k = value, bounds on u_k or Σ u_k) end the branch exactly on them.
 //
 //   ContinuationOptions options;
 //   options.turning_point_components = {"y"};
-//   Branch branch = TraceBranch(&circle, Vector2d(1, 0), options);
+//   Branch branch = TraceBranch(&circle, Vector2d(1, 0), options);   // the unit circle, zero_problem.h
 //   // branch.termination == TerminationReason::kClosedLoop, two turning points at (0, ±1)
-//
-//   ContinuationStepper stepper(&circle, options);        // the same, one point at a time
+//   ContinuationStepper stepper(&circle, options);                    // the same, one point at a time
 //   for (stepper.Start(u0); stepper.Step() == StepStatus::kContinuing;) { ... stepper.branch() ... }
 //
-// Decisions where the issue is silent:
-//  - Step length h is measured along the predictor direction (≈ arclength); branch arclength is the sum of
-//    chord lengths.
-//  - A corrected point at which the bordered tangent system is singular (a point exactly on an SB point)
-//    is rejected like a failed corrector: the step is halved, so branch points are always regular.
-//  - A bound crossed already at the start point (value exactly on the bound, moving outward) ends the
-//    branch with only its start point; a start point outside a bound ends it at once (kBoundReached).
-//  - The first interval of a branch started at a singular point (branch switching, singular starts) is
-//    not searched for special points: its start point is the bifurcation point itself.
-//  - A branch started at a singular point whose first predictor already has a singular bordered matrix
-//    and a kernel of dr of dimension k >= 2 (relative rank tolerance 1e-8) ends at once with kStartFailed,
-//    "dr has a kernel of dimension k along this direction: not a simple curve": a curve of singular
-//    points, such as the bouncing rod's at-rest ξ-line (kernel dimension 2 for every ξ), cannot be traced
-//    by a predictor–corrector method, and halving h would only repeat the failure ~20 times.
-//  - Closed loop: the start point lies within the chord-sag tolerance of the last chord and the tangents
-//    agree; the start point is then appended as the last point, so the curve closes exactly.
+// Design decisions (docs/design/continuation.md): h is measured along the predictor, arclength is the sum
+// of chords; singular corrected points are rejected, so branch points are regular; the first interval from
+// a singular start is not searched; a curve of singular points ends at once with kStartFailed; a closed
+// loop ends on its start point exactly.
 #ifndef HYBRIDCONT_CONTINUATION_H_
 #define HYBRIDCONT_CONTINUATION_H_
 
@@ -86,13 +59,14 @@ std::string ToString(TerminationReason reason);
 enum class PredictorType {
   kTangent,  // Euler predictor along τ (eq. predictor)
   kSecant,   // along the chord of the last two points: free, and often better on curved branches
-  // The cubic Hermite interpolant of the last two points and their tangents, extrapolated by h (and its
-  // derivative there as the hyperplane normal): third order instead of first, for free. The predictor's
-  // error drops from O(h²) to O(h⁴), so Newton needs about one iteration fewer per point (SLIP: 2.5 ->
-  // 1.9). Falls back to the tangent where there is no previous point or h > 2 × the last chord.
+  // The cubic Hermite interpolant of the last two points and their tangents, extrapolated by h (its
+  // derivative there the hyperplane normal): error O(h⁴) instead of O(h²) at no extra evaluation, so
+  // Newton needs fewer iterations. Falls back to the tangent where there is no previous point or h > 2 ×
+  // the last chord (docs/design/continuation.md, "Hermite predictor").
   kHermite,
 };
 std::string ToString(PredictorType type);
+// Parses "tangent" / "secant" / "hermite"; returns false for anything else.
 bool FromString(const std::string& text, PredictorType* type);
 
 enum class StepStatus {
@@ -171,8 +145,9 @@ struct ContinuationOptions {
   bool correct_start_point = true;
   // Detect (and locate) simple bifurcation points by the sign of det([dr; τᵀ]).
   bool detect_bifurcations = true;
-  // Components whose turning points (sign changes of τ_k) are detected and located. Empty means "H"
-  // when the problem names an unknown "H", and none otherwise.
+  // Components whose turning points (sign changes of τ_k) are detected and located. Empty means the
+  // unknown named "H" (the level of a first integral, the family parameter of conservative problems)
+  // when the problem has one, and none otherwise.
   std::vector<std::string> turning_point_components;
   // Width of the final root-finder bracket (in arclength) at which a special point counts as located.
   // 1e-11 makes located components exact to ~1e-11 (turning-point values to ~1e-20) when the
@@ -180,15 +155,15 @@ struct ContinuationOptions {
   double location_tolerance = 1e-11;
   // Root-finder budget per special point; Illinois needs ~10, bisection fallback ~40 for 1e-11.
   int max_location_iterations = 60;
-  // Estimate the integration error of every located special point (special_point.h, "Integration
-  // error"): one evaluation of the problem's refined copy (ZeroProblem::Refined, tolerances times
-  // kIntegrationErrorFactor) at the point, which widens precision() where the point amplifies the
-  // integration error beyond the root finder's bracket. Problems without a refined copy skip it.
+  // Estimate the evaluation error of every located special point (special_point.h, "Integration
+  // error"): one evaluation of the problem's more accurate copy (ZeroProblem::Refined, tolerances times
+  // kIntegrationErrorFactor) at the point, which widens precision() where the point amplifies the error
+  // beyond the root finder's bracket. Problems without such a copy (exact to rounding) skip it.
   bool check_integration_error = true;
+  // An order of magnitude: the change it shows is 0.9 of the error, yet the copy costs little more.
   static constexpr double kIntegrationErrorFactor = 0.1;
   // The estimate is doubled to make it a bound: errors are only roughly proportional to the tolerances
-  // (an adaptive step sequence changes with them). Measured: 1.0x the true error on a curve whose error
-  // is exactly proportional to its tolerance, 0.4–0.9x on the SLIP across tolerances x0.03 to x3.
+  // (docs/design/continuation.md, "Integration error of special points").
   static constexpr double kIntegrationErrorSafety = 2;
   // What turns the change a refined evaluation shows into the bound: safety over the part (1 − factor)
   // of the error the change is (errors proportional to the tolerances).

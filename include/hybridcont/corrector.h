@@ -9,15 +9,13 @@
 //
 // is square and, at a regular point, invertible. The three borders:
 //
-//   pseudo-arclength   F(u) = [ r(u) ; τᵀ(u − u_pred) ],  b = τ      u stays on the hyperplane ⟂ τ through
-//                                                                      u_pred (Keller).
-//   Moore–Penrose      Δ_k  = −[dr(u_k); τ_kᵀ]⁻¹ [r(u_k); 0],          the minimum-norm Newton step
-//                      τ_{k+1} = [dr(u_k); τ_kᵀ]⁻¹ e_{N+1} / ||·||      (Allgower–Georg §3.3): τ_k follows
-//                                                                      the kernel of dr, so u converges to
-//                                                                      the point of S nearest to u_pred —
-//                                                                      eq. (corrector) of the paper.
-//   linear constraint  F(u) = [ r(u) ; cᵀu − value ],  b = c         e.g. c = e_H, value = 2: the point of
-//                                                                      S with H = 2 exactly (stops, targets).
+//   pseudo-arclength   F = [r(u); τᵀ(u − u_pred)], b = τ: u stays on the hyperplane ⟂ τ through u_pred
+//                      (Keller).
+//   Moore–Penrose      Δ_k = −[dr(u_k); τ_kᵀ]⁻¹[r(u_k); 0], τ_{k+1} = [dr(u_k); τ_kᵀ]⁻¹e_{N+1} / ||·||: the
+//                      minimum-norm step, τ_k following the kernel of dr, so u converges to the point of S
+//                      nearest to u_pred, eq. (corrector) (Allgower–Georg §3.3).
+//   linear constraint  F = [r(u); cᵀu − value], b = c: e.g. c = e_k, the point of S with u_k = value
+//                      exactly (stops, targets).
 //
 // Tiny example (the unit circle x² + y² = 1, predictor off the curve):
 //
@@ -27,21 +25,11 @@
 //   CorrectorResult result = corrector.CorrectPseudoArclength(Vector2d(1.1, 0.2), Vector2d(0, 1), &u);
 //   // result.status == CorrectorStatus::kConverged, u ≈ (0.979796, 0.2)
 //
-// Convergence: ||F(u_k)||₂ <= residual_tolerance AND the last Newton step satisfies
-// ||Δ|| <= step_tolerance·(1 + ||u||). Decision where the issue is silent: when the residual is already
-// below its tolerance but the steps stop contracting (the rounding floor, e.g. near a bifurcation point
-// where B is ill-conditioned), the point is accepted as converged — the residual test decides there.
-// At least one Newton step is always taken, so a converged u is never the raw predictor (a predictor on
-// the curve to the rounding level is returned after that one step: CorrectorOptions::kOnCurveStep). From
-// the second step on, u_k is also accepted when Deuflhard's error estimate — the simplified Newton correction
-// Δ̄ = −B_{k−1}⁻¹F(u_k) — is below the step tolerance; u_k + Δ̄ is returned (NLEQ-ERR's termination).
-// And after every full Newton step Δ_k from k = 1 on, u_k + Δ_k is returned without evaluating r there
-// when its estimated error θ_k|Δ_k| (θ_k = |Δ_k|/|Δ_{k−1}|) is below the step tolerance
-// (Corrector::AcceptNewtonStep): from a Hermite predictor most continuation points then cost two r+dr
-// evaluations instead of three (SLIP exploration: 5142 -> 4290 evaluations, RHS work -19%).
-//
-// Numerical outcomes are statuses (CorrectorResult), never exceptions or prints. A wrong vector size is
-// a programming error and throws std::invalid_argument.
+// Convergence: ||F(u_k)||₂ <= residual_tolerance and a last Newton step ||Δ|| <= step_tolerance·(1 + ||u||),
+// or Deuflhard's error estimate below the step tolerance (CorrectorOptions::accept_on_error_estimate). At
+// least one Newton step is always taken. Numerical outcomes are statuses (CorrectorResult), never
+// exceptions or prints; vectors of the wrong size are a programming error (std::invalid_argument).
+// Design decisions: docs/design/continuation.md, "Corrector: ...".
 #ifndef HYBRIDCONT_CORRECTOR_H_
 #define HYBRIDCONT_CORRECTOR_H_
 
@@ -81,9 +69,10 @@ struct CorrectorOptions {
   // Last Newton step ||Δ||₂ / (1 + ||u||₂). With quadratic convergence the error after a step of 1e-10 is
   // ~1e-20, so accepted points are accurate to the rounding level.
   double step_tolerance = 1e-10;
-  // Also accept u_k when the simplified Newton correction Δ̄ = −B_{k−1}⁻¹F(u_k) (Deuflhard's error
-  // estimate, from the factorization at hand) is below step_tolerance·(1 + ||u||), returning u_k + Δ̄: one
-  // r+dr evaluation fewer per point (SLIP: 3.45 -> 2.5 Newton iterations per point), same accuracy.
+  // Also accept u_k (k >= 2) when the simplified Newton correction Δ̄ = −B_{k−1}⁻¹F(u_k) (Deuflhard's
+  // error estimate, from the factorization at hand) is below step_tolerance·(1 + ||u||), returning
+  // u_k + Δ̄ (NLEQ-ERR's termination): one r+dr evaluation fewer per point at the same accuracy
+  // (docs/design/continuation.md, "Corrector: acceptance on error estimates").
   bool accept_on_error_estimate = true;
   // With accept_on_error_estimate, a full Newton step Δ_k (k >= 1) whose estimated error θ_k|Δ_k| is below
   // step_tolerance is taken without evaluating r at its end (see Corrector::AcceptNewtonStep), when
@@ -92,25 +81,25 @@ struct CorrectorOptions {
   // also the safeguard of the estimate: θ_k is only a lower bound of Newton's contraction (a first step
   // may land close by chance on a strongly curved map), and whatever the contraction, the error after a
   // step of at most 1e-8 is ω|Δ_k|²/2 <= ω·5e-17 (ω the Lipschitz constant of B⁻¹dr): below the step
-  // tolerance unless ω > 2e6 in the scaled unknowns. 1e-6 allowed a point 3.7e-10 off on
-  // r = x + 1e5x² + 1e7x³ and tangents off by 2.8e-5 rad on the SLIP (1e-8: 2.2e-7); the cost: SLIP
-  // 4209 -> 4290 map evaluations (5142 without the acceptance).
+  // tolerance unless ω > 2e6 in the scaled unknowns (docs/design/continuation.md,
+  // "Corrector: max_jacobian_distance").
   double max_jacobian_distance = 1e-8;
   // ZeroProblem::set_jacobian_tolerance for the evaluation at the predictor, whose dr only steers the
   // first Newton step (a relative error ε adds ε·|u_0 − u*| to the error of u_1); every later evaluation
-  // is exact (0). SLIP exploration: the ξ·∇²H Hessians are left out at the predictors, 450 -> ~400 ms.
+  // is exact (0). A cheaper predictor Jacobian for a negligible loss (docs/design/continuation.md,
+  // "Corrector: predictor Jacobian tolerance").
   double predictor_jacobian_tolerance = 1e-2;
   // A predictor already on the curve: when the evaluation at it is exact (predictor_jacobian_tolerance
   // does not loosen the problem's own Jacobian tolerance), its residual is below residual_tolerance and
   // the first Newton step is at the rounding level of u (||Δ₀|| <= kOnCurveStep·(1 + ||u||), and within
   // max_jacobian_distance), u_0 + Δ₀ is returned with the Jacobian at u_0: the second evaluation would
-  // only confirm it. The root finders' trial points (branch_geometry.h) are often interpolated onto the
-  // curve to ~1e-15 once the bracket is small: SLIP exploration, 75 of ~730 location evaluations.
+  // only confirm it. The root finders' trial points are often interpolated onto the curve to ~1e-15 once
+  // their bracket is small.
   static constexpr double kOnCurveStep = 1e-13;
   // A step ratio ||Δ_{k+1}|| / ||Δ_k|| above this, with a residual that did not decrease either, is
   // divergence: Newton inside its basin contracts. (Steps alone may grow once: a first step overshooting
-  // along a nearly singular direction of the bordered matrix is taken back by the second, while the
-  // residual drops — the bouncing rod next to its SB point; max_iterations still bounds that case.)
+  // along a nearly singular direction of the bordered matrix, e.g. next to an SB point, is taken back by
+  // the second while the residual drops; max_iterations still bounds that case.)
   double max_contraction = 1.0;
   // ||u − u_pred||₂ above this is divergence: keeps the corrector from jumping to another branch.
   // The stepper sets it per step (a multiple of the step length); infinite for a bare corrector.
@@ -181,6 +170,14 @@ class Corrector {
   struct Workspace;
   enum class Border { kArclength, kMoorePenrose, kConstraint };
   CorrectorResult Run(Border border, const Vector& u_pred, const Vector& b, double value, Vector* u);
+  // The steps of Run, on its state (border, predictor, norms of the last steps); each returns whether
+  // Run goes on (EvaluateAt, TakeNewtonStep) or ends with *result (ConvergedAt, Stalled, AcceptedAfterStep).
+  struct Newton;
+  bool EvaluateAt(const Newton& newton, int k, const Vector& u, CorrectorResult* result);
+  bool ConvergedAt(const Newton& newton, int k, Vector* u, CorrectorResult* result);
+  bool Stalled(Newton* newton, int k, CorrectorResult* result) const;
+  bool TakeNewtonStep(Newton* newton, int k, Vector* u, CorrectorResult* result);
+  bool AcceptedAfterStep(const Newton& newton, int k, Vector* u, CorrectorResult* result) const;
   // Deuflhard's a-posteriori estimate after a full Newton step Δ_k (k >= 1): with the contraction
   // θ_k = |Δ_k| / |Δ_{k−1}|, the error of u_k + Δ_k is about θ_k / (1 − θ_k) · |Δ_k| (an over-estimate by
   // the factor θ_k under quadratic convergence). Accepted when that is below step_tolerance·(1 + ||u||),

@@ -1,10 +1,10 @@
 // Unknown scaling for continuation: trace r(u) = 0 in the coordinates ũ = u ./ s.
 //
 // Arclength steps, tangent angles, corrector distances and "same point / same branch" tolerances all use
-// the Euclidean norm of u. When components have very different typical magnitudes (the bouncing rod:
-// dalpha ~ sqrt(2H)/r ~ 100 while durations are ~ 0.01), that norm sees only the large ones: the curve
-// crawls in H and symmetry-breaking directions become invisible. Dividing each component by its typical
-// magnitude s_k makes all of them O(1) — the "weights" of AUTO and COCO.
+// the Euclidean norm of u. When components have very different typical magnitudes (an angular velocity
+// ~100 next to durations ~0.01), that norm sees only the large ones: the curve crawls in the small ones
+// and directions that break a symmetry become invisible. Dividing each component by its typical
+// magnitude s_k makes all of them O(1), the "weights" of AUTO and COCO.
 //
 //   ScaledProblem scaled(&shooting, scales);                 // scales(k) > 0
 //   BifurcationDiagram d = Explore(&scaled, scaled.ToScaled(u0), options);
@@ -20,7 +20,8 @@ namespace hybridcont {
 
 class ScaledProblem : public ZeroProblem {
  public:
-  // problem must outlive this object; scales must be positive and finite (std::invalid_argument).
+  // problem must outlive this object and scales has one entry per unknown (invariants); each scale must
+  // be positive and finite (std::invalid_argument).
   ScaledProblem(ZeroProblem* problem, Vector scales);
 
   int num_equations() const override { return problem_->num_equations(); }

@@ -27,11 +27,12 @@ struct TestFunctionRootOptions {
   double sigma_tolerance = 1e-11;
   // Illinois converges superlinearly; the budget covers the bisection fallback too.
   int max_iterations = 60;
-  // The test function evaluated with a refined copy of the problem (ZeroProblem::Refined, tolerances
-  // times ContinuationOptions::kIntegrationErrorFactor). When set and the problem has one, the located root's integration error is estimated as
-  // for the continuation's special points (special_point.h, "Integration error"): the estimate is
-  // corrected onto the refined curve (on its hyperplane ⟂ the chord), the test evaluated there, and twice
-  // the implied error along and off the branch widens `precision` where that exceeds the bracket.
+  // The test function evaluated with the problem's more accurate copy (ZeroProblem::Refined, factor
+  // ContinuationOptions::kIntegrationErrorFactor). When set and the problem has one, the located root's
+  // error is estimated as for the continuation's special points (special_point.h, "Integration error"):
+  // the estimate is corrected onto the refined curve (on its hyperplane ⟂ the chord), the test evaluated
+  // there, and twice the implied error along and off the branch widens `precision` where that exceeds
+  // the bracket.
   std::function<double(ZeroProblem& refined, const Vector& u)> refined_test;
 };
 
@@ -46,15 +47,16 @@ struct TestFunctionRoot {
   std::string message;   // why only bracketed
 };
 
-// test(u_a) and test(u_b) must differ in sign (else located = false with a message).
+// u_a and u_b have num_unknowns() entries (an invariant); test(u_a) and test(u_b) must differ in sign
+// (else located = false with a message).
 TestFunctionRoot LocateTestFunctionRoot(ZeroProblem* problem, const Vector& u_a, const Vector& u_b,
                                         const std::function<double(const Vector&)>& test,
                                         const TestFunctionRootOptions& options);
 
 // Two roots between samples: a smooth test function sampled at three consecutive points of a branch
 // with one sign and its smallest |value| in the middle may dip through zero and back between them (two
-// crossings inside one continuation step cancel in the signs: the SLIP's two −1 crossings of hopping in
-// place are 0.036 apart in H̄). The parabola through the samples (in arclength s) predicts the dip; when
+// crossings inside one continuation step cancel in the signs; docs/design/continuation.md, "Two roots
+// between samples"). The parabola through the samples (in arclength s) predicts the dip; when
 // its extremum has the other sign the test is evaluated on the curve there (one corrector solve on the
 // chord of the sample interval that holds it). A value of the other sign confirms two roots, bracketed
 // by [u_k, probe] and [probe, u_k+1] around it (`segment` = k, 0 or 1).

@@ -49,8 +49,8 @@ struct EvaluationStatus {
 
 // A symmetry of the zero set: the involution u -> S u, S = diag(signs) with entries ±1, such that
 // r(S u) = 0 exactly when r(u) = 0. Differentiating, dr(S u) S = T dr(u) for an invertible T, so the
-// kernel maps too: the tangent at S u is S τ (up to orientation). Declared by models (model.h,
-// ModelSymmetry) and used by the exploration to map half-branches instead of tracing them.
+// kernel maps too: the tangent at S u is S τ (up to orientation). The exploration maps half-branches
+// through them instead of tracing them.
 struct Symmetry {
   std::string name;
   Vector signs;
@@ -110,33 +110,32 @@ class ZeroProblem {
   // starts no threads of its own. nullptr, the default, says the problem cannot be copied; callers then
   // stay serial.
   virtual std::unique_ptr<ZeroProblem> Clone() const { return nullptr; }
-  // Adds the work counters of `clone` (made by this problem's Clone()) to this problem's, so that totals
-  // cover every thread's evaluations. Default: nothing is counted.
+  // Adds the work counters of `clone` (made by this problem's Clone() or Refined()) to this problem's, so
+  // that totals cover every copy's evaluations. Default: nothing is counted.
   virtual void AddWorkOf(const ZeroProblem& clone) { (void)clone; }
-  // A clone that evaluates more accurately: its discretization tolerances (the integrators' rtol and
-  // atol) times `factor` < 1. Evaluating a computed point again with it is an a-posteriori estimate of
-  // the problem's own error there (special_point.h, "Integration error"): where r and dr move little,
-  // the point is as good as its root finder says; where a badly conditioned point amplifies the
-  // integration error, the difference says by how much. Its work counts through AddWorkOf like a
-  // clone's. nullptr, the default: the problem is exact to rounding (algebraic problems).
+  // A more accurate copy: a clone whose evaluation error is `factor` < 1 times this problem's (e.g. its
+  // discretization tolerances times factor). Evaluating a computed point again with it estimates the
+  // problem's own error there (special_point.h, "Integration error"): where r and dr move little, the
+  // point is as good as its root finder says; where a badly conditioned point amplifies the error, the
+  // difference says by how much. Its work counts through AddWorkOf like a clone's. nullptr, the default:
+  // the problem is exact to rounding.
   virtual std::unique_ptr<ZeroProblem> Refined(double factor) const {
     (void)factor;
     return nullptr;
   }
 
-  // How exact the next evaluations' dr must be: terms of dr whose relative size is below `tolerance` may
-  // be left out (0, the default: dr exact to the problem's own accuracy). The corrector raises it for the
-  // Jacobian at the predictor, which only steers the first Newton step: a relative error ε there adds
-  // ε·|u_0 − u*| to the error of u_1, next to Newton's own C·|u_0 − u*|², and the Jacobians that tangents,
-  // test functions and monodromies are taken from are evaluated exactly. The time-based map then leaves
-  // out the ξ·∇²H term of df~/dx where it is below the tolerance (its Hessians were ~20% of a SLIP
-  // exploration). Default: ignored.
+  // How exact the next evaluations' dr must be: a cheaper Jacobian is acceptable to relative error
+  // `tolerance` (terms of dr whose relative size is below it may be left out; 0: dr exact to the
+  // problem's own accuracy). The corrector raises it for the Jacobian at the predictor, which only steers
+  // the first Newton step: a relative error ε there adds ε·|u_0 − u*| to the error of u_1, next to
+  // Newton's own C·|u_0 − u*|². Tangents and test functions are taken from exact Jacobians. Default:
+  // ignored.
   virtual void set_jacobian_tolerance(double tolerance) { (void)tolerance; }
   // The tolerance in effect (0 for problems that ignore it).
   virtual double jacobian_tolerance() const { return 0.0; }
 
   // The non-identity elements of a finite group of symmetries of the zero set (Symmetry above). Default:
-  // none. The time-based map derives them from the model's declarations.
+  // none.
   virtual std::vector<Symmetry> symmetries() const { return {}; }
 
   // Index of the named unknown, or -1.

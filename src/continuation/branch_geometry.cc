@@ -171,7 +171,7 @@ bool Segment::InterpolateNodes(double sigma, Vector* u_out) const {
   }
   // The interpolant amplifies the scatter of its nodes (points accepted inside the noise next to the SB
   // lie ~noise/σ_min off the curve) by Σ|w_i| (the Lebesgue function): clustered nodes, or a trial
-  // outside their span, raise it to 1e2–1e3 and the predictor's residual with it (SLIP: |r| = 5e-5).
+  // outside their span, raise it to 1e2–1e3 and the predictor's residual with it.
   // Beyond kMaxLebesgue the Hermite interpolant of the bracketing probes is used instead.
   if (!(lebesgue <= kMaxLebesgue)) return false;
   Vector& u = *u_out;
@@ -305,8 +305,7 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
     const std::array<double, 5> trials = {x0, x0 + 0.5 * tolerance, x0 - 0.5 * tolerance, 0.5 * (lo + x0), 0.5 * (x0 + hi)};
     for (size_t attempt = 0; attempt < trials.size(); ++attempt) {
       // The retries half a tolerance away only for a trial exactly on the root: any other failure (a jump
-      // along the nearly singular direction, a poor interpolant) recurs half a tolerance away (SLIP: ~2
-      // wasted evaluations per noise-limited iteration).
+      // along the nearly singular direction, a poor interpolant) recurs half a tolerance away.
       if ((attempt == 1 || attempt == 2) && !retry_nearby) continue;
       const double trial = std::clamp(trials[attempt], lo + margin, hi - margin);
       if (segment->Evaluate(trial, lo_probe, lo, hi_probe, hi, &probe, &message)) {
@@ -328,12 +327,8 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
                       "four times its width, or that correction if larger, on both sides: an estimate, not a bound)";
         // The bracket ends are themselves points accepted inside the noise: near the SB they scatter
         // across both branches, and an end on the crossing branch carries a test value of the wrong sign.
-        // The SB is then only known to lie within a few bracket widths (or the scatter) of the bracket.
-        // Measured: on a noisy transcritical map up to 1.05 bracket widths outside the bare bracket; on
-        // the SLIP (noise-limited points of the loop and of the crossing cluster near H̄ = 1.6116, each
-        // located again at integration tolerances x0.1, x0.3 and x3) up to 2.5 times what one width on
-        // each side claimed. kNoiseMargin = 4 widths covers all of them (3 left one 7% short; a test
-        // compares x0.1).
+        // The SB is then only known to lie within a few bracket widths (or the scatter) of the bracket:
+        // kNoiseMargin (docs/design/continuation.md, "Location to the noise level").
         RootLocation located = finish(true);
         const double margin = std::max(scatter, kNoiseMargin * (hi - lo));
         const double lowest = std::min(0.0, segment->sigma_b()), highest = std::max(0.0, segment->sigma_b());

@@ -137,8 +137,8 @@ struct RootLocation {
   // What turns an error of the test function into an error of the root (stepper, "Integration error" in
   // special_point.h): the flatter of the test's secant slopes over the whole segment and over the final
   // bracket (from the test's values at the ends). The segment's alone understates the error where the test is
-  // flatter at its root than across the step (30x on a curve with a nearly quartic turning point, an
-  // independent review's case). 0 when the end probes failed.
+  // flatter at its root than across the step (docs/design/continuation.md, "Slope of a located root").
+  // 0 when the end probes failed.
   double slope = 0;
   int iterations = 0;
   // Located to the noise level: a trial point inside the bracket had a residual at the corrector's

@@ -138,13 +138,23 @@ bool Corrector::AcceptNewtonStep(double before_previous_step, double previous_st
   if (!(previous_step > 0)) return false;
   // From k = 2 on, the contraction must be established over two steps: after a first step that overshot
   // along a nearly singular direction of B and a second that took it back, |Δ₂|/|Δ₁| is small although
-  // Newton is not yet in its quadratic regime (bouncing rod: estimate 3e-10, true error 8e-9).
+  // Newton is not yet in its quadratic regime (docs/design/continuation.md, "Corrector: acceptance on
+  // error estimates").
   if (before_previous_step > 0 && previous_step > kMaxAcceptedContraction * before_previous_step) return false;
   const double theta = last_step / previous_step;
   const double scale = 1.0 + u.norm();
   return theta <= kMaxAcceptedContraction && theta / (1 - theta) * last_step <= options_.step_tolerance * scale &&
          last_step <= options_.max_jacobian_distance * scale;
 }
+
+// The state of one Run: its border and predictor, and the norms of the last Newton steps.
+struct Corrector::Newton {
+  Border border;
+  const Vector& u_pred;
+  double value;
+  bool exact_at_predictor;  // dr at the predictor as exact as the later ones (CorrectorOptions::kOnCurveStep)
+  double last_step = 0, previous_step = 0, before_previous_step = 0, previous_residual = 0;
+};
 
 CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector& b, double value,
                                Vector* u_out) {
@@ -161,128 +171,155 @@ CorrectorResult Corrector::Run(Border border, const Vector& u_pred, const Vector
   if (border != Border::kConstraint) w.border.normalize();
 
   CorrectorResult result;
-  double last_step = 0, previous_step = 0, before_previous_step = 0, previous_residual = 0;
+  Newton newton{border, u_pred, value, false};
   w.sparse = problem_->prefers_sparse_jacobian();
-  // Whether dr at the predictor is as exact as the later ones (CorrectorOptions::kOnCurveStep).
-  const bool exact_at_predictor = !(options_.predictor_jacobian_tolerance > problem_->jacobian_tolerance());
+  newton.exact_at_predictor = !(options_.predictor_jacobian_tolerance > problem_->jacobian_tolerance());
   for (int k = 0;; ++k) {
-    const EvaluationStatus evaluation = [&] {
-      // The predictor's dr only steers the first step (CorrectorOptions::predictor_jacobian_tolerance);
-      // the problem's own tolerance is restored however Evaluate returns, an exception included.
-      const JacobianToleranceScope scope(problem_, k == 0 ? options_.predictor_jacobian_tolerance : -1.0);
-      return w.sparse ? problem_->EvaluateSparse(u, &w.r, &w.dr_sparse) : problem_->Evaluate(u, &w.r, &w.dr);
-    }();
-    w.dense_stale = w.sparse;
-    ++result.evaluations;
-    if (!evaluation.ok) {
-      result.status = CorrectorStatus::kEvaluationFailed;
-      result.message = evaluation.message;
+    if (!EvaluateAt(newton, k, u, &result)) return result;
+    if (k > 0 && result.residual_norm <= options_.residual_tolerance && ConvergedAt(newton, k, &u, &result)) {
       return result;
     }
-    w.F.head(n - 1) = w.r;
-    switch (border) {
-      case Border::kArclength: w.F(n - 1) = w.border.dot(u - u_pred); break;
-      case Border::kConstraint: w.F(n - 1) = w.border.dot(u) - value; break;
-      case Border::kMoorePenrose: w.F(n - 1) = 0; break;
-    }
-    result.residual_norm = w.F.norm();
-    result.distance = (u - u_pred).norm();
-    if (k == 0) result.predictor_residual_norm = result.residual_norm;
-    if (k == 1 && result.predictor_residual_norm > 0) {
-      result.residual_contraction = result.residual_norm / result.predictor_residual_norm;
-    }
-    const bool jacobian_finite = w.sparse ? Eigen::Map<const Vector>(w.dr_sparse.valuePtr(), w.dr_sparse.nonZeros()).allFinite()
-                                          : w.dr.allFinite();
-    if (!std::isfinite(result.residual_norm) || !jacobian_finite) {
-      result.status = CorrectorStatus::kDiverged;
-      result.message = "non-finite residual or Jacobian";
-      return result;
-    }
-    if (k > 0 && result.residual_norm <= options_.residual_tolerance) {
-      // Deuflhard's termination (NLEQ-ERR): the simplified Newton correction Δ̄ = −B_{k−1}⁻¹F(u_k), from
-      // the factorization already at hand, estimates the error left in u_k; when it is small, u_k + Δ̄
-      // (error ~κ·|Δ̄|, at the rounding level) is the solution. This saves the last Newton step and its
-      // r+dr evaluation on most points; dr (jacobian()) is then the one at u_k, |Δ̄| <= step_tolerance away.
-      // Only from the second step on: the estimate is trusted once Newton has shown its contraction
-      // (a first step from the predictor may sit next to a singular point, where the residual is
-      // quadratic in the distance and a small residual says little about the error).
-      const double tolerance = options_.step_tolerance * (1.0 + u.norm());
-      if (options_.accept_on_error_estimate && k >= 2) {
-        w.delta = -w.F;
-        w.solver.Solve(w.delta, &w.correction);
-      }
-      if (options_.accept_on_error_estimate && k >= 2 && last_step > tolerance && w.correction.norm() <= tolerance) {
-        u += w.correction;
-        result.step_norm = w.correction.norm();
-        result.distance = (u - u_pred).norm();
-        ProjectOnConstraint(border, value, &u);
-        result.status = CorrectorStatus::kConverged;
-        return result;
-      }
-      // At the rounding floor the steps stop contracting; the residual test decides there.
-      const bool at_floor = k >= 2 && last_step >= 0.5 * previous_step;
-      if (last_step <= tolerance || at_floor) {
-        ProjectOnConstraint(border, value, &u);
-        result.status = CorrectorStatus::kConverged;
-        return result;
-      }
-    }
-    // Growing steps alone are not divergence: a first step that overshoots along a nearly singular
-    // direction of B is taken back by the second one (|Δ₁| ≈ |Δ₀|) while the residual drops.
-    if (k >= 2 && last_step > options_.max_contraction * previous_step &&
-        result.residual_norm >= previous_residual) {
-      result.status = CorrectorStatus::kDiverged;
-      result.message = "Newton steps and residual grow: |du| " + std::to_string(previous_step) + " -> " +
-                       std::to_string(last_step) + ", |F| " + std::to_string(previous_residual) + " -> " +
-                       std::to_string(result.residual_norm);
-      return result;
-    }
-    previous_residual = result.residual_norm;
-    if (k == options_.max_iterations) {
-      result.status = CorrectorStatus::kMaxIterations;
-      result.message = "|F| = " + std::to_string(result.residual_norm) + " after " + std::to_string(k) +
-                       " iterations";
-      return result;
-    }
-    if (!(w.sparse ? w.solver.Factorize(w.dr_sparse, w.border) : w.solver.Factorize(w.dr, w.border))) {
-      result.status = CorrectorStatus::kSingular;
-      result.message = "bordered matrix [dr; b^T] singular at iteration " + std::to_string(k);
-      return result;
-    }
-    w.F = -w.F;
-    w.solver.Solve(w.F, &w.delta);
-    if (border == Border::kMoorePenrose) {
-      // Kernel update (Allgower–Georg): the new border is the tangent induced by dr(u_k), oriented like
-      // the old one (its last equation is τ_kᵀ v = 1 > 0).
-      w.solver.Solve(w.unit_last, &w.kernel);
-      w.border = w.kernel / w.kernel.norm();
-    }
-    before_previous_step = previous_step;
-    previous_step = last_step;
-    last_step = w.delta.norm();
-    result.step_norm = last_step;
-    if (k == 1) result.contraction = previous_step > 0 ? last_step / previous_step : 0.0;
-    u += w.delta;
-    result.iterations = k + 1;
-    if ((u - u_pred).norm() > options_.max_distance) {
-      result.status = CorrectorStatus::kDiverged;
-      result.message = "iterate left the ball of radius max_distance = " +
-                       std::to_string(options_.max_distance) + " around the predictor";
-      return result;
-    }
-    const bool on_curve = k == 0 && exact_at_predictor && result.residual_norm <= options_.residual_tolerance &&
-                          last_step <= std::min(CorrectorOptions::kOnCurveStep, options_.max_jacobian_distance) *
-                                           (1.0 + u.norm());
-    if (on_curve ||
-        (options_.accept_on_error_estimate && k >= 1 && AcceptNewtonStep(before_previous_step, previous_step, last_step, u))) {
-      // u_{k+1} = u_k + Δ_k is returned without evaluating r there: its error is estimated by θ_k·|Δ_k|
-      // (AcceptNewtonStep). jacobian() stays the one at u_k, |Δ_k| away.
-      result.distance = (u - u_pred).norm();
-      ProjectOnConstraint(border, value, &u);
-      result.status = CorrectorStatus::kConverged;
-      return result;
-    }
+    if (Stalled(&newton, k, &result) || !TakeNewtonStep(&newton, k, &u, &result)) return result;
+    if (AcceptedAfterStep(newton, k, &u, &result)) return result;
   }
+}
+
+bool Corrector::EvaluateAt(const Newton& newton, int k, const Vector& u, CorrectorResult* result) {
+  Workspace& w = *workspace_;
+  const int n = problem_->num_unknowns();
+  const EvaluationStatus evaluation = [&] {
+    // The predictor's dr only steers the first step (CorrectorOptions::predictor_jacobian_tolerance);
+    // the problem's own tolerance is restored however Evaluate returns, an exception included.
+    const JacobianToleranceScope scope(problem_, k == 0 ? options_.predictor_jacobian_tolerance : -1.0);
+    return w.sparse ? problem_->EvaluateSparse(u, &w.r, &w.dr_sparse) : problem_->Evaluate(u, &w.r, &w.dr);
+  }();
+  w.dense_stale = w.sparse;
+  ++result->evaluations;
+  if (!evaluation.ok) {
+    result->status = CorrectorStatus::kEvaluationFailed;
+    result->message = evaluation.message;
+    return false;
+  }
+  w.F.head(n - 1) = w.r;
+  switch (newton.border) {
+    case Border::kArclength: w.F(n - 1) = w.border.dot(u - newton.u_pred); break;
+    case Border::kConstraint: w.F(n - 1) = w.border.dot(u) - newton.value; break;
+    case Border::kMoorePenrose: w.F(n - 1) = 0; break;
+  }
+  result->residual_norm = w.F.norm();
+  result->distance = (u - newton.u_pred).norm();
+  if (k == 0) result->predictor_residual_norm = result->residual_norm;
+  if (k == 1 && result->predictor_residual_norm > 0) {
+    result->residual_contraction = result->residual_norm / result->predictor_residual_norm;
+  }
+  const bool jacobian_finite = w.sparse ? Eigen::Map<const Vector>(w.dr_sparse.valuePtr(), w.dr_sparse.nonZeros()).allFinite()
+                                        : w.dr.allFinite();
+  if (!std::isfinite(result->residual_norm) || !jacobian_finite) {
+    result->status = CorrectorStatus::kDiverged;
+    result->message = "non-finite residual or Jacobian";
+    return false;
+  }
+  return true;
+}
+
+bool Corrector::ConvergedAt(const Newton& newton, int k, Vector* u, CorrectorResult* result) {
+  Workspace& w = *workspace_;
+  // Deuflhard's termination (NLEQ-ERR): the simplified Newton correction Δ̄ = −B_{k−1}⁻¹F(u_k), from
+  // the factorization already at hand, estimates the error left in u_k; when it is small, u_k + Δ̄
+  // (error ~κ·|Δ̄|, at the rounding level) is the solution. This saves the last Newton step and its
+  // r+dr evaluation on most points; dr (jacobian()) is then the one at u_k, |Δ̄| <= step_tolerance away.
+  // Only from the second step on: the estimate is trusted once Newton has shown its contraction
+  // (a first step from the predictor may sit next to a singular point, where the residual is
+  // quadratic in the distance and a small residual says little about the error).
+  const double tolerance = options_.step_tolerance * (1.0 + u->norm());
+  if (options_.accept_on_error_estimate && k >= 2) {
+    w.delta = -w.F;
+    w.solver.Solve(w.delta, &w.correction);
+  }
+  if (options_.accept_on_error_estimate && k >= 2 && newton.last_step > tolerance && w.correction.norm() <= tolerance) {
+    *u += w.correction;
+    result->step_norm = w.correction.norm();
+    result->distance = (*u - newton.u_pred).norm();
+    ProjectOnConstraint(newton.border, newton.value, u);
+    result->status = CorrectorStatus::kConverged;
+    return true;
+  }
+  // At the rounding floor the steps stop contracting; the residual test decides there.
+  const bool at_floor = k >= 2 && newton.last_step >= 0.5 * newton.previous_step;
+  if (newton.last_step <= tolerance || at_floor) {
+    ProjectOnConstraint(newton.border, newton.value, u);
+    result->status = CorrectorStatus::kConverged;
+    return true;
+  }
+  return false;
+}
+
+bool Corrector::Stalled(Newton* newton, int k, CorrectorResult* result) const {
+  // Growing steps alone are not divergence: a first step that overshoots along a nearly singular
+  // direction of B is taken back by the second one (|Δ₁| ≈ |Δ₀|) while the residual drops.
+  if (k >= 2 && newton->last_step > options_.max_contraction * newton->previous_step &&
+      result->residual_norm >= newton->previous_residual) {
+    result->status = CorrectorStatus::kDiverged;
+    result->message = "Newton steps and residual grow: |du| " + std::to_string(newton->previous_step) + " -> " +
+                      std::to_string(newton->last_step) + ", |F| " + std::to_string(newton->previous_residual) +
+                      " -> " + std::to_string(result->residual_norm);
+    return true;
+  }
+  newton->previous_residual = result->residual_norm;
+  if (k == options_.max_iterations) {
+    result->status = CorrectorStatus::kMaxIterations;
+    result->message = "|F| = " + std::to_string(result->residual_norm) + " after " + std::to_string(k) +
+                      " iterations";
+    return true;
+  }
+  return false;
+}
+
+bool Corrector::TakeNewtonStep(Newton* newton, int k, Vector* u, CorrectorResult* result) {
+  Workspace& w = *workspace_;
+  if (!(w.sparse ? w.solver.Factorize(w.dr_sparse, w.border) : w.solver.Factorize(w.dr, w.border))) {
+    result->status = CorrectorStatus::kSingular;
+    result->message = "bordered matrix [dr; b^T] singular at iteration " + std::to_string(k);
+    return false;
+  }
+  w.F = -w.F;
+  w.solver.Solve(w.F, &w.delta);
+  if (newton->border == Border::kMoorePenrose) {
+    // Kernel update (Allgower–Georg): the new border is the tangent induced by dr(u_k), oriented like
+    // the old one (its last equation is τ_kᵀ v = 1 > 0).
+    w.solver.Solve(w.unit_last, &w.kernel);
+    w.border = w.kernel / w.kernel.norm();
+  }
+  newton->before_previous_step = newton->previous_step;
+  newton->previous_step = newton->last_step;
+  newton->last_step = w.delta.norm();
+  result->step_norm = newton->last_step;
+  if (k == 1) result->contraction = newton->previous_step > 0 ? newton->last_step / newton->previous_step : 0.0;
+  *u += w.delta;
+  result->iterations = k + 1;
+  if ((*u - newton->u_pred).norm() > options_.max_distance) {
+    result->status = CorrectorStatus::kDiverged;
+    result->message = "iterate left the ball of radius max_distance = " + std::to_string(options_.max_distance) +
+                      " around the predictor";
+    return false;
+  }
+  return true;
+}
+
+bool Corrector::AcceptedAfterStep(const Newton& newton, int k, Vector* u, CorrectorResult* result) const {
+  const bool on_curve = k == 0 && newton.exact_at_predictor && result->residual_norm <= options_.residual_tolerance &&
+                        newton.last_step <= std::min(CorrectorOptions::kOnCurveStep, options_.max_jacobian_distance) *
+                                                (1.0 + u->norm());
+  if (on_curve || (options_.accept_on_error_estimate && k >= 1 &&
+                   AcceptNewtonStep(newton.before_previous_step, newton.previous_step, newton.last_step, *u))) {
+    // u_{k+1} = u_k + Δ_k is returned without evaluating r there: its error is estimated by θ_k·|Δ_k|
+    // (AcceptNewtonStep). jacobian() stays the one at u_k, |Δ_k| away.
+    result->distance = (*u - newton.u_pred).norm();
+    ProjectOnConstraint(newton.border, newton.value, u);
+    result->status = CorrectorStatus::kConverged;
+    return true;
+  }
+  return false;
 }
 
 }  // namespace hybridcont
