@@ -232,127 +232,39 @@ bool Segment::RefinedProbe(ZeroProblem* refined, const Probe& probe, Probe* fine
   return correction->allFinite();
 }
 
-RootLocation LocateRoot(Segment* segment, const std::function<double(const Segment::Probe&)>& test,
-                        double tolerance, int max_iterations) {
-  RootLocation out;
+namespace {
+
+// The bracket of LocateRoot: its ends in σ, their probes and test values, and the Illinois state.
+struct Bracket {
+  double lo = 0, hi = 0;
   Segment::Probe lo_probe, hi_probe;
-  std::string message;
-  double lo = 0, hi = segment->sigma_b();
-  if (!segment->EndProbe(false, &lo_probe, &message) || !segment->EndProbe(true, &hi_probe, &message)) {
-    out.message = message;
-    out.lo = lo;
-    out.hi = hi;
-    out.estimate = segment->sigma_b() > 0 ? hi_probe : lo_probe;
-    out.u_lo = segment->a().u;
-    out.u_hi = segment->b().u;
-    return out;
-  }
-  double g_lo = test(lo_probe), g_hi = test(hi_probe);
-  if (hi > lo) out.slope = (g_hi - g_lo) / (hi - lo);
-  // Illinois factors: the value of an end retained twice is halved.
-  double f_lo = g_lo, f_hi = g_hi;
-  int side = 0;
-  double width_at_check = hi - lo;
-  int last_side = 0;
-  // The estimate is a bracket end: with |test| smaller, or the most recent one on a tie (a test function
-  // that jumps at its root has equal |test| on both sides).
-  auto finish = [&](bool located) {
-    out.located = located;
-    out.lo = lo;
-    out.hi = hi;
+  double g_lo = 0, g_hi = 0;  // the test at the ends
+  double f_lo = 0, f_hi = 0;  // Illinois factors: the value of an end retained twice is halved
+  int side = 0;               // the end kept last time
+  int last_side = 0;          // the end that moved last
+
+  // *out completed from the bracket. The estimate is a bracket end: with |test| smaller, or the most
+  // recent one on a tie (a test function that jumps at its root has equal |test| on both sides).
+  RootLocation Finish(RootLocation* out, bool located) const {
+    out->located = located;
+    out->lo = lo;
+    out->hi = hi;
     const bool use_hi = std::abs(g_hi) < std::abs(g_lo) || (std::abs(g_hi) == std::abs(g_lo) && last_side == +1);
-    out.estimate = use_hi ? hi_probe : lo_probe;
-    out.sigma = use_hi ? hi : lo;
-    out.test = use_hi ? g_hi : g_lo;
-    out.u_lo = lo_probe.u;
-    out.u_hi = hi_probe.u;
+    out->estimate = use_hi ? hi_probe : lo_probe;
+    out->sigma = use_hi ? hi : lo;
+    out->test = use_hi ? g_hi : g_lo;
+    out->u_lo = lo_probe.u;
+    out->u_hi = hi_probe.u;
     // The flatter of the segment's secant and the final bracket's (RootLocation::slope).
     if (hi > lo && g_lo != 0 && g_hi != 0 && std::signbit(g_lo) != std::signbit(g_hi)) {
       const double local = (g_hi - g_lo) / (hi - lo);
-      if (std::abs(local) < std::abs(out.slope)) out.slope = local;
+      if (std::abs(local) < std::abs(out->slope)) out->slope = local;
     }
-    return out;
-  };
-  if (g_lo != 0 && g_hi != 0 && std::signbit(g_lo) == std::signbit(g_hi)) {
-    // The end probes recompute the SB test from dr at the points themselves, while the sign change was
-    // seen in the values stored with the points (from dr up to CorrectorOptions::max_jacobian_distance
-    // away): the crossing lies within that distance of an end, or is not there. Not a root to locate.
-    out.message = "no sign change between the bracketing points when the test is re-evaluated there (" +
-                  FormatShort(g_lo) + ", " + FormatShort(g_hi) + ")";
-    return finish(false);
+    return *out;
   }
-  for (int it = 1; it <= max_iterations; ++it) {
-    const double width = hi - lo;
-    if (width <= tolerance) return finish(true);
-    double x = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
-    if (it % 3 == 0) {
-      if (width > 0.5 * width_at_check) x = 0.5 * (lo + hi);
-      width_at_check = width;
-    }
-    // Keep every trial point strictly inside, at least tolerance/4 from the ends, so the bracket shrinks.
-    const double margin = std::min(0.25 * tolerance, 0.25 * width);
-    if (!std::isfinite(x)) x = 0.5 * (lo + hi);
-    x = std::clamp(x, lo + margin, hi - margin);
-    // A trial point exactly on the root of the SB test is exactly singular (regula falsi hits it for a
-    // linear test function): retry half a tolerance to either side, which still brackets the root. With
-    // a noisy map the points within ~noise/slope of an SB cannot be corrected at all: then retry halfway
-    // to either bracket end, which still halves the bracket.
-    Segment::Probe probe;
-    bool corrected = false, noise_limited = false;
-    double scatter = 0;
-    const double x0 = x;
-    bool retry_nearby = false;
-    const std::array<double, 5> trials = {x0, x0 + 0.5 * tolerance, x0 - 0.5 * tolerance, 0.5 * (lo + x0), 0.5 * (x0 + hi)};
-    for (size_t attempt = 0; attempt < trials.size(); ++attempt) {
-      // The retries half a tolerance away only for a trial exactly on the root: any other failure (a jump
-      // along the nearly singular direction, a poor interpolant) recurs half a tolerance away.
-      if ((attempt == 1 || attempt == 2) && !retry_nearby) continue;
-      const double trial = std::clamp(trials[attempt], lo + margin, hi - margin);
-      if (segment->Evaluate(trial, lo_probe, lo, hi_probe, hi, &probe, &message)) {
-        x = trial;
-        corrected = true;
-        break;
-      }
-      if (attempt == 0) retry_nearby = probe.singular_at_trial;
-      noise_limited = noise_limited || probe.noise_limited;
-      if (probe.noise_limited) scatter = std::max(scatter, probe.scatter);
-    }
-    if (!corrected) {
-      out.iterations = it;
-      if (noise_limited) {
-        out.noise_limited = true;
-        out.message = "located to the noise level: a trial point inside the bracket has |r| = " +
-                      FormatShort(probe.residual) + " before any correction, and Newton's correction of that " +
-                      "noise is not small against the bracket (the precision is the bracket widened by " +
-                      "four times its width, or that correction if larger, on both sides: an estimate, not a bound)";
-        // The bracket ends are themselves points accepted inside the noise: near the SB they scatter
-        // across both branches, and an end on the crossing branch carries a test value of the wrong sign.
-        // The SB is then only known to lie within a few bracket widths (or the scatter) of the bracket:
-        // kNoiseMargin (docs/design/continuation.md, "Location to the noise level").
-        RootLocation located = finish(true);
-        const double margin = std::max(scatter, kNoiseMargin * (hi - lo));
-        const double lowest = std::min(0.0, segment->sigma_b()), highest = std::max(0.0, segment->sigma_b());
-        located.lo = std::max(lowest, lo - margin);
-        located.hi = std::min(highest, hi + margin);
-        return located;
-      }
-      out.message = message;
-      return finish(false);
-    }
-    out.iterations = it;
-    const double g = test(probe);
-    if (g == 0) {
-      // Exactly on the root: the slope from the bracket just before (RootLocation::slope), then a
-      // one-point bracket whose test value is that 0.
-      for (const auto& [end, value] : {std::pair{lo, g_lo}, std::pair{hi, g_hi}}) {
-        const double local = value / (end - x);
-        if (end != x && std::abs(local) < std::abs(out.slope)) out.slope = local;
-      }
-      lo = hi = x;
-      g_lo = g_hi = 0;
-      lo_probe = hi_probe = probe;
-      return finish(true);
-    }
+
+  // The corrected trial point at x with test value g != 0 replaces the end of its sign.
+  void Replace(double x, double g, Segment::Probe probe) {
     if (std::signbit(g) == std::signbit(g_lo)) {
       lo = x;
       g_lo = f_lo = g;
@@ -369,8 +281,131 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
       side = +1;
     }
   }
+};
+
+// A trial point of one LocateRoot iteration, corrected onto the curve, and what its failures said.
+struct Trial {
+  bool corrected = false;
+  double x = 0;                // where it was corrected
+  Segment::Probe probe;
+  bool noise_limited = false;  // a failed attempt was limited by the noise
+  double scatter = 0;          // the largest correction of such an attempt
+};
+
+// A trial point exactly on the root of the SB test is exactly singular (regula falsi hits it for a linear
+// test function): retried half a tolerance to either side, which still brackets the root. With a noisy map
+// the points within ~noise/slope of an SB cannot be corrected at all: then retried halfway to either
+// bracket end, which still halves the bracket.
+Trial CorrectTrial(Segment* segment, const Bracket& bracket, double x0, double margin, double tolerance,
+                   std::string* message) {
+  const double lo = bracket.lo, hi = bracket.hi;
+  Trial trial;
+  trial.x = x0;
+  bool retry_nearby = false;
+  const std::array<double, 5> trials = {x0, x0 + 0.5 * tolerance, x0 - 0.5 * tolerance, 0.5 * (lo + x0), 0.5 * (x0 + hi)};
+  for (size_t attempt = 0; attempt < trials.size(); ++attempt) {
+    // The retries half a tolerance away only for a trial exactly on the root: any other failure (a jump
+    // along the nearly singular direction, a poor interpolant) recurs half a tolerance away.
+    if ((attempt == 1 || attempt == 2) && !retry_nearby) continue;
+    const double x = std::clamp(trials[attempt], lo + margin, hi - margin);
+    if (segment->Evaluate(x, bracket.lo_probe, lo, bracket.hi_probe, hi, &trial.probe, message)) {
+      trial.x = x;
+      trial.corrected = true;
+      break;
+    }
+    if (attempt == 0) retry_nearby = trial.probe.singular_at_trial;
+    trial.noise_limited = trial.noise_limited || trial.probe.noise_limited;
+    if (trial.probe.noise_limited) trial.scatter = std::max(trial.scatter, trial.probe.scatter);
+  }
+  return trial;
+}
+
+// Located to the noise level. The bracket ends are themselves points accepted inside the noise: near the
+// SB they scatter across both branches, and an end on the crossing branch carries a test value of the
+// wrong sign. The SB is then only known to lie within a few bracket widths (or the scatter) of the
+// bracket: kNoiseMargin (docs/design/continuation.md, "Location to the noise level").
+RootLocation NoiseLimited(const Bracket& bracket, const Trial& trial, double sigma_b, RootLocation* out) {
+  out->noise_limited = true;
+  out->message = "located to the noise level: a trial point inside the bracket has |r| = " +
+                 FormatShort(trial.probe.residual) + " before any correction, and Newton's correction of that " +
+                 "noise is not small against the bracket (the precision is the bracket widened by " +
+                 "four times its width, or that correction if larger, on both sides: an estimate, not a bound)";
+  RootLocation located = bracket.Finish(out, true);
+  const double margin = std::max(trial.scatter, kNoiseMargin * (bracket.hi - bracket.lo));
+  const double lowest = std::min(0.0, sigma_b), highest = std::max(0.0, sigma_b);
+  located.lo = std::max(lowest, bracket.lo - margin);
+  located.hi = std::min(highest, bracket.hi + margin);
+  return located;
+}
+
+}  // namespace
+
+RootLocation LocateRoot(Segment* segment, const std::function<double(const Segment::Probe&)>& test,
+                        double tolerance, int max_iterations) {
+  RootLocation out;
+  Bracket bracket;
+  std::string message;
+  double& lo = bracket.lo;
+  double& hi = bracket.hi;
+  hi = segment->sigma_b();
+  if (!segment->EndProbe(false, &bracket.lo_probe, &message) || !segment->EndProbe(true, &bracket.hi_probe, &message)) {
+    out.message = message;
+    out.lo = lo;
+    out.hi = hi;
+    out.estimate = segment->sigma_b() > 0 ? bracket.hi_probe : bracket.lo_probe;
+    out.u_lo = segment->a().u;
+    out.u_hi = segment->b().u;
+    return out;
+  }
+  bracket.g_lo = test(bracket.lo_probe), bracket.g_hi = test(bracket.hi_probe);
+  if (hi > lo) out.slope = (bracket.g_hi - bracket.g_lo) / (hi - lo);
+  bracket.f_lo = bracket.g_lo, bracket.f_hi = bracket.g_hi;
+  double width_at_check = hi - lo;
+  if (bracket.g_lo != 0 && bracket.g_hi != 0 && std::signbit(bracket.g_lo) == std::signbit(bracket.g_hi)) {
+    // The end probes recompute the SB test from dr at the points themselves, while the sign change was
+    // seen in the values stored with the points (from dr up to CorrectorOptions::max_jacobian_distance
+    // away): the crossing lies within that distance of an end, or is not there. Not a root to locate.
+    out.message = "no sign change between the bracketing points when the test is re-evaluated there (" +
+                  FormatShort(bracket.g_lo) + ", " + FormatShort(bracket.g_hi) + ")";
+    return bracket.Finish(&out, false);
+  }
+  for (int it = 1; it <= max_iterations; ++it) {
+    const double width = hi - lo;
+    if (width <= tolerance) return bracket.Finish(&out, true);
+    double x = (lo * bracket.f_hi - hi * bracket.f_lo) / (bracket.f_hi - bracket.f_lo);
+    if (it % 3 == 0) {  // a bisection every third iteration without halving of the bracket
+      if (width > 0.5 * width_at_check) x = 0.5 * (lo + hi);
+      width_at_check = width;
+    }
+    // Keep every trial point strictly inside, at least tolerance/4 from the ends, so the bracket shrinks.
+    const double margin = std::min(0.25 * tolerance, 0.25 * width);
+    if (!std::isfinite(x)) x = 0.5 * (lo + hi);
+    x = std::clamp(x, lo + margin, hi - margin);
+    Trial trial = CorrectTrial(segment, bracket, x, margin, tolerance, &message);
+    out.iterations = it;
+    if (!trial.corrected) {
+      if (trial.noise_limited) return NoiseLimited(bracket, trial, segment->sigma_b(), &out);
+      out.message = message;
+      return bracket.Finish(&out, false);
+    }
+    x = trial.x;
+    const double g = test(trial.probe);
+    if (g == 0) {
+      // Exactly on the root: the slope from the bracket just before (RootLocation::slope), then a
+      // one-point bracket whose test value is that 0.
+      for (const auto& [end, value] : {std::pair{lo, bracket.g_lo}, std::pair{hi, bracket.g_hi}}) {
+        const double local = value / (end - x);
+        if (end != x && std::abs(local) < std::abs(out.slope)) out.slope = local;
+      }
+      lo = hi = x;
+      bracket.g_lo = bracket.g_hi = 0;
+      bracket.lo_probe = bracket.hi_probe = trial.probe;
+      return bracket.Finish(&out, true);
+    }
+    bracket.Replace(x, g, std::move(trial.probe));
+  }
   out.message = "root finder budget of " + std::to_string(max_iterations) + " iterations spent";
-  return finish(hi - lo <= tolerance);
+  return bracket.Finish(&out, hi - lo <= tolerance);
 }
 
 }  // namespace hybridcont::internal
