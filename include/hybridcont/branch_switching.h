@@ -9,38 +9,23 @@
 //
 // A branch through u* leaves it along v = Φα with α solving the algebraic bifurcation equations (ABE)
 //
-//   Q_j(α) = ψ_jᵀ d²r(u*)[Φα, Φα] = αᵀ A_j α = 0,   (A_j)_pq = ψ_jᵀ d²r(u*)[φ_p, φ_q],   j = 1..k−1,
+//   Q_j(α) = ψ_jᵀ d²r(u*)[Φα, Φα] = αᵀ A_j α = 0,   j = 1..k−1,
+//   d²r[v, w] ≈ (dr(u* + εw) − dr(u* − εw)) v / (2ε)      (central differences of the exact Jacobian)
 //
-// with the second derivative from central differences of the exact Jacobian (symmetrized):
-//
-//   d²r[v, w] ≈ (dr(u* + εw) − dr(u* − εw)) v / (2ε)          (error O(ε²), rounding O(eps/ε))
-//
-// k = 2 (a simple bifurcation point): one quadratic a α₁² + 2b α₁α₂ + c α₂² = 0 with discriminant
-// b² − ac > 0 has two real roots = the two branches crossing at u*. On a traced branch one root is the
-// incoming tangent; the new branch leaves along the other, "transverse" root, in both directions ±v.
-// k > 2: user linear conditions Cv = 0 on the direction (e.g. the rod's symmetry t2 = t1 + t3 as
-// {{"t2", 1}, {"t1", −1}, {"t3", −1}}) restrict the kernel; with a 2-dim restriction the roots of the
-// dominant restricted form that make all forms vanish are the branches; with a 1-dim one the conditions
-// alone select the direction.
+// k = 2: one quadratic a α₁² + 2b α₁α₂ + c α₂² with b² − ac > 0 has two real roots, the two branches
+// crossing at u*; on a traced branch the new one leaves along the root transverse to the incoming
+// tangent, in both directions ±v (d of eq. (IVP)). k > 2: linear conditions C v = 0 restrict the kernel
+// (e.g. t2 = t1 + t3 as {{"t2", 1}, {"t1", −1}, {"t3", −1}}); the roots of the dominant restricted form
+// that make all forms vanish are the branches.
+// Contract: directions are lines (unit, largest-magnitude component positive); a double root is one
+// line; a degenerate ABE gives the kernel direction orthogonal to the incoming tangent (kFallback). At an
+// SB point found on a branch the kernel is taken to be 2-dimensional. Design decisions:
+// docs/design/exploration.md ("Branch switching: rank decision and fallback").
 //
 // Tiny example (pitchfork x³ − λx at its singular point (0, 0): d²r = [[6x, −1], [−1, 0]] → Q = −2αβ):
 //
 //   std::vector<Vector> lines = BranchDirectionsAt(pitchfork, Vector2d(0, 0), StartOptions());
 //   // lines = {(1, 0), (0, 1)}: the parabola's tangent and the trivial branch
-//
-// Decisions where the issue is silent:
-//  - Rank decision: singular values below rank_tolerance · max(1, σ_max) count as zero (absolute below
-//    1, so an all-zero dr, like the pitchfork at the origin, has full kernel).
-//  - At an SB point found on a branch the kernel is *taken* to be 2-dimensional (the two smallest right
-//    singular vectors): the sign change of the test function proved it, even if the located point is only
-//    bracketed and σ_min is not yet below the rank tolerance.
-//  - Directions are reported as lines (unit vectors whose largest-magnitude component is positive); a
-//    line is two half-branches, ±v.
-//  - A double root of the (restricted) ABE is reported as one line: after restriction by linear
-//    conditions this is the usual case (the other branches leave the restricted plane); message says so.
-//  - Fallback when the ABE is degenerate (relative discriminant below degeneracy_tolerance, or no real
-//    root): the kernel direction orthogonal to the incoming tangent, status kFallback, and the message
-//    says so.
 #ifndef HYBRIDCONT_BRANCH_SWITCHING_H_
 #define HYBRIDCONT_BRANCH_SWITCHING_H_
 
@@ -56,11 +41,11 @@
 namespace hybridcont {
 
 struct BranchSwitchOptions {
-  // Relative rank decision (see the header comment). 1e-8 separates a located SB (σ_min ~ 1e-11) from
-  // genuinely nonzero singular values of O(1) problems.
+  // Singular values below this · max(1, σ_max) count as zero: separates a located SB point's σ_min from
+  // the genuinely nonzero singular values of O(1) problems.
   double rank_tolerance = 1e-8;
-  // ε of the central differences: truncation O(ε²) ~ 1e-8 and rounding O(1e-16/ε) ~ 1e-12 for exact
-  // Jacobians; integrator noise δ in dr adds δ/ε, still small for δ ~ 1e-10.
+  // ε of the central differences: balances truncation O(ε²) against rounding and integrator noise in
+  // dr, which enter as O(δ/ε).
   double fd_step = 1e-4;
   // A discriminant below this times (a² + b² + c²) means a double root: the ABE does not separate two
   // branches (degenerate; not a simple bifurcation).

@@ -1,6 +1,10 @@
 // Lyapunov–Schmidt reduction at singular points (branch_switching.h).
 #include "hybridcont/branch_switching.h"
+
 #include "continuation/jacobian_tolerance_scope.h"
+#include "hybridcont/internal/enum_names.h"
+#include "hybridcont/internal/options_check.h"
+#include "hybridcont/invariant.h"
 
 #include <Eigen/SVD>
 #include <algorithm>
@@ -30,6 +34,15 @@ bool QuadraticForms(ZeroProblem* problem, const Vector& u, const Matrix& kernel,
   for (Matrix& form : *forms) form = 0.5 * (form + form.transpose()).eval();
   return true;
 }
+
+constexpr internal::EnumName<BranchSwitchStatus> kBranchSwitchStatusNames[] = {
+    {BranchSwitchStatus::kOk, "ok"},
+    {BranchSwitchStatus::kFallback, "fallback"},
+    {BranchSwitchStatus::kRegular, "regular"},
+    {BranchSwitchStatus::kUnderdetermined, "underdetermined"},
+    {BranchSwitchStatus::kNoRoots, "no-roots"},
+    {BranchSwitchStatus::kEvaluationFailed, "evaluation-failed"},
+};
 
 enum class Roots { kTwo, kDouble, kNone };
 
@@ -63,41 +76,112 @@ Vector CanonicalLine(Vector v) {
   return v(i) < 0 ? Vector(-v) : v;
 }
 
-std::string ToString(BranchSwitchStatus status) {
-  switch (status) {
-    case BranchSwitchStatus::kOk: return "ok";
-    case BranchSwitchStatus::kFallback: return "fallback";
-    case BranchSwitchStatus::kRegular: return "regular";
-    case BranchSwitchStatus::kUnderdetermined: return "underdetermined";
-    case BranchSwitchStatus::kNoRoots: return "no-roots";
-    case BranchSwitchStatus::kEvaluationFailed: return "evaluation-failed";
+namespace {
+
+// The conditions as rows c_i of C (C v = 0), on the unknowns named by their coefficients.
+Matrix ConditionMatrix(const ZeroProblem& problem, const std::vector<LinearCondition>& conditions) {
+  Matrix C(static_cast<Eigen::Index>(conditions.size()), problem.num_unknowns());
+  C.setZero();
+  for (size_t i = 0; i < conditions.size(); ++i) {
+    for (const auto& [name, coefficient] : conditions[i].coefficients) {
+      const int index = problem.UnknownIndex(name);
+      if (index < 0) throw std::invalid_argument("StartOptions::conditions: \"" + name + "\" is not an unknown");
+      C(static_cast<Eigen::Index>(i), index) += coefficient;
+    }
   }
-  return "unknown";
+  return C;
 }
 
-std::string BranchSwitchOptions::Validate() const {
-  std::ostringstream out;
-  if (!(rank_tolerance > 0 && rank_tolerance < 1)) {
-    out << "BranchSwitchOptions::rank_tolerance = " << rank_tolerance << " must lie in (0, 1)";
-  } else if (!(fd_step > 0)) {
-    out << "BranchSwitchOptions::fd_step = " << fd_step << " must be > 0";
-  } else if (!(degeneracy_tolerance >= 0)) {
-    out << "BranchSwitchOptions::degeneracy_tolerance = " << degeneracy_tolerance << " must be >= 0";
-  } else if (!(abe_tolerance > 0)) {
-    out << "BranchSwitchOptions::abe_tolerance = " << abe_tolerance << " must be > 0";
+// Singular values, kernel and cokernel of dr(u0) (rank decided relative to max(1, σ_max)); false when
+// the evaluation failed (out says why).
+bool AnalyzeKernel(ZeroProblem* problem, const Vector& u0, double rank_tolerance, BranchDirections* out) {
+  Matrix dr;
+  if (const EvaluationStatus status = problem->Evaluate(u0, nullptr, &dr); !status.ok) {
+    out->status = BranchSwitchStatus::kEvaluationFailed;
+    out->message = status.message;
+    return false;
   }
-  return out.str();
+  const int n = problem->num_unknowns();
+  Eigen::JacobiSVD<Matrix> svd(dr, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  out->singular_values = svd.singularValues();
+  const double threshold = rank_tolerance * std::max(1.0, out->singular_values.maxCoeff());
+  int rank = 0;
+  while (rank < out->singular_values.size() && out->singular_values(rank) > threshold) ++rank;
+  out->kernel_dimension = n - rank;
+  out->cokernel_dimension = static_cast<int>(dr.rows()) - rank;
+  out->kernel = svd.matrixV().rightCols(out->kernel_dimension);
+  out->cokernel = svd.matrixU().rightCols(out->cokernel_dimension);
+  return true;
+}
+
+// Z spanning the null space of C Φ: the kernel Φ restricted by the conditions is Φ Z.
+Matrix RestrictedKernel(const Matrix& C, const Matrix& kernel, double rank_tolerance) {
+  const Eigen::Index k = kernel.cols();
+  if (C.rows() == 0) return Matrix::Identity(k, k);
+  const Matrix CPhi = C * kernel;
+  Eigen::JacobiSVD<Matrix> csvd(CPhi, Eigen::ComputeFullV);
+  const double cmax = std::max(1.0, csvd.singularValues().size() ? csvd.singularValues().maxCoeff() : 0.0);
+  int crank = 0;
+  while (crank < csvd.singularValues().size() && csvd.singularValues()(crank) > rank_tolerance * cmax) ++crank;
+  return csvd.matrixV().rightCols(k - crank);
+}
+
+// The branch lines Φ Z α of a 2-dim restricted kernel: roots α of the dominant form that make every
+// other form vanish too (out->status, directions and message).
+void CommonRoots(const std::vector<Matrix>& forms, const Matrix& basis, const BranchSwitchOptions& options,
+                 BranchDirections* out) {
+  HYBRIDCONT_DEMAND(!forms.empty());
+  size_t dominant = 0;
+  for (size_t j = 1; j < forms.size(); ++j) {
+    if (forms[j].norm() > forms[dominant].norm()) dominant = j;
+  }
+  std::vector<Eigen::Vector2d> roots;
+  const Roots kind = QuadraticRoots(forms[dominant], options.degeneracy_tolerance, &roots);
+  if (kind == Roots::kNone) {
+    out->status = BranchSwitchStatus::kNoRoots;
+    out->message = "the algebraic bifurcation equation has no real roots (or vanishes identically)";
+    return;
+  }
+  // A double root is one branch line: with a 2-dim kernel a degenerate (non-simple) point, after
+  // restriction by conditions the usual case (the other branches lie outside the restricted plane).
+  if (kind == Roots::kDouble) out->message = "double root of the algebraic bifurcation equation";
+  for (const Eigen::Vector2d& root : roots) {
+    bool common = true;
+    for (const Matrix& form : forms) {
+      if (std::abs(root.dot(form * root)) > options.abe_tolerance * std::max(form.norm(), 1e-300) &&
+          form.norm() > options.abe_tolerance * forms[dominant].norm()) {
+        common = false;
+      }
+    }
+    if (common) out->directions.push_back(CanonicalLine(basis * root));
+  }
+  out->status = out->directions.empty() ? BranchSwitchStatus::kNoRoots : BranchSwitchStatus::kOk;
+  if (out->directions.empty()) out->message = "the roots of the dominant form do not solve the other forms";
+  if (out->directions.size() == 2 && std::abs(out->directions[0].dot(out->directions[1])) > 1 - 1e-12) {
+    out->directions.pop_back();
+  }
+}
+
+}  // namespace
+
+std::string ToString(BranchSwitchStatus status) { return internal::EnumToString(kBranchSwitchStatusNames, status); }
+
+std::string BranchSwitchOptions::Validate() const {
+  return internal::OptionsCheck("BranchSwitchOptions")
+      .Between("rank_tolerance", rank_tolerance, 0, 1)
+      .Require(fd_step > 0, "fd_step", fd_step, "must be > 0")
+      .Require(degeneracy_tolerance >= 0, "degeneracy_tolerance", degeneracy_tolerance, "must be >= 0")
+      .Require(abe_tolerance > 0, "abe_tolerance", abe_tolerance, "must be > 0")
+      .message();
 }
 
 std::string StartOptions::Validate() const {
-  std::string error = switching.Validate();
-  if (!error.empty()) return "StartOptions::switching: " + error;
+  internal::OptionsCheck check("StartOptions");
+  check.Nested("switching", switching.Validate());
   for (size_t i = 0; i < conditions.size(); ++i) {
-    if (conditions[i].coefficients.empty()) {
-      return "StartOptions::conditions[" + std::to_string(i) + "] has no coefficients";
-    }
+    check.Require(!conditions[i].coefficients.empty(), "conditions[" + std::to_string(i) + "] has no coefficients");
   }
-  return "";
+  return check.message();
 }
 
 std::string BranchDirections::BriefReport() const {
@@ -125,51 +209,16 @@ BranchDirections AnalyzeSingularPoint(ZeroProblem* problem, const Vector& u0, co
     throw std::invalid_argument("AnalyzeSingularPoint: u0 has size " + std::to_string(u0.size()) +
                                 ", expected " + std::to_string(n));
   }
-  Matrix C(static_cast<Eigen::Index>(options.conditions.size()), n);
-  C.setZero();
-  for (size_t i = 0; i < options.conditions.size(); ++i) {
-    for (const auto& [name, coefficient] : options.conditions[i].coefficients) {
-      const int index = problem->UnknownIndex(name);
-      if (index < 0) throw std::invalid_argument("StartOptions::conditions: \"" + name + "\" is not an unknown");
-      C(static_cast<Eigen::Index>(i), index) += coefficient;
-    }
-  }
+  const Matrix C = ConditionMatrix(*problem, options.conditions);
 
   BranchDirections out;
-  Matrix dr;
-  if (const EvaluationStatus status = problem->Evaluate(u0, nullptr, &dr); !status.ok) {
-    out.status = BranchSwitchStatus::kEvaluationFailed;
-    out.message = status.message;
-    return out;
-  }
-  Eigen::JacobiSVD<Matrix> svd(dr, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  out.singular_values = svd.singularValues();
-  const double threshold = options.switching.rank_tolerance * std::max(1.0, out.singular_values.maxCoeff());
-  int rank = 0;
-  while (rank < out.singular_values.size() && out.singular_values(rank) > threshold) ++rank;
-  out.kernel_dimension = n - rank;
-  out.cokernel_dimension = static_cast<int>(dr.rows()) - rank;
-  out.kernel = svd.matrixV().rightCols(out.kernel_dimension);
-  out.cokernel = svd.matrixU().rightCols(out.cokernel_dimension);
+  if (!AnalyzeKernel(problem, u0, options.switching.rank_tolerance, &out)) return out;
   if (out.kernel_dimension == 1) {
     out.status = BranchSwitchStatus::kRegular;
     out.directions.push_back(CanonicalLine(out.kernel.col(0)));
     return out;
   }
-
-  // Restrict the kernel by the conditions: Φ Z with Z spanning the null space of C Φ.
-  Matrix Z = Matrix::Identity(out.kernel_dimension, out.kernel_dimension);
-  if (C.rows() > 0) {
-    const Matrix CPhi = C * out.kernel;
-    Eigen::JacobiSVD<Matrix> csvd(CPhi, Eigen::ComputeFullV);
-    const double cmax = std::max(1.0, csvd.singularValues().size() ? csvd.singularValues().maxCoeff() : 0.0);
-    int crank = 0;
-    while (crank < csvd.singularValues().size() && csvd.singularValues()(crank) > options.switching.rank_tolerance * cmax) {
-      ++crank;
-    }
-    Z = csvd.matrixV().rightCols(out.kernel_dimension - crank);
-  }
-  const Matrix basis = out.kernel * Z;
+  const Matrix basis = out.kernel * RestrictedKernel(C, out.kernel, options.switching.rank_tolerance);
   if (basis.cols() == 0) {
     out.status = BranchSwitchStatus::kNoRoots;
     out.message = "the linear conditions exclude every kernel direction";
@@ -193,36 +242,7 @@ BranchDirections AnalyzeSingularPoint(ZeroProblem* problem, const Vector& u0, co
     out.status = BranchSwitchStatus::kEvaluationFailed;
     return out;
   }
-  // The dominant form gives the candidate roots; the others must vanish there too.
-  size_t dominant = 0;
-  for (size_t j = 1; j < forms.size(); ++j) {
-    if (forms[j].norm() > forms[dominant].norm()) dominant = j;
-  }
-  std::vector<Eigen::Vector2d> roots;
-  const Roots kind = QuadraticRoots(forms[dominant], options.switching.degeneracy_tolerance, &roots);
-  if (kind == Roots::kNone) {
-    out.status = BranchSwitchStatus::kNoRoots;
-    out.message = "the algebraic bifurcation equation has no real roots (or vanishes identically)";
-    return out;
-  }
-  // A double root is one branch line: with a 2-dim kernel a degenerate (non-simple) point, after
-  // restriction by conditions the usual case (the other branches lie outside the restricted plane).
-  if (kind == Roots::kDouble) out.message = "double root of the algebraic bifurcation equation";
-  for (const Eigen::Vector2d& root : roots) {
-    bool common = true;
-    for (const Matrix& form : forms) {
-      if (std::abs(root.dot(form * root)) > options.switching.abe_tolerance * std::max(form.norm(), 1e-300) &&
-          form.norm() > options.switching.abe_tolerance * forms[dominant].norm()) {
-        common = false;
-      }
-    }
-    if (common) out.directions.push_back(CanonicalLine(basis * root));
-  }
-  out.status = out.directions.empty() ? BranchSwitchStatus::kNoRoots : BranchSwitchStatus::kOk;
-  if (out.directions.empty()) out.message = "the roots of the dominant form do not solve the other forms";
-  if (out.directions.size() == 2 && std::abs(out.directions[0].dot(out.directions[1])) > 1 - 1e-12) {
-    out.directions.pop_back();
-  }
+  CommonRoots(forms, basis, options.switching, &out);
   return out;
 }
 
