@@ -17,6 +17,10 @@
 // tangent, in both directions ±v (d of eq. (IVP)). k > 2: linear conditions C v = 0 restrict the kernel
 // (e.g. t2 = t1 + t3 as {{"t2", 1}, {"t1", −1}, {"t3", −1}}); the roots of the dominant restricted form
 // that make all forms vanish are the branches.
+// Second derivatives: the differences with step ε must be confirmed by those with ε/10 (agreement to 1 %);
+// where they are not, or an evaluation fails, ε shrinks tenfold (down to 1e-6 fd_step) and the report
+// says which step served. A badly conditioned map (single shooting through an orbit with multipliers
+// ~1e7, docs/design/state-based.md) is far from quadratic over 1e-4 and needs it.
 // Contract: directions are lines (unit, largest-magnitude component positive); a double root is one
 // line; a degenerate ABE gives the kernel direction orthogonal to the incoming tangent (kFallback). At an
 // SB point found on a branch the kernel is taken to be 2-dimensional. Design decisions:
@@ -44,8 +48,8 @@ struct BranchSwitchOptions {
   // Singular values below this · max(1, σ_max) count as zero: separates a located SB point's σ_min from
   // the genuinely nonzero singular values of O(1) problems.
   double rank_tolerance = 1e-8;
-  // ε of the central differences: balances truncation O(ε²) against rounding and integrator noise in
-  // dr, which enter as O(δ/ε).
+  // The first ε of the central differences (see "Second derivatives" above): balances truncation O(ε²)
+  // against rounding and integrator noise in dr, which enter as O(δ/ε).
   double fd_step = 1e-4;
   // A discriminant below this times (a² + b² + c²) means a double root: the ABE does not separate two
   // branches (degenerate; not a simple bifurcation).

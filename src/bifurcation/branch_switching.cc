@@ -15,9 +15,16 @@
 namespace hybridcont {
 namespace {
 
-// Forms (A_j)_pq = ψ_jᵀ d²r[φ_p, φ_q] by central differences of dr along each φ_q, symmetrized.
-bool QuadraticForms(ZeroProblem* problem, const Vector& u, const Matrix& kernel, const Matrix& cokernel,
-                    double eps, std::vector<Matrix>* forms, std::string* message) {
+std::string FormatNumber(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+// Forms (A_j)_pq = ψ_jᵀ d²r[φ_p, φ_q] by central differences of dr along each φ_q with step eps,
+// symmetrized. False (and *message) where an evaluation at u ± eps·φ_q fails.
+bool DifferencedForms(ZeroProblem* problem, const Vector& u, const Matrix& kernel, const Matrix& cokernel,
+                      double eps, std::vector<Matrix>* forms, std::string* message) {
   const Eigen::Index k = kernel.cols(), m = cokernel.cols();
   forms->assign(m, Matrix::Zero(k, k));
   Matrix dr_plus, dr_minus;
@@ -25,7 +32,7 @@ bool QuadraticForms(ZeroProblem* problem, const Vector& u, const Matrix& kernel,
     const EvaluationStatus plus = problem->Evaluate(u + eps * kernel.col(q), nullptr, &dr_plus);
     const EvaluationStatus minus = problem->Evaluate(u - eps * kernel.col(q), nullptr, &dr_minus);
     if (!plus.ok || !minus.ok) {
-      *message = "finite-difference evaluation failed: " + plus.message + minus.message;
+      *message = plus.ok ? minus.message : plus.message;
       return false;
     }
     const Matrix second = cokernel.transpose() * ((dr_plus - dr_minus) / (2 * eps)) * kernel;  // m x k: [j, p]
@@ -33,6 +40,59 @@ bool QuadraticForms(ZeroProblem* problem, const Vector& u, const Matrix& kernel,
   }
   for (Matrix& form : *forms) form = 0.5 * (form + form.transpose()).eval();
   return true;
+}
+
+// ||a - b|| / max(||a||, ||b||) over all forms (Frobenius).
+double FormsDistance(const std::vector<Matrix>& a, const std::vector<Matrix>& b) {
+  double difference = 0, size = 0;
+  for (size_t j = 0; j < a.size(); ++j) {
+    difference += (a[j] - b[j]).squaredNorm();
+    size += std::max(a[j].squaredNorm(), b[j].squaredNorm());
+  }
+  return size > 0 ? std::sqrt(difference / size) : 0.0;
+}
+
+// The forms by differences with step eps, confirmed by the differences with step eps/10 (branch_switching.h,
+// "Second derivatives"). Where the two disagree by more than kFormAgreement, or an evaluation fails, the
+// step shrinks tenfold, down to eps·kMinStepFactor. The forms of the coarsest confirmed step are kept
+// (less rounding noise than the finer one), so a problem confirmed at once gets exactly the forms of eps.
+// *message notes a shrunken step; false with the history where no step is confirmed.
+bool QuadraticForms(ZeroProblem* problem, const Vector& u, const Matrix& kernel, const Matrix& cokernel,
+                    double eps, std::vector<Matrix>* forms, std::string* message) {
+  // 1 %: far above the agreement of a quadratic-enough map (truncation O(eps^2) plus integration noise
+  // over eps, ~1e-5 relative at eps = 1e-5) and far below what steers a switch to the wrong branch.
+  constexpr double kFormAgreement = 1e-2;
+  // Six decades: below ~1e-10 integration noise in dr (~1e-10 relative) outweighs any second derivative.
+  constexpr double kMinStepFactor = 1e-6;
+  std::vector<Matrix> coarse, fine;
+  std::string why;
+  bool have_coarse = DifferencedForms(problem, u, kernel, cokernel, eps, &coarse, &why);
+  std::ostringstream history;
+  for (double step = eps; step / 10 >= eps * kMinStepFactor; step /= 10) {
+    std::string fine_why;
+    const bool have_fine = DifferencedForms(problem, u, kernel, cokernel, step / 10, &fine, &fine_why);
+    const double distance = have_coarse && have_fine ? FormsDistance(coarse, fine) : -1;
+    if (distance >= 0 && distance <= kFormAgreement) {
+      *forms = std::move(coarse);
+      if (step != eps) {
+        *message = "second derivatives by differences with step " + FormatNumber(step) + " (" + history.str() +
+                   "the map is far from quadratic over larger steps)";
+      }
+      return true;
+    }
+    history << "step " << FormatNumber(step) << ": "
+            << (!have_coarse ? why
+                : !have_fine ? "the step ten times smaller failed: " + fine_why
+                             : "differs from the step ten times smaller by " + FormatNumber(distance))
+            << "; ";
+    coarse = std::move(fine);
+    have_coarse = have_fine;
+    why = fine_why;
+  }
+  *message = "finite-difference evaluation failed: no step from " + FormatNumber(eps) + " down to " +
+             FormatNumber(eps * kMinStepFactor) + " gives second derivatives that the step ten times smaller confirms (" +
+             history.str() + "end)";
+  return false;
 }
 
 constexpr internal::EnumName<BranchSwitchStatus> kBranchSwitchStatusNames[] = {
