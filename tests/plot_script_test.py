@@ -240,3 +240,19 @@ def test_key_frame_shapes_follow_the_phase_drawing(plot, results):
     assert body[1] - foot[1] == pytest.approx(1.0, abs=1e-9)
     # a phase without a drawing draws nothing
     assert drawing.shapes((t, seg, "swing", points), "blue") == []
+
+
+@pytest.mark.parametrize("damage, message", [
+    (lambda folder: os.remove(folder / "branch-1.csv"), "branch-1.csv, which is missing"),
+    (lambda folder: open(folder / "branch-0.csv", "a").write("garbage,,,x\n"), "branch-0.csv:14: 4 cells"),
+    (lambda folder: os.remove(folder / "orbit-0.csv"), "orbit-0.csv, which is missing"),
+    (lambda folder: open(folder / "summary.json", "w").write("[" * 100000), "nested too deeply"),
+])
+def test_damaged_folder_exits_2_before_drawing(plot, results, capsys, damage, message):
+    damage(results)
+    code = plot.main([str(results)])
+    out, err = capsys.readouterr()
+    assert code == 2, err
+    assert out == ""
+    assert message in err and "Traceback" not in err, err
+    assert not list(results.glob("*.png")), "figures drawn from a damaged folder"
