@@ -62,6 +62,175 @@ double Finite(double value, const SetupValue& v) {
   return value;
 }
 
+// Symbols of an orbit's expressions (quantities and family rules): the unknowns of the time-based layout
+// (inputs 0..n-1), the period T (input n), the quantities declared so far when `with_quantities`, then
+// the global symbols.
+class OrbitSymbols {
+ public:
+  OrbitSymbols(const ShootingLayout& layout, GlobalSymbols& global)
+      : unknowns_(layout.unknown_names()), num_unknowns_(layout.num_unknowns()), global_(global) {}
+
+  ExprPtr operator()(const std::string& s, bool with_quantities) {
+    if (const auto it = std::find(unknowns_.begin(), unknowns_.end(), s); it != unknowns_.end()) {
+      return MakeInput(static_cast<int>(it - unknowns_.begin()));
+    }
+    if (s == "T") return MakeInput(num_unknowns_);
+    if (with_quantities) {
+      if (const auto it = quantities_.find(s); it != quantities_.end()) return it->second;
+    }
+    return global_(s);
+  }
+  void AddQuantity(const std::string& name, const ExprPtr& e) { quantities_[name] = e; }
+
+ private:
+  const std::vector<std::string>& unknowns_;
+  const int num_unknowns_;
+  GlobalSymbols& global_;
+  std::map<std::string, ExprPtr> quantities_;
+};
+
+// The orbit program: one output per quantity (which may not name other quantities), then one per family
+// rule (which may); inputs u, then T. Fills the quantities' and the families' names in the same order.
+ExpressionProgram CompileOrbitProgram(const ModelSetup& setup, const ShootingLayout& layout, GlobalSymbols& global,
+                                      std::vector<std::string>* quantity_names,
+                                      std::vector<std::string>* family_names) {
+  OrbitSymbols symbols(layout, global);
+  std::vector<ExprPtr> outputs;
+  std::vector<SourceLocation> where;
+  for (const QuantitySpec& q : setup.quantities) {
+    const SetupValue v = Located(q.expression, "quantities." + q.name);
+    const ExprPtr e = ParseExpression(v.expression, [&](const std::string& s) { return symbols(s, false); }, v.where);
+    symbols.AddQuantity(q.name, e);
+    quantity_names->push_back(q.name);
+    outputs.push_back(e);
+    where.push_back(v.where);
+  }
+  for (std::size_t i = 0; i < setup.families.size(); ++i) {
+    const SetupValue v = Located(setup.families[i].when, "families[" + std::to_string(i) + "].when");
+    outputs.push_back(ParseExpression(v.expression, [&](const std::string& s) { return symbols(s, true); }, v.where));
+    where.push_back(v.where);
+    family_names->push_back(setup.families[i].name);
+  }
+  return ExpressionProgram(outputs, layout.num_unknowns() + 1, false, where);
+}
+
+// A compiled phase drawing, field by field as OrbitPresentation::CompiledDrawing holds it.
+struct DrawingParts {
+  int phase = -1;
+  std::vector<int> segments;
+  ExpressionProgram program;
+  std::vector<int> columns;
+};
+
+// The index of the phase a drawing names; throws naming `field` when the model has no such phase.
+int DrawnPhase(const HybridModel& model, const DrawingSpec::PhaseDrawing& pd, const std::string& field) {
+  int phase = -1;
+  for (int i = 0; i < model.num_phases(); ++i) {
+    if (model.phase(i).name() == pd.phase) phase = i;
+  }
+  if (phase < 0) throw ModelInputError(SourceLocation{"", 0, field}, "'" + pd.phase + "' is not a phase of the model");
+  return phase;
+}
+
+// The drawing's segments, 1-based in the file and 0-based here; each must be a segment of its phase.
+std::vector<int> DrawnSegments(const DrawingSpec::PhaseDrawing& pd, int m, int phase, const std::string& field) {
+  std::vector<int> segments;
+  for (int s : pd.segments) {
+    if (s < 1 || s > m + 1 || (s - 1) % m != phase) {
+      throw ModelInputError(SourceLocation{"", 0, field + ".segments"},
+                            "segment " + std::to_string(s) + " is not a segment of phase '" + pd.phase + "'");
+    }
+    segments.push_back(s - 1);
+  }
+  return segments;
+}
+
+// The drawing's outputs (x_velocity, then x and y of each point) over its phase's states (inputs
+// 0..dim-1) and X (input dim). Adds new point names to `point_names` and the column of each point to
+// `columns`; returns the drawing's own point names, in order (a name declared twice throws).
+std::vector<std::string> ParseDrawingOutputs(const HybridModel& model, const DrawingSpec::PhaseDrawing& pd, int phase,
+                                             const std::string& field, GlobalSymbols& global,
+                                             std::vector<ExprPtr>* outputs, std::vector<SourceLocation>* where,
+                                             std::vector<int>* columns, std::vector<std::string>* point_names) {
+  const std::vector<std::string>& states = model.phase(phase).state_names();
+  const int dim = static_cast<int>(states.size());
+  const auto symbol = [&](const std::string& s) -> ExprPtr {
+    if (const auto it = std::find(states.begin(), states.end(), s); it != states.end()) {
+      return MakeInput(static_cast<int>(it - states.begin()));
+    }
+    if (s == "X") return MakeInput(dim);
+    return global(s);
+  };
+  const auto parse = [&](const SetupValue& value, const std::string& f) {
+    const SetupValue v = Located(value, f);
+    where->push_back(v.where);
+    return ParseExpression(v.expression, symbol, v.where);
+  };
+  outputs->push_back(parse(pd.x_velocity, field + ".x_velocity"));
+  std::vector<std::string> names;
+  for (const DrawingSpec::Point& point : pd.points) {
+    const std::string pf = field + ".points." + point.name;
+    if (std::find(names.begin(), names.end(), point.name) != names.end()) {
+      throw ModelInputError(SourceLocation{"", 0, pf}, "point '" + point.name + "' is declared twice");
+    }
+    names.push_back(point.name);
+    outputs->push_back(parse(point.x, pf + "[0]"));
+    outputs->push_back(parse(point.y, pf + "[1]"));
+    const auto it = std::find(point_names->begin(), point_names->end(), point.name);
+    columns->push_back(static_cast<int>(it - point_names->begin()));
+    if (it == point_names->end()) point_names->push_back(point.name);
+  }
+  return names;
+}
+
+// Every line and mass of the drawing names one of its points.
+void CheckLinesAndMasses(const DrawingSpec::PhaseDrawing& pd, const std::vector<std::string>& names,
+                         const std::string& field) {
+  const auto check_point = [&](const std::string& name, const std::string& f) {
+    if (std::find(names.begin(), names.end(), name) == names.end()) {
+      throw ModelInputError(SourceLocation{"", 0, f}, "'" + name + "' is not a point of " + field);
+    }
+  };
+  for (std::size_t i = 0; i < pd.lines.size(); ++i) {
+    for (const std::string& name : pd.lines[i]) check_point(name, field + ".lines[" + std::to_string(i) + "]");
+  }
+  for (const std::string& name : pd.masses) check_point(name, field + ".masses");
+}
+
+// Drawings of one phase for different segments must look alike: the results name lines and masses per
+// phase. Compares pd with the drawings declared before it.
+void CheckAlikeDrawings(const DrawingSpec& drawing, const DrawingSpec::PhaseDrawing& pd,
+                        const std::vector<std::string>& names, const std::string& field) {
+  for (const DrawingSpec::PhaseDrawing& other : drawing.phases) {
+    if (&other == &pd) break;
+    if (other.phase != pd.phase) continue;
+    std::vector<std::string> other_names;
+    for (const DrawingSpec::Point& point : other.points) other_names.push_back(point.name);
+    if (other_names != names || other.lines != pd.lines || other.masses != pd.masses) {
+      throw ModelInputError(SourceLocation{"", 0, field},
+                            "two drawings of phase '" + pd.phase + "' with different points, lines or masses");
+    }
+  }
+}
+
+// One phase drawing of the model's set-up, checked and compiled; `point_names` gains its new points.
+DrawingParts CompileDrawing(const HybridModel& model, const DrawingSpec::PhaseDrawing& pd, GlobalSymbols& global,
+                            std::vector<std::string>* point_names) {
+  const std::string field = "drawing." + pd.phase;
+  DrawingParts d;
+  d.phase = DrawnPhase(model, pd, field);
+  d.segments = DrawnSegments(pd, model.num_phases(), d.phase, field);
+  std::vector<ExprPtr> outputs;
+  std::vector<SourceLocation> where;
+  const std::vector<std::string> names =
+      ParseDrawingOutputs(model, pd, d.phase, field, global, &outputs, &where, &d.columns, point_names);
+  CheckLinesAndMasses(pd, names, field);
+  CheckAlikeDrawings(model.setup().drawing, pd, names, field);
+  const int dim = static_cast<int>(model.phase(d.phase).state_names().size());
+  d.program = ExpressionProgram(outputs, dim + 1, false, where);
+  return d;
+}
+
 }  // namespace
 
 double EvaluateSetupValue(const HybridModel& model, const SetupValue& value, const std::string& field) {
@@ -87,113 +256,11 @@ Vector StartPoint(const HybridModel& model) {
 }
 
 OrbitPresentation::OrbitPresentation(const HybridModel& model) : model_(&model), layout_(model) {
-  const ModelSetup& setup = model.setup();
-  const std::vector<std::string>& unknowns = layout_.unknown_names();
-  const int num_unknowns = layout_.num_unknowns();
-  std::map<std::string, ExprPtr> quantities;
   GlobalSymbols global(model);
-  // Unknowns, T, (quantities,) parameters and definitions.
-  const auto orbit_symbol = [&](const std::string& s, bool with_quantities) -> ExprPtr {
-    if (const auto it = std::find(unknowns.begin(), unknowns.end(), s); it != unknowns.end()) {
-      return MakeInput(static_cast<int>(it - unknowns.begin()));
-    }
-    if (s == "T") return MakeInput(num_unknowns);
-    if (with_quantities) {
-      if (const auto it = quantities.find(s); it != quantities.end()) return it->second;
-    }
-    return global(s);
-  };
-  std::vector<ExprPtr> outputs;
-  std::vector<SourceLocation> where;
-  for (const QuantitySpec& q : setup.quantities) {
-    const SetupValue v = Located(q.expression, "quantities." + q.name);
-    const ExprPtr e =
-        ParseExpression(v.expression, [&](const std::string& s) { return orbit_symbol(s, false); }, v.where);
-    quantities[q.name] = e;
-    quantity_names_.push_back(q.name);
-    outputs.push_back(e);
-    where.push_back(v.where);
-  }
-  for (std::size_t i = 0; i < setup.families.size(); ++i) {
-    const SetupValue v = Located(setup.families[i].when, "families[" + std::to_string(i) + "].when");
-    outputs.push_back(
-        ParseExpression(v.expression, [&](const std::string& s) { return orbit_symbol(s, true); }, v.where));
-    where.push_back(v.where);
-    family_names_.push_back(setup.families[i].name);
-  }
-  orbit_program_ = ExpressionProgram(outputs, num_unknowns + 1, false, where);
-
-  const int m = model.num_phases();
-  for (const DrawingSpec::PhaseDrawing& pd : setup.drawing.phases) {
-    const std::string field = "drawing." + pd.phase;
-    CompiledDrawing d;
-    d.phase = -1;
-    for (int i = 0; i < m; ++i) {
-      if (model.phase(i).name() == pd.phase) d.phase = i;
-    }
-    if (d.phase < 0) {
-      throw ModelInputError(SourceLocation{"", 0, field}, "'" + pd.phase + "' is not a phase of the model");
-    }
-    for (int s : pd.segments) {
-      if (s < 1 || s > m + 1 || (s - 1) % m != d.phase) {
-        throw ModelInputError(SourceLocation{"", 0, field + ".segments"},
-                              "segment " + std::to_string(s) + " is not a segment of phase '" + pd.phase + "'");
-      }
-      d.segments.push_back(s - 1);
-    }
-    const std::vector<std::string>& states = model.phase(d.phase).state_names();
-    const int dim = static_cast<int>(states.size());
-    const auto symbol = [&](const std::string& s) -> ExprPtr {
-      if (const auto it = std::find(states.begin(), states.end(), s); it != states.end()) {
-        return MakeInput(static_cast<int>(it - states.begin()));
-      }
-      if (s == "X") return MakeInput(dim);
-      return global(s);
-    };
-    const auto parse = [&](const SetupValue& value, const std::string& f) {
-      const SetupValue v = Located(value, f);
-      where.push_back(v.where);
-      return ParseExpression(v.expression, symbol, v.where);
-    };
-    outputs.clear();
-    where.clear();
-    outputs.push_back(parse(pd.x_velocity, field + ".x_velocity"));
-    std::vector<std::string> names;
-    for (const DrawingSpec::Point& point : pd.points) {
-      const std::string pf = field + ".points." + point.name;
-      if (std::find(names.begin(), names.end(), point.name) != names.end()) {
-        throw ModelInputError(SourceLocation{"", 0, pf}, "point '" + point.name + "' is declared twice");
-      }
-      names.push_back(point.name);
-      outputs.push_back(parse(point.x, pf + "[0]"));
-      outputs.push_back(parse(point.y, pf + "[1]"));
-      const auto it = std::find(point_names_.begin(), point_names_.end(), point.name);
-      d.columns.push_back(static_cast<int>(it - point_names_.begin()));
-      if (it == point_names_.end()) point_names_.push_back(point.name);
-    }
-    const auto check_point = [&](const std::string& name, const std::string& f) {
-      if (std::find(names.begin(), names.end(), name) == names.end()) {
-        throw ModelInputError(SourceLocation{"", 0, f}, "'" + name + "' is not a point of " + field);
-      }
-    };
-    for (std::size_t i = 0; i < pd.lines.size(); ++i) {
-      for (const std::string& name : pd.lines[i]) check_point(name, field + ".lines[" + std::to_string(i) + "]");
-    }
-    for (const std::string& name : pd.masses) check_point(name, field + ".masses");
-    // Drawings of one phase for different segments must look alike: the results name lines and masses
-    // per phase.
-    for (const DrawingSpec::PhaseDrawing& other : setup.drawing.phases) {
-      if (&other == &pd) break;
-      if (other.phase != pd.phase) continue;
-      std::vector<std::string> other_names;
-      for (const DrawingSpec::Point& point : other.points) other_names.push_back(point.name);
-      if (other_names != names || other.lines != pd.lines || other.masses != pd.masses) {
-        throw ModelInputError(SourceLocation{"", 0, field},
-                              "two drawings of phase '" + pd.phase + "' with different points, lines or masses");
-      }
-    }
-    d.program = ExpressionProgram(outputs, dim + 1, false, where);
-    drawings_.push_back(std::move(d));
+  orbit_program_ = CompileOrbitProgram(model.setup(), layout_, global, &quantity_names_, &family_names_);
+  for (const DrawingSpec::PhaseDrawing& pd : model.setup().drawing.phases) {
+    DrawingParts d = CompileDrawing(model, pd, global, &point_names_);
+    drawings_.push_back({d.phase, std::move(d.segments), std::move(d.program), std::move(d.columns)});
   }
 }
 
