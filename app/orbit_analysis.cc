@@ -1,0 +1,64 @@
+#include "orbit_analysis.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "hybridcont/classification.h"
+#include "hybridcont/floquet.h"
+
+namespace hybridcont::app {
+
+ReplayOptions ReplayOptionsFor(const IntegratorOptions& integrator) {
+  ReplayOptions replay_options;
+  replay_options.poincare.event.integrator.rtol = integrator.rtol;
+  replay_options.poincare.event.integrator.atol = integrator.atol;
+  return replay_options;
+}
+
+void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator, TimeBasedShooting& floquet_map,
+                  const ReplayOptions& replay_options, PointRecord* record) {
+  const Vector& u = record->u;
+  if (!ClassifyByUnknowns(model, u, ClassificationOptions{}, &record->classification)) {  // no trace needed
+    const OrbitTrace trace(model, u, integrator);
+    record->classification = ClassifyOrbit(model, u, trace, ClassificationOptions{});
+  }
+  // Floquet data first: its r + dr evaluation leaves r in the map's cache, so the residual below costs no
+  // second integration on physical points.
+  AnalyzePhysicalOrbit(model, floquet_map, replay_options, u, record);
+  Vector r;
+  const EvaluationStatus status = floquet_map.Evaluate(u, &r, nullptr);
+  record->residual = status.ok ? r.norm() : std::nan("");
+}
+
+void AnalyzePhysicalOrbit(const HybridModel& model, TimeBasedShooting& floquet_map, const ReplayOptions& replay_options,
+                          const Vector& u, PointRecord* record) {
+  const double nan = std::nan("");
+  const int nontrivial = std::max(model.phase(0).dim() - 2, 0);
+  record->extra = {{"replay_error", nan}, {"stable", nan},        {"normal", nan}, {"num_unit", nan},
+                   {"max_multiplier", nan}, {"bp_test", nan},     {"pd_test", nan}};
+  for (int j = 0; j < nontrivial; ++j) {
+    record->extra.push_back({"mu" + std::to_string(j + 1) + "_re", nan});
+    record->extra.push_back({"mu" + std::to_string(j + 1) + "_im", nan});
+  }
+  if (!record->classification.physical) return;
+  const ReplayResult replay = ReplayOrbit(model, u, replay_options);
+  record->extra[0].second = replay.error;
+  if (!replay.physical()) {
+    record->classification = {false, OrbitClass::kReplayFailed, replay.message};
+    return;
+  }
+  const FloquetResult floquet = ComputeFloquet(floquet_map, u);
+  if (!floquet.ok()) return;
+  record->extra[1].second = floquet.stable ? 1 : 0;
+  record->extra[2].second = floquet.normal ? 1 : 0;
+  record->extra[3].second = floquet.num_unit;
+  record->extra[4].second = floquet.max_modulus;
+  record->extra[kBpColumn].second = floquet.bp_test;
+  record->extra[kPdColumn].second = floquet.pd_test;
+  for (int j = 0; j < nontrivial && j < static_cast<int>(floquet.nontrivial.size()); ++j) {
+    record->extra[7 + 2 * j].second = floquet.nontrivial[j].real();
+    record->extra[8 + 2 * j].second = floquet.nontrivial[j].imag();
+  }
+}
+
+}  // namespace hybridcont::app

@@ -1,0 +1,112 @@
+#include "summary_json.h"
+
+#include <cmath>
+
+#include "model_exploration.h"
+
+namespace hybridcont::app {
+
+namespace {
+
+std::string SpecialPointTypeCode(SpecialPointType type) {
+  switch (type) {
+    case SpecialPointType::kSimpleBifurcation: return "SB";
+    case SpecialPointType::kTurningPoint: return "TP";
+    case SpecialPointType::kSingularStart: return "start";
+  }
+  return "?";
+}
+
+nlohmann::json BoundsJson(const ContinuationOptions& c) {
+  nlohmann::json bounds = nlohmann::json::array();
+  for (const auto& b : c.bounds) bounds.push_back({{"component", b.component}, {"lower", b.lower}, {"upper", b.upper}});
+  for (const auto& b : c.sum_bounds) {
+    bounds.push_back({{"sum_of", b.components}, {"lower", b.lower}, {"upper", b.upper}});
+  }
+  return bounds;
+}
+
+}  // namespace
+
+nlohmann::json OptionsJson(const RunArguments& args, const RunSetup& setup) {
+  nlohmann::json j;
+  j["formulation"] = args.formulation;
+  j["integrator"] = {{"method", ToString(setup.integrator.method)},
+                     {"rtol", setup.integrator.rtol},
+                     {"atol", setup.integrator.atol}};
+  const ContinuationOptions& c = setup.exploration.continuation;
+  j["continuation"] = {{"initial_step", c.initial_step},
+                       {"min_step", c.min_step},
+                       {"max_step", c.max_step},
+                       {"max_points", c.max_points},
+                       {"location_tolerance", c.location_tolerance}};
+  j["bounds"] = BoundsJson(c);
+  nlohmann::json targets = nlohmann::json::array();
+  for (const auto& t : c.targets) targets.push_back({{"component", t.component}, {"value", t.value}});
+  j["targets"] = targets;
+  j["max_branches"] = setup.exploration.max_branches;
+  j["max_depth"] = setup.exploration.max_depth;
+  j["threads"] = setup.exploration.threads;
+  j["use_symmetries"] = setup.exploration.use_symmetries;
+  nlohmann::json conditions = nlohmann::json::array();
+  for (const auto& sc : setup.scenario.start_conditions) conditions.push_back(sc.description);
+  j["start_conditions"] = conditions;
+  for (const auto& [name, scale] : setup.scenario.unknown_scales) j["unknown_scales"][name] = scale;
+  return j;
+}
+
+nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayout& layout) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const SpecialPoint& sp : d.special_points) {
+    const double H = sp.u.size() ? sp.u(layout.H_index()) : std::nan("");
+    const double precision_H = sp.interval_width.size() ? sp.interval_width(layout.H_index()) : std::nan("");
+    // "precision": the width of the interval that holds the point, as a distance in u (model units), like
+    // the Floquet points' (LocateFloquetPoints); state-based runs know the widths of their own unknowns
+    // only (x̄_1, ξ, H̄; NaN for the rest). "precision_arclength": the same interval along the branch in
+    // the engine's scaled arclength (SpecialPoint::precision()).
+    const double precision_u =
+        sp.interval_width.size() ? sp.interval_width.array().isNaN().select(0.0, sp.interval_width.array()).matrix().norm()
+                                 : sp.precision();
+    nlohmann::json j = {{"id", sp.id},
+                        {"type", SpecialPointTypeCode(sp.type)},
+                        {"branch", sp.branch_id},
+                        {"index", sp.index},
+                        {"H", H},
+                        {"T", sp.u.size() ? layout.Period(sp.u) : std::nan("")},
+                        {"status", ToString(sp.status)},
+                        {"precision", precision_u},
+                        {"precision_arclength", sp.precision()},
+                        {"precision_H", precision_H},
+                        {"residual", sp.residual_norm},
+                        {"component", sp.component},
+                        {"duplicate_of", sp.duplicate_of},
+                        {"message", sp.message}};
+    j["u"] = std::vector<double>(sp.u.data(), sp.u.data() + sp.u.size());
+    list.push_back(j);
+  }
+  return list;
+}
+
+nlohmann::json FloquetPointJson(int id, const std::string& type, int branch, int index, const TestFunctionRoot& root,
+                                const ShootingLayout& layout) {
+  nlohmann::json j = {{"id", id},
+                      {"type", type},
+                      {"branch", branch},
+                      {"index", index},
+                      {"H", root.u(layout.H_index())},
+                      {"T", layout.Period(root.u)},
+                      {"status", root.located ? "located" : "bracketed"},
+                      {"precision", root.precision},
+                      // the same fields as the continuation's points: the width in H is bounded by the
+                      // distance in u; an arclength, residual and component they do not have
+                      {"precision_arclength", nullptr},
+                      {"precision_H", root.precision},
+                      {"residual", nullptr},
+                      {"component", ""},
+                      {"duplicate_of", -1},
+                      {"message", root.message}};
+  j["u"] = std::vector<double>(root.u.data(), root.u.data() + root.u.size());
+  return j;
+}
+
+}  // namespace hybridcont::app
