@@ -1,0 +1,273 @@
+// The reader's common means: the walk over the top-level tables, messages with file, line and field,
+// typed access to TOML nodes, and the symbols of expressions (parameters, definitions, phase states and lets).
+#include "model_reader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace hybridcont::internal {
+
+ExpressionModelSpec Reader::Read() {
+  CheckKeys(root_, "", {"hybridcont", "name", "description", "title", "parameters", "definitions", "phases",
+                        "symmetries", "start", "run", "families", "quantities", "figures", "drawing"});
+  ReadVersion();
+  spec_.name = RequiredString(root_, "name", "");
+  if (spec_.name.empty() || spec_.name.find_first_of("/\\ \t\n") != std::string::npos) {
+    Fail(root_["name"].node(), "name", "a model name must be non-empty without spaces or slashes, got '" +
+                                           spec_.name + "'");
+  }
+  spec_.description = OptionalString(root_, "description", "", "");
+  spec_.setup.title = OptionalString(root_, "title", "", spec_.name);
+  ReadParameters();
+  ReadDefinitions();
+  ReadPhaseHeaders();
+  for (std::size_t i = 0; i < phase_tables_.size(); ++i) ReadPhaseFunctions(static_cast<int>(i));
+  ReadSymmetries();
+  ReadStart();
+  ReadRun();
+  ReadFamilies();
+  ReadQuantities();
+  for (const FamilyRule& rule : spec_.setup.families) CheckSetupValue(rule.when, OrbitSymbols());
+  ReadFigures();
+  ReadDrawing();
+  return std::move(spec_);
+}
+
+SourceLocation Reader::At(const toml::node* node, const std::string& field) const {
+  SourceLocation where;
+  where.file = file_;
+  where.field = field;
+  if (node != nullptr) where.line = static_cast<int>(node->source().begin.line);
+  return where;
+}
+
+void Reader::Fail(const toml::node* node, const std::string& field, const std::string& what) const {
+  throw ModelInputError(At(node, field), what);
+}
+
+std::string Reader::Join(const std::string& prefix, const std::string& key) {
+  return prefix.empty() ? key : prefix + "." + key;
+}
+
+std::string Reader::TypeName(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    default: return "a date or time";
+  }
+}
+
+void Reader::CheckKeys(const toml::table& table, const std::string& prefix, std::initializer_list<const char*> known) const {
+  for (auto&& [key, node] : table) {
+    const std::string k(key.str());
+    if (std::none_of(known.begin(), known.end(), [&](const char* n) { return k == n; })) {
+      std::string list;
+      for (const char* n : known) list += (list.empty() ? "" : ", ") + std::string(n);
+      Fail(&node, Join(prefix, k), "unknown field '" + k + "' (expected one of: " + list + ")");
+    }
+  }
+}
+
+const toml::table& Reader::RequiredTable(const toml::table& t, const std::string& key, const std::string& prefix) const {
+  const toml::node* n = t.get(key);
+  if (n == nullptr) Fail(&t, Join(prefix, key), "missing field '" + key + "'");
+  if (!n->is_table()) Fail(n, Join(prefix, key), "expected a table, got " + TypeName(*n));
+  return *n->as_table();
+}
+
+const toml::table* Reader::OptionalTable(const toml::table& t, const std::string& key, const std::string& prefix) const {
+  const toml::node* n = t.get(key);
+  if (n == nullptr) return nullptr;
+  if (!n->is_table()) Fail(n, Join(prefix, key), "expected a table, got " + TypeName(*n));
+  return n->as_table();
+}
+
+std::string Reader::RequiredString(const toml::table& t, const std::string& key, const std::string& prefix) const {
+  const toml::node* n = t.get(key);
+  if (n == nullptr) Fail(&t, Join(prefix, key), "missing field '" + key + "'");
+  return AsString(*n, Join(prefix, key));
+}
+
+std::string Reader::OptionalString(const toml::table& t, const std::string& key, const std::string& prefix,
+                           const std::string& fallback) const {
+  const toml::node* n = t.get(key);
+  return n == nullptr ? fallback : AsString(*n, Join(prefix, key));
+}
+
+std::string Reader::AsString(const toml::node& n, const std::string& field) const {
+  if (!n.is_string()) Fail(&n, field, "expected a string, got " + TypeName(n));
+  return std::string(n.as_string()->get());
+}
+
+double Reader::AsNumber(const toml::node& n, const std::string& field) const {
+  double v = 0.0;
+  if (n.is_integer()) v = static_cast<double>(n.as_integer()->get());
+  else if (n.is_floating_point()) v = n.as_floating_point()->get();
+  else Fail(&n, field, "expected a number, got " + TypeName(n));
+  if (!std::isfinite(v)) Fail(&n, field, "expected a finite number");
+  return v;
+}
+
+double Reader::OptionalNumber(const toml::table& t, const std::string& key, const std::string& prefix, double fallback) const {
+  const toml::node* n = t.get(key);
+  return n == nullptr ? fallback : AsNumber(*n, Join(prefix, key));
+}
+
+int Reader::OptionalInteger(const toml::table& t, const std::string& key, const std::string& prefix, int fallback, int lo,
+                    int hi) const {
+  const toml::node* n = t.get(key);
+  if (n == nullptr) return fallback;
+  if (!n->is_integer()) Fail(n, Join(prefix, key), "expected an integer, got " + TypeName(*n));
+  const std::int64_t v = n->as_integer()->get();
+  if (v < lo || v > hi) {
+    Fail(n, Join(prefix, key), std::to_string(v) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  return static_cast<int>(v);
+}
+
+bool Reader::OptionalBool(const toml::table& t, const std::string& key, const std::string& prefix, bool fallback) const {
+  const toml::node* n = t.get(key);
+  if (n == nullptr) return fallback;
+  if (!n->is_boolean()) Fail(n, Join(prefix, key), "expected true or false, got " + TypeName(*n));
+  return n->as_boolean()->get();
+}
+
+const toml::array& Reader::AsArray(const toml::node& n, const std::string& field) const {
+  if (!n.is_array()) Fail(&n, field, "expected an array, got " + TypeName(n));
+  return *n.as_array();
+}
+
+std::vector<std::string> Reader::StringArray(const toml::node& n, const std::string& field) const {
+  std::vector<std::string> out;
+  const toml::array& a = AsArray(n, field);
+  for (std::size_t i = 0; i < a.size(); ++i) out.push_back(AsString(*a.get(i), field + "[" + std::to_string(i) + "]"));
+  return out;
+}
+
+SetupValue Reader::AsSetupValue(const toml::node& n, const std::string& field) const {
+  if (n.is_string()) return SetupValue(std::string(n.as_string()->get()), At(&n, field));
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.17g", AsNumber(n, field));
+  return SetupValue(buffer, At(&n, field));
+}
+
+std::string Reader::ExpressionText(const toml::node& n, const std::string& field) const {
+  if (n.is_string()) return std::string(n.as_string()->get());
+  return AsSetupValue(n, field).expression;
+}
+
+ExprPtr Reader::GlobalSymbol(const std::string& name) {
+  if (auto it = parameter_index_.find(name); it != parameter_index_.end()) return MakeParameter(it->second);
+  return Definition(name);
+}
+
+ExprPtr Reader::Definition(const std::string& name) {
+  if (auto it = definitions_.find(name); it != definitions_.end()) return it->second;
+  const auto src = definition_sources_.find(name);
+  if (src == definition_sources_.end()) return nullptr;
+  if (!resolving_.insert("definitions." + name).second) {
+    Fail(src->second, "definitions." + name, "'" + name + "' is defined in terms of itself");
+  }
+  const ExprPtr e = ParseExpression(ExpressionText(*src->second, "definitions." + name),
+                                    [this](const std::string& s) { return GlobalSymbol(s); },
+                                    At(src->second, "definitions." + name));
+  if (DependsOnInputs(e)) Fail(src->second, "definitions." + name, "definitions may use parameters only");
+  resolving_.erase("definitions." + name);
+  definitions_[name] = e;
+  return e;
+}
+
+ExprPtr Reader::PhaseSymbol(int phase, const std::string& name) {
+  const std::vector<std::string>& states = spec_.phases[phase].state_names;
+  if (auto it = std::find(states.begin(), states.end(), name); it != states.end()) {
+    return MakeInput(static_cast<int>(it - states.begin()));
+  }
+  const std::string key = std::to_string(phase) + ":" + name;
+  if (auto it = lets_.find(key); it != lets_.end()) return it->second;
+  if (const toml::table* let = phase_lets_[phase]) {
+    if (const toml::node* n = let->get(name)) {
+      const std::string field = "phases." + spec_.phases[phase].name + ".let." + name;
+      if (!resolving_.insert(field).second) Fail(n, field, "'" + name + "' is defined in terms of itself");
+      const ExprPtr e = ParseExpression(ExpressionText(*n, field),
+                                        [this, phase](const std::string& s) { return PhaseSymbol(phase, s); },
+                                        At(n, field));
+      resolving_.erase(field);
+      lets_[key] = e;
+      return e;
+    }
+  }
+  return GlobalSymbol(name);
+}
+
+ExprPtr Reader::ParsePhaseExpression(int phase, const toml::node& n, const std::string& field) {
+  return ParseExpression(ExpressionText(n, field), [this, phase](const std::string& s) { return PhaseSymbol(phase, s); },
+                         At(&n, field));
+}
+
+void Reader::CheckSetupValue(const SetupValue& v, const std::vector<std::string>& extra_symbols) {
+  ParseExpression(v.expression,
+                  [&](const std::string& s) -> ExprPtr {
+                    if (std::find(extra_symbols.begin(), extra_symbols.end(), s) != extra_symbols.end()) {
+                      return MakeInput(0);
+                    }
+                    return GlobalSymbol(s);
+                  },
+                  v.where);
+}
+
+std::vector<std::string> Reader::UnknownNames() const {
+  std::vector<std::string> names;
+  const int m = static_cast<int>(spec_.phases.size());
+  for (int i = 0; i <= m; ++i) names.push_back("t" + std::to_string(i + 1));
+  for (int i = 0; i <= m; ++i) {
+    for (const std::string& s : spec_.phases[i % m].state_names) names.push_back("x" + std::to_string(i + 1) + "_" + s);
+  }
+  if (num_integrals_ <= 1) {
+    names.push_back("xi");
+  } else {
+    for (int j = 1; j <= num_integrals_; ++j) names.push_back("xi" + std::to_string(j));
+  }
+  names.push_back("H");
+  return names;
+}
+
+void Reader::CheckName(const toml::node* n, const std::string& field, const std::string& name) const {
+  static const std::set<std::string> kReserved = {"pi",   "X",    "T",    "sin",  "cos",  "tan",   "asin", "acos",
+                                                  "atan", "sinh", "cosh", "tanh", "exp",  "log",   "sqrt", "abs",
+                                                  "atan2", "pow", "min",  "max"};
+  const bool identifier = !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_') &&
+                          std::all_of(name.begin(), name.end(), [](char c) {
+                            return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+                          });
+  if (!identifier) Fail(n, field, "'" + name + "' is not a name (letters, digits, '_'; not starting with a digit)");
+  if (kReserved.count(name)) Fail(n, field, "'" + name + "' is reserved (a function or a built-in symbol)");
+}
+
+std::string Reader::JoinNames(const std::vector<std::string>& names) {
+  std::string s;
+  for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+void Reader::CheckUnknown(const toml::node* n, const std::string& field, const std::string& name, bool allow_period) const {
+  const std::vector<std::string> names = UnknownNames();
+  if (allow_period && name == "period") return;
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    Fail(n, field, "'" + name + "' is not an unknown of the model (unknowns: " + JoinNames(names) +
+                       (allow_period ? "; or 'period', the sum of all durations" : "") + ")");
+  }
+}
+
+std::vector<std::string> Reader::OrbitSymbols() const {
+  std::vector<std::string> s = UnknownNames();
+  s.push_back("T");
+  for (const QuantitySpec& q : spec_.setup.quantities) s.push_back(q.name);
+  return s;
+}
+
+}  // namespace hybridcont::internal

@@ -1,0 +1,136 @@
+// The model-file reader (private to src/modelfile): walks the parsed TOML tree of a model file, checks every
+// field against the format and builds the ExpressionModelSpec; a violation throws ModelInputError with the
+// file, line and field. Its methods are defined by section:
+//   model_reader.cc        Read (the order of the tables), messages, typed access, symbols
+//   read_setup.cc          version, parameters, definitions, start, run, families, quantities
+//   read_phases.cc         phases (headers, then the functions of each) and symmetries
+//   read_presentation.cc   figures and drawing
+//   ExpressionModelSpec spec = Reader(root, "slip.toml").Read();
+#ifndef HYBRIDCONT_SRC_MODELFILE_MODEL_READER_H_
+#define HYBRIDCONT_SRC_MODELFILE_MODEL_READER_H_
+
+#include <toml++/toml.h>
+
+#include <initializer_list>
+#include <map>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hybridcont/model_file.h"
+#include "hybridcont/shooting_layout.h"
+#include "model_compiler.h"
+
+namespace hybridcont::internal {
+
+class Reader {
+ public:
+  Reader(const toml::table& root, std::string file) : root_(root), file_(std::move(file)) {}
+
+  ExpressionModelSpec Read();
+
+ private:
+  // ---- messages
+  SourceLocation At(const toml::node* node, const std::string& field) const;
+  [[noreturn]] void Fail(const toml::node* node, const std::string& field, const std::string& what) const;
+  static std::string Join(const std::string& prefix, const std::string& key);
+  static std::string TypeName(const toml::node& n);
+
+  // Every key of `table` must be one of `known`.
+  void CheckKeys(const toml::table& table, const std::string& prefix, std::initializer_list<const char*> known) const;
+
+  // ---- typed access
+  const toml::table& RequiredTable(const toml::table& t, const std::string& key, const std::string& prefix) const;
+  const toml::table* OptionalTable(const toml::table& t, const std::string& key, const std::string& prefix) const;
+  std::string RequiredString(const toml::table& t, const std::string& key, const std::string& prefix) const;
+  std::string OptionalString(const toml::table& t, const std::string& key, const std::string& prefix,
+                             const std::string& fallback) const;
+  std::string AsString(const toml::node& n, const std::string& field) const;
+  double AsNumber(const toml::node& n, const std::string& field) const;
+  double OptionalNumber(const toml::table& t, const std::string& key, const std::string& prefix, double fallback) const;
+  int OptionalInteger(const toml::table& t, const std::string& key, const std::string& prefix, int fallback, int lo,
+                      int hi) const;
+  bool OptionalBool(const toml::table& t, const std::string& key, const std::string& prefix, bool fallback) const;
+  const toml::array& AsArray(const toml::node& n, const std::string& field) const;
+  std::vector<std::string> StringArray(const toml::node& n, const std::string& field) const;
+  // A set-up value: a number or an expression string (checked later against its symbols).
+  SetupValue AsSetupValue(const toml::node& n, const std::string& field) const;
+  // An expression string (numbers are accepted and written as constants).
+  std::string ExpressionText(const toml::node& n, const std::string& field) const;
+
+  // ---- symbols
+  // Parameters and [definitions] (definitions are expressions over parameters and other definitions).
+  ExprPtr GlobalSymbol(const std::string& name);
+  ExprPtr Definition(const std::string& name);
+  // A phase's states, its `let` quantities, then the global symbols.
+  ExprPtr PhaseSymbol(int phase, const std::string& name);
+  ExprPtr ParsePhaseExpression(int phase, const toml::node& n, const std::string& field);
+  // Checks a set-up value against its symbols now, so that a typo is reported before anything runs.
+  void CheckSetupValue(const SetupValue& v, const std::vector<std::string>& extra_symbols);
+  // Names of the time-based layout's unknowns: t1..t<m+1>, x<i>_<state>, xi (xi1.. for k > 1), H.
+  std::vector<std::string> UnknownNames() const;
+
+  // Checks shared by several sections.
+  // A symbol name must be an identifier that is not a function or a reserved name.
+  void CheckName(const toml::node* n, const std::string& field, const std::string& name) const;
+  // `name` must be an unknown of the time-based layout (or, with allow_period, "period").
+  void CheckUnknown(const toml::node* n, const std::string& field, const std::string& name, bool allow_period) const;
+  static std::string JoinNames(const std::vector<std::string>& names);
+  // The symbols of an orbit's columns: the unknowns, T and the quantities.
+  std::vector<std::string> OrbitSymbols() const;
+
+  // ---- sections (read_setup.cc)
+  void ReadVersion();
+  // A parameter range written as an interval: "(0, inf)", "[0, 1]".
+  ParameterRange ParseRange(const toml::node& n, const std::string& field) const;
+  void ReadParameters();
+  void ReadDefinitions();
+  void ReadStart();
+  void ReadRun();
+  void ReadFamilies();
+  void ReadQuantities();
+
+  // ---- sections (read_phases.cc)
+  void ReadPhaseHeaders();
+  // The functions of phase i: its let quantities, ode, first integrals, event, reset and (first phase) anchor.
+  void ReadPhaseFunctions(int i);
+  // The let quantities of phase i, each parsed now: errors in unused quantities are errors too.
+  void ReadLets(int i);
+  // ode: one expression per state, keyed by the state's name.
+  void ReadVectorField(int i);
+  // First integrals: `energy` (one) or `integrals` (several), as many in every phase as in the first.
+  void ReadIntegrals(int i);
+  // reset: the next phase's states by name (the next phase may have another dimension).
+  void ReadReset(int i);
+  void ReadSymmetries();
+
+  // ---- sections (read_presentation.cc)
+  void ReadFigures();
+  void ReadDrawing();
+  // The drawing of one phase: [drawing.<phase>] with x_velocity, points, lines and masses.
+  DrawingSpec::PhaseDrawing ReadPhaseDrawing(const toml::node& node, const std::string& k, int phase);
+  // A drawing value, checked against the symbols OrbitPresentation gives a drawing: the phase's states, X,
+  // parameters, definitions (not the phase's let quantities, which the run would refuse after compiling the
+  // model).
+  SetupValue DrawingValue(const toml::node& n, const std::string& f, int phase);
+  // A drawing's lines (two or more points each) and masses, each naming a point of the drawing.
+  void ReadLinesAndMasses(const toml::table& pt, const std::string& field, const std::set<std::string>& point_names,
+                          DrawingSpec::PhaseDrawing* pd) const;
+
+  const toml::table& root_;
+  std::string file_;
+  ExpressionModelSpec spec_;
+  std::map<std::string, int> parameter_index_;
+  std::map<std::string, const toml::node*> definition_sources_;
+  std::map<std::string, ExprPtr> definitions_;
+  std::map<std::string, ExprPtr> lets_;
+  std::set<std::string> resolving_;
+  std::vector<const toml::table*> phase_tables_;
+  std::vector<const toml::table*> phase_lets_;
+  int num_integrals_ = 1;
+};
+
+}  // namespace hybridcont::internal
+
+#endif  // HYBRIDCONT_SRC_MODELFILE_MODEL_READER_H_
