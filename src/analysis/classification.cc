@@ -3,25 +3,30 @@
 #include <cmath>
 #include <sstream>
 
+#include "hybridcont/internal/enum_names.h"
+
 namespace hybridcont {
 
-std::string ToString(OrbitClass c) {
-  switch (c) {
-    case OrbitClass::kPhysical: return "physical";
-    case OrbitClass::kAtRest: return "at-rest";
-    case OrbitClass::kDissipative: return "dissipative";
-    case OrbitClass::kReversedTime: return "reversed-time";
-    case OrbitClass::kZeroDuration: return "zero-duration";
-    case OrbitClass::kWrongDirection: return "wrong-direction";
-    case OrbitClass::kGrazing: return "grazing";
-    case OrbitClass::kAnchorGrazing: return "anchor-grazing";
-    case OrbitClass::kMissedEvent: return "missed-event";
-    case OrbitClass::kMissedAnchor: return "missed-anchor";
-    case OrbitClass::kIntegrationFailed: return "integration-failed";
-    case OrbitClass::kReplayFailed: return "replay-failed";
-  }
-  return "unknown";
-}
+namespace {
+
+constexpr internal::EnumName<OrbitClass> kOrbitClassNames[] = {
+    {OrbitClass::kPhysical, "physical"},
+    {OrbitClass::kAtRest, "at-rest"},
+    {OrbitClass::kDissipative, "dissipative"},
+    {OrbitClass::kReversedTime, "reversed-time"},
+    {OrbitClass::kZeroDuration, "zero-duration"},
+    {OrbitClass::kWrongDirection, "wrong-direction"},
+    {OrbitClass::kGrazing, "grazing"},
+    {OrbitClass::kAnchorGrazing, "anchor-grazing"},
+    {OrbitClass::kMissedEvent, "missed-event"},
+    {OrbitClass::kMissedAnchor, "missed-anchor"},
+    {OrbitClass::kIntegrationFailed, "integration-failed"},
+    {OrbitClass::kReplayFailed, "replay-failed"},
+};
+
+}  // namespace
+
+std::string ToString(OrbitClass c) { return internal::EnumToString(kOrbitClassNames, c); }
 
 namespace {
 

@@ -10,31 +10,32 @@
 
 #include "hybridcont/saltation.h"
 
+#include "hybridcont/internal/enum_names.h"
+#include "hybridcont/internal/options_check.h"
+
 namespace hybridcont {
 
+namespace {
+
+constexpr internal::EnumName<FloquetStatus> kFloquetStatusNames[] = {
+    {FloquetStatus::kSuccess, "success"},
+    {FloquetStatus::kEvaluationFailed, "evaluation failed"},
+    {FloquetStatus::kSaltationUndefined, "saltation matrix undefined"},
+    {FloquetStatus::kDegenerateOrbit, "degenerate orbit"},
+    {FloquetStatus::kEigenFailed, "eigenvalue computation failed"},
+};
+
+}  // namespace
+
 std::string FloquetOptions::Validate() const {
-  std::ostringstream os;
-  auto positive = [&](const char* field, double v) {
-    if (os.tellp() == 0 && (!(v > 0.0) || !std::isfinite(v))) {
-      os << "FloquetOptions::" << field << " = " << v << " must be finite and > 0";
-    }
-  };
-  positive("unit_tolerance", unit_tolerance);
-  positive("circle_tolerance", circle_tolerance);
-  positive("min_transversality", min_transversality);
-  return os.str();
+  return internal::OptionsCheck("FloquetOptions")
+      .Positive("unit_tolerance", unit_tolerance)
+      .Positive("circle_tolerance", circle_tolerance)
+      .Positive("min_transversality", min_transversality)
+      .message();
 }
 
-std::string ToString(FloquetStatus status) {
-  switch (status) {
-    case FloquetStatus::kSuccess: return "success";
-    case FloquetStatus::kEvaluationFailed: return "evaluation failed";
-    case FloquetStatus::kSaltationUndefined: return "saltation matrix undefined";
-    case FloquetStatus::kDegenerateOrbit: return "degenerate orbit";
-    case FloquetStatus::kEigenFailed: return "eigenvalue computation failed";
-  }
-  return "unknown";
-}
+std::string ToString(FloquetStatus status) { return internal::EnumToString(kFloquetStatusNames, status); }
 
 std::string FloquetResult::BriefReport() const {
   std::ostringstream os;

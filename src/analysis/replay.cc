@@ -6,30 +6,31 @@
 
 #include "hybridcont/shooting_layout.h"
 
+#include "hybridcont/internal/enum_names.h"
+#include "hybridcont/internal/options_check.h"
+
 namespace hybridcont {
 
+namespace {
+
+constexpr internal::EnumName<ReplayStatus> kReplayStatusNames[] = {
+    {ReplayStatus::kReturned, "returned"},
+    {ReplayStatus::kNotClosed, "not closed"},
+    {ReplayStatus::kEventFailed, "event failed"},
+};
+
+}  // namespace
+
 std::string ReplayOptions::Validate() const {
-  if (std::string why = poincare.Validate(); !why.empty()) return "ReplayOptions::poincare: " + why;
-  if (poincare.section != PoincareSection::kAnchor) {
-    return "ReplayOptions::poincare.section = " + ToString(poincare.section) +
-           " must be 'anchor' (a time-based orbit ends at the anchor)";
-  }
-  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) {
-    std::ostringstream os;
-    os << "ReplayOptions::tolerance = " << tolerance << " must be finite and > 0";
-    return os.str();
-  }
-  return "";
+  return internal::OptionsCheck("ReplayOptions")
+      .Nested("poincare", poincare.Validate())
+      .Require(poincare.section == PoincareSection::kAnchor, "poincare.section", ToString(poincare.section),
+               "must be 'anchor' (a time-based orbit ends at the anchor)")
+      .Positive("tolerance", tolerance)
+      .message();
 }
 
-std::string ToString(ReplayStatus status) {
-  switch (status) {
-    case ReplayStatus::kReturned: return "returned";
-    case ReplayStatus::kNotClosed: return "not closed";
-    case ReplayStatus::kEventFailed: return "event failed";
-  }
-  return "unknown";
-}
+std::string ToString(ReplayStatus status) { return internal::EnumToString(kReplayStatusNames, status); }
 
 std::string ReplayResult::BriefReport() const {
   std::ostringstream os;

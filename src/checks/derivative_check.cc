@@ -10,16 +10,17 @@
 
 #include "hybridcont/timebased_shooting.h"
 
+#include "hybridcont/internal/options_check.h"
+
 namespace hybridcont {
 
 std::string DerivativeCheckOptions::Validate() const {
-  std::ostringstream os;
-  if (num_points < 1) os << "DerivativeCheckOptions::num_points = " << num_points << " must be >= 1";
-  else if (!(model_step > 0.0)) os << "DerivativeCheckOptions::model_step = " << model_step << " must be > 0";
-  else if (!(flow_step > 0.0)) os << "DerivativeCheckOptions::flow_step = " << flow_step << " must be > 0";
-  else if (!(max_duration >= 0.0)) os << "DerivativeCheckOptions::max_duration = " << max_duration << " must be >= 0";
-  else return integrator.Validate();
-  return os.str();
+  const internal::OptionsCheck check = internal::OptionsCheck("DerivativeCheckOptions")
+                                            .AtLeast("num_points", num_points, 1)
+                                            .Require(model_step > 0.0, "model_step", model_step, "must be > 0")
+                                            .Require(flow_step > 0.0, "flow_step", flow_step, "must be > 0")
+                                            .Require(max_duration >= 0.0, "max_duration", max_duration, "must be >= 0");
+  return check.failed() ? check.message() : integrator.Validate();
 }
 
 bool DerivativeCheckReport::passed() const {

@@ -12,39 +12,38 @@
 
 #include "integration/augmented_rhs.h"
 
+#include "hybridcont/internal/enum_names.h"
+#include "hybridcont/internal/options_check.h"
+
 namespace hybridcont {
+
+namespace {
+
+constexpr internal::EnumName<EventFlowStatus> kEventFlowStatusNames[] = {
+    {EventFlowStatus::kEventReached, "event reached"},
+    {EventFlowStatus::kGrazing, "grazing"},
+    {EventFlowStatus::kZeroDuration, "zero-duration phase"},
+    {EventFlowStatus::kGuardNotReached, "guard not reached"},
+    {EventFlowStatus::kNonFinite, "non-finite value"},
+    {EventFlowStatus::kStepTooSmall, "step size too small"},
+    {EventFlowStatus::kMaxSteps, "maximum number of steps"},
+};
+
+}  // namespace
 
 namespace odeint = boost::numeric::odeint;
 
-std::string ToString(EventFlowStatus status) {
-  switch (status) {
-    case EventFlowStatus::kEventReached: return "event reached";
-    case EventFlowStatus::kGrazing: return "grazing";
-    case EventFlowStatus::kZeroDuration: return "zero-duration phase";
-    case EventFlowStatus::kGuardNotReached: return "guard not reached";
-    case EventFlowStatus::kNonFinite: return "non-finite value";
-    case EventFlowStatus::kStepTooSmall: return "step size too small";
-    case EventFlowStatus::kMaxSteps: return "maximum number of steps";
-  }
-  return "unknown";
-}
+std::string ToString(EventFlowStatus status) { return internal::EnumToString(kEventFlowStatusNames, status); }
 
 std::string EventFlowOptions::Validate() const {
-  if (std::string why = integrator.Validate(); !why.empty()) return "EventFlowOptions::integrator: " + why;
-  std::ostringstream os;
-  auto positive = [&](const char* field, double v) {
-    if (os.tellp() == 0 && (!(v > 0.0) || !std::isfinite(v))) {
-      os << "EventFlowOptions::" << field << " = " << v << " must be finite and > 0";
-    }
-  };
-  positive("max_duration", max_duration);
-  positive("grazing_tolerance", grazing_tolerance);
-  positive("touch_tolerance", touch_tolerance);
-  positive("start_tolerance", start_tolerance);
-  if (os.tellp() == 0 && grazing_tolerance >= 1.0) {
-    os << "EventFlowOptions::grazing_tolerance = " << grazing_tolerance << " must be < 1 (it bounds a sine)";
-  }
-  return os.str();
+  return internal::OptionsCheck("EventFlowOptions")
+      .Nested("integrator", integrator.Validate())
+      .Positive("max_duration", max_duration)
+      .Positive("grazing_tolerance", grazing_tolerance)
+      .Positive("touch_tolerance", touch_tolerance)
+      .Positive("start_tolerance", start_tolerance)
+      .Require(grazing_tolerance < 1.0, "grazing_tolerance", grazing_tolerance, "must be < 1 (it bounds a sine)")
+      .message();
 }
 
 std::string EventFlowResult::BriefReport() const {

@@ -3,35 +3,32 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "hybridcont/internal/enum_names.h"
+
 namespace hybridcont {
 
-std::string ToString(PoincareSection section) {
-  switch (section) {
-    case PoincareSection::kAnchor: return "anchor";
-    case PoincareSection::kLastEvent: return "last-event";
-  }
-  return "unknown";
-}
+namespace {
+
+constexpr internal::EnumName<PoincareSection> kPoincareSectionNames[] = {
+    {PoincareSection::kAnchor, "anchor"},
+    {PoincareSection::kLastEvent, "last-event"},
+};
+
+constexpr internal::EnumName<PoincareStatus> kPoincareStatusNames[] = {
+    {PoincareStatus::kSuccess, "success"},
+    {PoincareStatus::kEventFailed, "event failed"},
+    {PoincareStatus::kNonFinite, "non-finite value"},
+};
+
+}  // namespace
+
+std::string ToString(PoincareSection section) { return internal::EnumToString(kPoincareSectionNames, section); }
 
 bool FromString(const std::string& name, PoincareSection* section) {
-  if (name == "anchor") {
-    *section = PoincareSection::kAnchor;
-  } else if (name == "last-event") {
-    *section = PoincareSection::kLastEvent;
-  } else {
-    return false;
-  }
-  return true;
+  return internal::EnumFromString(kPoincareSectionNames, name, section);
 }
 
-std::string ToString(PoincareStatus status) {
-  switch (status) {
-    case PoincareStatus::kSuccess: return "success";
-    case PoincareStatus::kEventFailed: return "event failed";
-    case PoincareStatus::kNonFinite: return "non-finite value";
-  }
-  return "unknown";
-}
+std::string ToString(PoincareStatus status) { return internal::EnumToString(kPoincareStatusNames, status); }
 
 std::string PoincareResult::BriefReport() const {
   std::ostringstream os;

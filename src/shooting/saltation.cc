@@ -3,15 +3,20 @@
 #include <cmath>
 #include <limits>
 
+#include "hybridcont/internal/enum_names.h"
+
 namespace hybridcont {
 
-std::string ToString(SaltationStatus status) {
-  switch (status) {
-    case SaltationStatus::kSuccess: return "success";
-    case SaltationStatus::kDegenerate: return "degenerate (grazing: de f^- = 0)";
-  }
-  return "unknown";
-}
+namespace {
+
+constexpr internal::EnumName<SaltationStatus> kSaltationStatusNames[] = {
+    {SaltationStatus::kSuccess, "success"},
+    {SaltationStatus::kDegenerate, "degenerate (grazing: de f^- = 0)"},
+};
+
+}  // namespace
+
+std::string ToString(SaltationStatus status) { return internal::EnumToString(kSaltationStatusNames, status); }
 
 namespace {
 
