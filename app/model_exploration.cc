@@ -5,6 +5,7 @@
 
 #include "hybridcont/classification.h"
 #include "hybridcont/corrector.h"
+#include "hybridcont/internal/enum_names.h"
 
 namespace hybridcont::app {
 
@@ -22,14 +23,18 @@ ExplorationOptions ScenarioExplorationOptions(const Scenario& sc) {
   return o;
 }
 
-std::string ToString(Formulation f) { return f == Formulation::kTimeBased ? "time" : "state"; }
+namespace {
 
-bool FromString(const std::string& text, Formulation* f) {
-  if (text == "time") *f = Formulation::kTimeBased;
-  else if (text == "state") *f = Formulation::kStateBased;
-  else return false;
-  return true;
-}
+constexpr internal::EnumName<Formulation> kFormulationNames[] = {
+    {Formulation::kTimeBased, "time"},
+    {Formulation::kStateBased, "state"},
+};
+
+}  // namespace
+
+std::string ToString(Formulation f) { return internal::EnumToString(kFormulationNames, f); }
+
+bool FromString(const std::string& text, Formulation* f) { return internal::EnumFromString(kFormulationNames, text, f); }
 
 ModelExploration::ModelExploration(const HybridModel& model, const Scenario& scenario,
                                    const IntegratorOptions& integrator, ExplorationOptions options,
