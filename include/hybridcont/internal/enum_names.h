@@ -47,17 +47,6 @@ bool EnumFromString(const EnumName<E> (&table)[N], std::string_view text, E* val
   return false;
 }
 
-// The names of the table joined by ", " (for messages listing the accepted values).
-template <class E, std::size_t N>
-std::string EnumNamesList(const EnumName<E> (&table)[N]) {
-  std::string list;
-  for (const EnumName<E>& row : table) {
-    if (!list.empty()) list += ", ";
-    list += row.name;
-  }
-  return list;
-}
-
 }  // namespace hybridcont::internal
 
 #endif  // HYBRIDCONT_INTERNAL_ENUM_NAMES_H_
