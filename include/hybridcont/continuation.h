@@ -146,8 +146,8 @@ struct ContinuationOptions {
   // Detect (and locate) simple bifurcation points by the sign of det([dr; τᵀ]).
   bool detect_bifurcations = true;
   // Components whose turning points (sign changes of τ_k) are detected and located. Empty means the
-  // unknown named "H" (the level of a first integral, the family parameter of conservative problems)
-  // when the problem has one, and none otherwise.
+  // problem's family parameter (ZeroProblem::family_parameter: "H", the level of a first integral, or
+  // the free model parameter at fixed H̄), and none when it has none.
   std::vector<std::string> turning_point_components;
   // Width of the final root-finder bracket (in arclength) at which a special point counts as located.
   // 1e-11 makes located components exact to ~1e-11 (turning-point values to ~1e-20) when the

@@ -123,6 +123,10 @@ class ExpressionProgram {
   // out[i] = output i at (x, p). x has num_inputs() entries, out num_outputs().
   template <class T>
   void Evaluate(const T* x, const double* p, T* out) const;
+  // The same with the parameters as values of the scalar type (derivatives with respect to a parameter);
+  // always interpreted.
+  template <class T>
+  void EvaluateWithParameterJets(const T* x, const T* p, T* out) const;
   // One output in double precision (for set-up values and presentation rules).
   double EvaluateScalar(const double* x, const double* p, int output = 0) const;
 
@@ -274,6 +278,68 @@ void ExpressionProgram::Evaluate(const T* x, const double* p, T* out) const {
   for (int i = 0; i < num_outputs(); ++i) {
     const Operand& o = outputs_[i];
     out[i] = o.kind == 'r' ? r[o.index] : T(c[o.index]);
+  }
+}
+
+namespace internal {
+// The double inside a (possibly nested) jet.
+template <class T>
+double PlainValue(const T& v) {
+  if constexpr (std::is_same_v<T, double>) {
+    return v;
+  } else if constexpr (requires { v.value(); }) {
+    return PlainValue(v.value());  // AutoDiffScalar
+  } else {
+    return v.value;  // HessianJet
+  }
+}
+}  // namespace internal
+
+template <class T>
+void ExpressionProgram::EvaluateWithParameterJets(const T* x, const T* p, T* out) const {
+  // Differentiable programs have no comparisons, logic, min or max (see the constructor), so the
+  // parameter-only code runs over T with the operations of Evaluate's double registers. An exponent that is
+  // a literal (no parameter in it) stays a double, so that x^2 and (-g)^3 are the exact products Evaluate
+  // forms, not exp(n log x).
+  thread_local std::vector<T> c;
+  thread_local std::vector<T> r;
+  thread_local std::vector<char> literal;
+  if (static_cast<int>(c.size()) < num_c_) c.resize(num_c_);
+  if (static_cast<int>(literal.size()) < num_c_) literal.resize(num_c_);
+  if (static_cast<int>(r.size()) < num_r_) r.resize(num_r_);
+  const auto binary = [&](const Instruction& in, const T& a, const T& b, bool b_literal) {
+    if (b_literal) return internal::ApplyBinary<T>(in.op, a, internal::PlainValue(b));
+    return internal::ApplyBinary<T>(in.op, a, b);
+  };
+  for (const Instruction& in : constant_code_) {
+    if (in.op == ExprOp::kParameter) {
+      c[in.dst] = p[in.a.index];
+      literal[in.dst] = false;
+    } else if (in.op == ExprOp::kConstant) {
+      c[in.dst] = T(in.value);
+      literal[in.dst] = true;
+    } else if (in.b.index >= 0) {
+      c[in.dst] = binary(in, c[in.a.index], c[in.b.index], literal[in.b.index]);
+      literal[in.dst] = literal[in.a.index] && literal[in.b.index];
+    } else {
+      c[in.dst] = internal::ApplyUnary(in.op, c[in.a.index]);
+      literal[in.dst] = literal[in.a.index];
+    }
+  }
+  for (const Instruction& in : code_) {
+    switch (in.op) {
+      case ExprOp::kInput: r[in.dst] = x[in.a.index]; break;
+      case ExprOp::kAdd: case ExprOp::kSub: case ExprOp::kMul: case ExprOp::kDiv: case ExprOp::kPow:
+      case ExprOp::kAtan2:
+        r[in.dst] = binary(in, in.a.kind == 'r' ? r[in.a.index] : c[in.a.index],
+                           in.b.kind == 'r' ? r[in.b.index] : c[in.b.index], in.b.kind == 'c' && literal[in.b.index]);
+        break;
+      default: r[in.dst] = internal::ApplyUnary(in.op, r[in.a.index]); break;
+    }
+  }
+  for (int i = 0; i < num_outputs(); ++i) {
+    const Operand& o = outputs_[i];
+    out[i] = o.kind == 'r' ? r[o.index] : c[o.index];
   }
 }
 

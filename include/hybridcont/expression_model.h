@@ -99,36 +99,59 @@ struct ExpressionPhaseData {
   }
 };
 
-// The functor AutoDiffPhase instantiates (model.h's interface, with the data as its "parameters").
+// A phase's data with the parameters as jets S (derivatives with respect to one parameter): the same
+// programs, interpreted over S.
+template <class S>
+struct ExpressionJetData {
+  const ExpressionPhaseData* base = nullptr;
+  std::vector<S> parameters;
+  void Run(ProgramKind kind, const S* x, S* out) const {
+    base->programs[static_cast<int>(kind)]->EvaluateWithParameterJets(x, parameters.data(), out);
+  }
+};
+
+// The functor AutoDiffPhase instantiates (model.h's interface, with the data as its "parameters"):
+// D is ExpressionPhaseData, or ExpressionJetData for derivatives in a parameter.
 struct ExpressionFunctions {
-  template <class T>
-  static StateVector<T> VectorField(const StateVector<T>& x, const ExpressionPhaseData& d) {
+  template <class T, class D>
+  static StateVector<T> VectorField(const StateVector<T>& x, const D& d) {
     return Outputs(ProgramKind::kVectorField, x, d);
   }
-  template <class T>
-  static StateVector<T> FirstIntegrals(const StateVector<T>& x, const ExpressionPhaseData& d) {
+  template <class T, class D>
+  static StateVector<T> FirstIntegrals(const StateVector<T>& x, const D& d) {
     return Outputs(ProgramKind::kIntegrals, x, d);
   }
-  template <class T>
-  static T Event(const StateVector<T>& x, const ExpressionPhaseData& d) {
+  template <class T, class D>
+  static T Event(const StateVector<T>& x, const D& d) {
     return Outputs(ProgramKind::kEvent, x, d)(0);
   }
-  template <class T>
-  static StateVector<T> Reset(const StateVector<T>& x, const ExpressionPhaseData& d) {
+  template <class T, class D>
+  static StateVector<T> Reset(const StateVector<T>& x, const D& d) {
     return Outputs(ProgramKind::kReset, x, d);
   }
-  template <class T>
-  static T Anchor(const StateVector<T>& x, const ExpressionPhaseData& d) {
+  template <class T, class D>
+  static T Anchor(const StateVector<T>& x, const D& d) {
     return Outputs(ProgramKind::kAnchor, x, d)(0);
   }
 
  private:
-  template <class T>
-  static StateVector<T> Outputs(ProgramKind kind, const StateVector<T>& x, const ExpressionPhaseData& d) {
-    StateVector<T> out(d.programs[static_cast<int>(kind)]->num_outputs());
+  static const ExpressionPhaseData& Base(const ExpressionPhaseData& d) { return d; }
+  template <class S>
+  static const ExpressionPhaseData& Base(const ExpressionJetData<S>& d) {
+    return *d.base;
+  }
+  template <class T, class D>
+  static StateVector<T> Outputs(ProgramKind kind, const StateVector<T>& x, const D& d) {
+    StateVector<T> out(Base(d).programs[static_cast<int>(kind)]->num_outputs());
     d.Run(kind, x.data(), out.data());
     return out;
   }
+};
+
+// Expression models differentiate in every parameter.
+template <class S>
+struct ParametersAs<ExpressionPhaseData, S> {
+  using type = ExpressionJetData<S>;
 };
 
 }  // namespace internal

@@ -5,7 +5,8 @@
 //     x'   = f~(x, xi),                       x(0)   = x0,
 //     Phi' = A(x, xi) Phi,                    Phi(0) = I      (A = df~/dx),
 //     Psi' = A(x, xi) Psi + dH(x)^T,          Psi(0) = 0      (n x k, k first integrals),
-// so that x(t) = phi(t, x0; xi), Phi = dphi/dx0 and Psi = dphi/dxi. t = 0 is the identity without any
+// so that x(t) = phi(t, x0; xi), Phi = dphi/dx0 and Psi = dphi/dxi. With free model parameters p
+// (set_free_parameters) Psi has q more columns, dphi/dp, from Psi_p' = A Psi_p + df~/dp, Psi_p(0) = 0. t = 0 is the identity without any
 // integration; t < 0 integrates backward in time (the paper's reversed-time, non-physical orbits).
 //
 //   PhaseFlow flow(model.phase(0), IntegratorOptions{});
@@ -21,6 +22,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "hybridcont/model.h"
 
@@ -80,7 +82,7 @@ struct PhaseFlowResult {
   std::string message;  // empty on success
   Vector x;             // phi(t, x0; xi)
   Matrix Phi;           // dphi/dx0, n x n (only with sensitivities)
-  Matrix Psi;           // dphi/dxi, n x k (only with sensitivities)
+  Matrix Psi;           // [dphi/dxi, dphi/dp], n x (k + q) (only with sensitivities)
   FlowCounters counters;
   // The ξ·∇²H term was left out of the sensitivities only because of set_jacobian_tolerance: Phi and Psi
   // are then exact only to that relative tolerance.
@@ -111,6 +113,9 @@ class PhaseFlow {
   // Relative size below which the ξ·∇²H term of A = df~/dx may be left out of the sensitivities
   // (ZeroProblem::set_jacobian_tolerance); 0, the default, keeps it unless it is below 1e-3 rtol.
   void set_jacobian_tolerance(double tolerance) { jacobian_tolerance_ = tolerance; }
+  // Model parameters (indices into HybridModel::parameters()) whose sensitivities are integrated as the
+  // last columns of Psi. The phase must have parameter derivatives (Phase::has_parameter_derivatives).
+  void set_free_parameters(std::vector<int> parameters);
 
  private:
   struct Steppers;

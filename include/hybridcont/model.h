@@ -76,6 +76,29 @@ class Phase {
     ComputeUnfoldedVectorField(x, xi, f_tilde, A, B, include_hessian_term);
   }
 
+  // Derivatives with respect to a model parameter p (index into HybridModel::parameters()), for
+  // continuation in p (shooting_layout.h, "Free parameters"). A phase that provides them says so here;
+  // AutoDiffPhase does when the model's parameter struct is a template over the scalar type
+  // (model_builder.h), and model-file phases always do.
+  virtual bool has_parameter_derivatives() const { return false; }
+  // At x: ∂f/∂p (n), ∂H_j/∂p (k), ∂e/∂p and ∂Δ/∂p (next_dim). Each output optional (nullptr: not wanted).
+  virtual void ParameterDerivatives(const Eigen::Ref<const Vector>& x, int parameter, Vector* field,
+                                    Vector* integrals, double* event, Vector* reset) const;
+  // ∂f~/∂p = ∂f/∂p + Σ_j ξ_j ∂(∇H_j)/∂p (n) of the unfolded field at (x, ξ): the inhomogeneity of the
+  // parameter's sensitivity equation (flow.h). The mixed term is left out when include_mixed_term is
+  // false (it vanishes on every orbit, where ξ = 0; see TimeBasedShooting::kXiHessianTolerance).
+  virtual void UnfoldedFieldParameterDerivative(const Eigen::Ref<const Vector>& x,
+                                                const Eigen::Ref<const Vector>& xi, int parameter,
+                                                Vector* dfdp, bool include_mixed_term = true) const;
+
+  // The same phase reading its parameters from `parameters`, a copy of the block it was made with
+  // (HybridModel::Clone). nullptr, the default: the phase cannot be rebound (a hand-written phase that
+  // keeps its own parameters), and its model cannot be cloned.
+  virtual std::unique_ptr<Phase> CloneWith(const class ParameterBlock& parameters) const {
+    (void)parameters;
+    return nullptr;
+  }
+
  protected:
   // UnfoldedVectorField from the four functions above. A phase may override it to compute the same in one
   // pass (AutoDiffPhase does): it runs once per right-hand-side evaluation of the integrator.
@@ -95,6 +118,14 @@ class Anchor {
  public:
   virtual ~Anchor() = default;
   virtual double Evaluate(const Eigen::Ref<const Vector>& x, RowVector* da) const = 0;
+  // ∂a/∂p for model parameter `parameter` (Phase::has_parameter_derivatives). Default: unavailable.
+  virtual bool has_parameter_derivatives() const { return false; }
+  virtual double ParameterDerivative(const Eigen::Ref<const Vector>& x, int parameter) const;
+  // Phase::CloneWith's twin.
+  virtual std::unique_ptr<Anchor> CloneWith(const class ParameterBlock& parameters) const {
+    (void)parameters;
+    return nullptr;
+  }
 };
 
 // The values a parameter may take: an interval with open or closed ends (default: every finite value).
@@ -130,6 +161,14 @@ class ParameterBlock {
   virtual const std::vector<ParameterInfo>& infos() const = 0;
   virtual double Get(int index) const = 0;
   virtual void Set(int index, double value) = 0;
+  // An independent copy with the same values (HybridModel::Clone); nullptr: the block cannot be copied.
+  virtual std::unique_ptr<ParameterBlock> Clone() const { return nullptr; }
+  // What phase or anchor `slot` (phase index; the anchor is slot num_phases) reads its parameters from:
+  // the typed storage that Phase::CloneWith binds a rebound phase to. Internal to the model builders.
+  virtual const void* BindingFor(int slot) const {
+    (void)slot;
+    return nullptr;
+  }
 };
 
 // An involution x_i -> S_i x_i (S_i = diag(state_signs[i]), entries ±1) of every phase that maps orbits of
@@ -171,6 +210,11 @@ class HybridModel {
   const std::vector<ParameterInfo>& parameters() const { return parameters_->infos(); }
   // Value of the named parameter; throws std::invalid_argument naming the parameter if unknown.
   double parameter(const std::string& name) const;
+  // Index of the named parameter in parameters(), or -1.
+  int FindParameter(const std::string& name) const;
+  // Value of parameter `index`; sets it without the name lookup (the range is still enforced).
+  double parameter_value(int index) const { return parameters_->Get(index); }
+  void SetParameterValue(int index, double value);
   // Sets a parameter; throws std::invalid_argument if the name is unknown, the value is not finite or it
   // lies outside the parameter's range (the message names the parameter, the value and the range).
   void SetParameter(const std::string& name, double value);
@@ -178,6 +222,15 @@ class HybridModel {
   // The model's default run and presentation (model_setup.h).
   const ModelSetup& setup() const { return setup_; }
   void SetSetup(ModelSetup setup) { setup_ = std::move(setup); }
+
+  // Every phase and the anchor differentiate with respect to parameters (Phase::ParameterDerivatives), so
+  // a parameter can be a free unknown of the shooting maps.
+  bool has_parameter_derivatives() const;
+  // An independent model with the same phases, anchor, parameter values, symmetries and set-up, its
+  // parameters its own: a shooting map whose parameter is an unknown sets it on its own copy, so that
+  // copies evaluating on several threads never share a parameter. Only when is_cloneable().
+  bool is_cloneable() const;
+  HybridModel Clone() const;
 
   // Declared symmetries (generators; see ModelSymmetry).
   const std::vector<ModelSymmetry>& symmetries() const { return symmetries_; }

@@ -27,6 +27,24 @@
 //
 // A phase functor may define `FirstIntegrals` (returning a StateVector<T> of k values) instead of
 // `FirstIntegral` when the system has k > 1 hybrid first integrals (the paper's remark on N_H > 1).
+//
+// Parameters that can be free unknowns (continuation in a model parameter, shooting_layout.h): write the
+// parameter struct as a template over its scalar, the functions over any parameter type Q, and register
+// each parameter by an accessor; the builder then differentiates in the parameters exactly too:
+//
+//   template <class T> struct BallParameters { T m = 1.0, g = 1.0; };
+//   struct Fall {
+//     template <class T, class Q> static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
+//       StateVector<T> f(2); f << x(1), T(-p.g); return f;
+//     }
+//     ...
+//   };
+//   ModelBuilder<BallParameters<double>> b("bouncing-ball", "...");
+//   b.Parameter("g", [](auto& p) -> auto& { return p.g; }, "gravity");
+//
+// Q is BallParameters<double> for values and state derivatives (no cost over a plain struct) and
+// BallParameters<jet> for derivatives in a parameter. A model with a plain struct, or with parameters
+// registered by member pointer, runs as before; its parameters can only be set, not freed.
 #ifndef HYBRIDCONT_MODEL_BUILDER_H_
 #define HYBRIDCONT_MODEL_BUILDER_H_
 
@@ -35,6 +53,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "hybridcont/internal/autodiff_phase.h"
@@ -57,6 +76,14 @@ class ModelBuilder {
     parameters_->Add(std::move(name), member, std::move(description), range);
     return *this;
   }
+  // Registers a named parameter by a generic accessor, [](auto& p) -> auto& { return p.member; }, which
+  // also reaches the member of the parameter struct over jets (see the header comment).
+  template <class Accessor>
+    requires std::is_invocable_v<Accessor, P&>
+  ModelBuilder& Parameter(std::string name, Accessor accessor, std::string description, ParameterRange range = {}) {
+    parameters_->Add(std::move(name), std::move(accessor), std::move(description), range);
+    return *this;
+  }
 
   // The model's default run and presentation (model_setup.h).
   ModelBuilder& Setup(ModelSetup setup) {
@@ -69,9 +96,10 @@ class ModelBuilder {
   template <class F>
   ModelBuilder& AddPhase(std::string name, std::vector<std::string> state_names, Vector typical_state) {
     pending_.push_back({std::move(name), std::move(state_names), std::move(typical_state),
-                        [](PendingPhase& pp, int next_dim, const P* params) -> std::unique_ptr<Phase> {
+                        [](PendingPhase& pp, int next_dim, const ParameterBlock* block,
+                           int slot) -> std::unique_ptr<Phase> {
                           return std::make_unique<internal::AutoDiffPhase<F, P>>(
-                              pp.name, pp.state_names, next_dim, pp.typical_state, params);
+                              pp.name, pp.state_names, next_dim, pp.typical_state, block, slot);
                         }});
     return *this;
   }
@@ -83,8 +111,8 @@ class ModelBuilder {
 
   template <class A>
   ModelBuilder& SetAnchor() {
-    anchor_factory_ = [](const P* params) -> std::unique_ptr<Anchor> {
-      return std::make_unique<internal::AutoDiffAnchor<A, P>>(params);
+    anchor_factory_ = [](const ParameterBlock* block, int slot) -> std::unique_ptr<Anchor> {
+      return std::make_unique<internal::AutoDiffAnchor<A, P>>(block, slot);
     };
     return *this;
   }
@@ -101,7 +129,7 @@ class ModelBuilder {
     const int m = static_cast<int>(pending_.size());
     if (m == 0) throw std::invalid_argument("model '" + name_ + "': no phases");
     if (!anchor_factory_) throw std::invalid_argument("model '" + name_ + "': no anchor set");
-    const P* params = &parameters_->values();
+    const ParameterBlock* block = parameters_.get();
     std::vector<std::unique_ptr<Phase>> phases(m);
     std::vector<int> dims(m);
     for (int i = 0; i < m; ++i) {
@@ -121,11 +149,11 @@ class ModelBuilder {
                                       std::to_string(dims[i]) + " outside [1, kMaxPhaseDim = " +
                                       std::to_string(kMaxPhaseDim) + "]");
         }
-        phases[i] = pending_[i].make(pending_[i], dims[(i + 1) % m], params);
+        phases[i] = pending_[i].make(pending_[i], dims[(i + 1) % m], block, i);
       }
     }
     internal::ValidatePhaseSizes(name_, phases);
-    HybridModel model(name_, description_, std::move(parameters_), std::move(phases), anchor_factory_(params));
+    HybridModel model(name_, description_, std::move(parameters_), std::move(phases), anchor_factory_(block, m));
     for (ModelSymmetry& symmetry : symmetries_) model.AddSymmetry(std::move(symmetry));
     model.SetSetup(std::move(setup_));
     return model;
@@ -136,14 +164,14 @@ class ModelBuilder {
     std::string name;
     std::vector<std::string> state_names;
     Vector typical_state;
-    std::function<std::unique_ptr<Phase>(PendingPhase&, int, const P*)> make;
+    std::function<std::unique_ptr<Phase>(PendingPhase&, int, const ParameterBlock*, int)> make;
   };
   std::string name_;
   std::string description_;
   std::unique_ptr<internal::TypedParameterBlock<P>> parameters_;
   std::vector<PendingPhase> pending_;
   std::map<int, std::unique_ptr<Phase>> ready_;
-  std::function<std::unique_ptr<Anchor>(const P*)> anchor_factory_;
+  std::function<std::unique_ptr<Anchor>(const ParameterBlock*, int)> anchor_factory_;
   std::vector<ModelSymmetry> symmetries_;
   ModelSetup setup_;
 };

@@ -10,8 +10,18 @@
 // Levels H̄_j, j >= 2, of further first integrals are fixed values, not unknowns: the continuation stays
 // one-dimensional (paper's remark on N_H > 1).
 //
+// Free parameters. Continuation in model parameters p_1..p_q (e.g. the SLIP's leg stiffness k) appends them
+// to u, and as many fixing rows u_j − c_j (e.g. H̄ held at 1.5) to r, so that the zero set is again a curve:
+//
+//   u = [ ... | xi_1..xi_k | H̄ | p_1..p_q ]      r = [ ... | first integrals | u_{j_1} − c_1 .. u_{j_q} − c_q ]
+//
+// The Jacobian columns of p come from the flows' parameter sensitivities (flow.h) and the parameter
+// derivatives of resets, events, anchor and first integrals (Phase::ParameterDerivatives): exact, like the
+// others. A parameter is named as in the model ("k"); any unknown may be fixed ("H", "t2", "x1_l", "xi").
+// Without free parameters the layout is the paper's.
+//
 // Names (used as CSV column headers and to address components): "t1".."t<m+1>", "x<i>_<state>" (e.g.
-// "x2_dx"), "xi" (or "xi1".."xik"), "H".
+// "x2_dx"), "xi" (or "xi1".."xik"), "H", then the free parameters' names.
 //
 //   ShootingLayout layout(model);
 //   double H = u(layout.H_index());
@@ -20,6 +30,7 @@
 #define HYBRIDCONT_SHOOTING_LAYOUT_H_
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hybridcont/invariant.h"
@@ -27,9 +38,18 @@
 
 namespace hybridcont {
 
+// Which model parameters are free unknowns and which unknowns are held fixed (equally many).
+struct FreeParameters {
+  std::vector<std::string> parameters;                  // model parameter names, appended to u in order
+  std::vector<std::pair<std::string, double>> fixed;    // unknown name and the value it is held at
+  bool empty() const { return parameters.empty() && fixed.empty(); }
+};
+
 class ShootingLayout {
  public:
-  explicit ShootingLayout(const HybridModel& model);
+  // Throws std::invalid_argument naming the offending entry when a parameter is unknown to the model,
+  // named twice or named like another unknown, a fixed name is no unknown, or the counts differ.
+  explicit ShootingLayout(const HybridModel& model, const FreeParameters& free = {});
 
   // Number of shooting segments, m + 1.
   int num_segments() const { return static_cast<int>(dims_.size()); }
@@ -44,11 +64,22 @@ class ShootingLayout {
   // Index of the first entry of x̄_{i+1} in u.
   int state_offset(int i) const { return time_index(i) + 1; }
   int xi_index(int j = 0) const { return xi_index_ + j; }
-  int H_index() const { return num_unknowns_ - 1; }
+  int H_index() const { return H_index_; }
+
+  // Free parameters: their number q, the index in u of the i-th and its index among the model's parameters.
+  int num_free_parameters() const { return static_cast<int>(parameter_model_index_.size()); }
+  int parameter_index(int i = 0) const { return H_index_ + 1 + i; }
+  int parameter_model_index(int i) const { return parameter_model_index_.at(i); }
+  // Fixing rows: the i-th holds unknown fixed_index(i) at fixed_value(i), in row fixed_row(i).
+  int num_fixed() const { return static_cast<int>(fixed_index_.size()); }
+  int fixed_index(int i) const { return fixed_index_.at(i); }
+  double fixed_value(int i) const { return fixed_value_.at(i); }
+  void set_fixed_value(int i, double value) { fixed_value_.at(i) = value; }
+  int fixed_row(int i) const { return first_integral_row() + k_ + i; }
 
   // First row of block i of r (segment i's shooting/periodicity rows followed by its event/anchor row).
   int block_row(int i) const { return block_row_[CheckedSegment(i)]; }
-  int first_integral_row() const { return num_equations() - k_; }
+  int first_integral_row() const { return num_equations() - k_ - num_fixed(); }
 
   const std::vector<std::string>& unknown_names() const { return names_; }
 
@@ -66,7 +97,11 @@ class ShootingLayout {
   std::vector<int> time_index_;
   std::vector<int> block_row_;
   int xi_index_;
+  int H_index_;
   int num_unknowns_;
+  std::vector<int> parameter_model_index_;
+  std::vector<int> fixed_index_;
+  std::vector<double> fixed_value_;
   std::vector<std::string> names_;
 };
 

@@ -51,8 +51,12 @@ class WorkerTeam;
 
 class TimeBasedShooting : public ShootingProblem {
  public:
-  // Keeps a reference to model (it must outlive this object).
-  TimeBasedShooting(const HybridModel& model, IntegratorOptions options);
+  // Keeps a reference to model (it must outlive this object). With free parameters (shooting_layout.h,
+  // "Free parameters") the map evaluates on its own copy of the model (HybridModel::Clone), on which it sets
+  // the parameters from u before each evaluation; the model must then have parameter derivatives and be
+  // cloneable (throws std::invalid_argument naming the model otherwise, or for a bad FreeParameters). A
+  // parameter value outside its range is an evaluation failure naming it, not an exception.
+  TimeBasedShooting(const HybridModel& model, IntegratorOptions options, FreeParameters free = {});
   ~TimeBasedShooting() override;
   TimeBasedShooting(TimeBasedShooting&&) noexcept;
   TimeBasedShooting& operator=(TimeBasedShooting&&) noexcept;
@@ -71,6 +75,9 @@ class TimeBasedShooting : public ShootingProblem {
 
   // Fixed levels H̄_j of first integrals j = 2..k (size k-1); zero by default.
   void SetFixedLevels(const Vector& levels);
+  const FreeParameters& free_parameters() const { return free_; }
+  // The value the i-th fixed unknown is held at (FreeParameters::fixed).
+  void SetFixedValue(int i, double value);
 
   // Flow of segment i (0-based) at the last evaluated u (x, Phi, Psi when dr was requested).
   const PhaseFlowResult& segment_flow(int i) const {
@@ -103,6 +110,10 @@ class TimeBasedShooting : public ShootingProblem {
   // The model's symmetries (ModelSymmetry) and their products, on u: states by the phases' signs;
   // durations and ξ change sign under time reversal; H̄ is invariant.
   std::vector<Symmetry> symmetries() const override;
+  // "H", or the first free parameter when there are any (its families are traced at fixed values).
+  std::string family_parameter() const override {
+    return layout_.num_free_parameters() > 0 ? layout_.unknown_names()[layout_.parameter_index(0)] : "H";
+  }
   // Clone, Refined, AddWorkOf, counters(): shooting_problem.h.
 
  protected:
@@ -114,8 +125,13 @@ class TimeBasedShooting : public ShootingProblem {
   template <class Sink>
   EvaluationStatus Assemble(const Vector& u, Vector* r, Sink* dr);
 
+  // Sets the free parameters of own_model_ from u; a failure when a value lies outside its range.
+  EvaluationStatus SetParameters(const Vector& u);
+
+  std::unique_ptr<HybridModel> own_model_;  // with free parameters: the copy evaluated on
   const HybridModel* model_;
   IntegratorOptions options_;
+  FreeParameters free_;
   int threads_;
   std::unique_ptr<internal::WorkerTeam> team_;  // made at the first evaluation that uses it
   ShootingLayout layout_;
@@ -130,7 +146,7 @@ class TimeBasedShooting : public ShootingProblem {
   bool cache_valid_ = false;
   EvaluationStatus cached_status_;
   // scratch
-  Vector out_, H_;
+  Vector out_, H_, dp_out_, dp_H_;
   Matrix D_, dH_;
   RowVector de_;
   std::vector<Eigen::Triplet<double>> triplets_;

@@ -138,6 +138,12 @@ class ZeroProblem {
   // none.
   virtual std::vector<Symmetry> symmetries() const { return {}; }
 
+  // The unknown that parametrizes the problem's families, whose turning points the continuation locates
+  // by default (ContinuationOptions::turning_point_components): "H", the level of the first integral, for
+  // the shooting maps of conservative problems; the free model parameter when H̄ is held fixed
+  // (shooting_layout.h, "Free parameters"). Empty: none.
+  virtual std::string family_parameter() const { return UnknownIndex("H") >= 0 ? "H" : ""; }
+
   // Index of the named unknown, or -1.
   int UnknownIndex(const std::string& name) const {
     const std::vector<std::string> names = unknown_names();

@@ -22,7 +22,7 @@ SpecialPointDetector::SpecialPointDetector(ZeroProblem* problem, Corrector* corr
       location_tolerance_(options.location_tolerance),
       max_location_iterations_(options.max_location_iterations) {
   std::vector<std::string> turning = options.turning_point_components;
-  if (turning.empty() && problem_->UnknownIndex("H") >= 0) turning.push_back("H");
+  if (turning.empty() && !problem_->family_parameter().empty()) turning.push_back(problem_->family_parameter());
   for (const std::string& name : turning) {
     turning_.push_back(problem_->UnknownIndex(name));
     HYBRIDCONT_DEMAND(turning_.back() >= 0);  // ValidateFor checked the names

@@ -74,6 +74,11 @@ PhaseFlow::~PhaseFlow() = default;
 PhaseFlow::PhaseFlow(PhaseFlow&&) noexcept = default;
 PhaseFlow& PhaseFlow::operator=(PhaseFlow&&) noexcept = default;
 
+void PhaseFlow::set_free_parameters(std::vector<int> parameters) {
+  HYBRIDCONT_DEMAND(parameters.empty() || phase_->has_parameter_derivatives());
+  steppers_->rhs.parameters = std::move(parameters);
+}
+
 FlowStatus PhaseFlow::Integrate(const Eigen::Ref<const Vector>& x0, const Eigen::Ref<const Vector>& xi, double t,
                                 bool with_sensitivities, PhaseFlowResult* result) {
   return Integrate(x0, xi, t, with_sensitivities, result, Observer());
@@ -120,6 +125,7 @@ FlowStatus PhaseFlow::Integrate(const Eigen::Ref<const Vector>& x0, const Eigen:
   // |xi| |d2H| <= 1e-3 rtol max(|df|, 1): the Jacobian stays exact to the integration tolerance, and any
   // sizable xi (the at-rest branches, the derivative checks) keeps the exact term. A caller that needs dr
   // only to the relative tolerance set_jacobian_tolerance (the corrector, at the predictor) raises the bar.
+  // The ξ-term of df~/dp (ξ·∂∇H/∂p, free parameters) is kept or dropped with it.
   if (with_sensitivities && (w.xi.array() != 0.0).any()) {
     Vector H;
     Matrix df, dH;

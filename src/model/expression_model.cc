@@ -16,14 +16,66 @@ struct ExpressionModelData {
   std::vector<internal::ExpressionPhaseData> phase_data;  // one per phase, the anchor's last
 };
 
-class ExpressionParameterBlock final : public ParameterBlock {
+// Points each phase's (and the anchor's) data at the programs, values and compiled code of `data`.
+void BindPhaseData(ExpressionModelData* data) {
+  const int m = static_cast<int>(data->phases.size());
+  const auto entry = [&](int phase, ProgramKind kind) -> const std::array<CompiledProgramFn, kNumScalarKinds>* {
+    if (!data->compiled) return nullptr;
+    return &data->compiled->entries[5 * phase + static_cast<int>(kind)];
+  };
+  data->phase_data.assign(m + 1, internal::ExpressionPhaseData{});
+  for (int i = 0; i < m; ++i) {
+    internal::ExpressionPhaseData& d = data->phase_data[i];
+    ExpressionPhaseSpec& p = data->phases[i];
+    d.programs[0] = &p.vector_field;
+    d.programs[1] = &p.integrals;
+    d.programs[2] = &p.event;
+    d.programs[3] = &p.reset;
+    d.parameters = data->values.data();
+    for (int k = 0; k < 4; ++k) d.compiled[k] = entry(i, static_cast<ProgramKind>(k));
+  }
+  internal::ExpressionPhaseData& anchor = data->phase_data[m];
+  anchor.programs[static_cast<int>(ProgramKind::kAnchor)] = &data->anchor;
+  anchor.parameters = data->values.data();
+  anchor.compiled[static_cast<int>(ProgramKind::kAnchor)] = entry(m, ProgramKind::kAnchor);
+}
+
+class ExpressionParameterBlock final : public ParameterBlock,
+                                       public internal::ParameterSeeding<internal::ExpressionPhaseData> {
  public:
   explicit ExpressionParameterBlock(std::unique_ptr<ExpressionModelData> data) : data_(std::move(data)) {}
   const std::vector<ParameterInfo>& infos() const override { return data_->infos; }
   double Get(int index) const override { return data_->values[index]; }
   void Set(int index, double value) override { data_->values[index] = value; }
+  std::unique_ptr<ParameterBlock> Clone() const override {
+    auto copy = std::make_unique<ExpressionModelData>(*data_);
+    BindPhaseData(copy.get());
+    return std::make_unique<ExpressionParameterBlock>(std::move(copy));
+  }
+  const void* BindingFor(int slot) const override { return &data_->phase_data.at(slot); }
+
+  bool can_seed() const override { return true; }
+  internal::ExpressionJetData<internal::ParamJet> SeedParamJets(const internal::ExpressionPhaseData& values,
+                                                                 int index) const override {
+    return Seed<internal::ParamJet>(values, index, internal::MakeParamJet);
+  }
+  internal::ExpressionJetData<internal::MixedJet> SeedMixedJets(const internal::ExpressionPhaseData& values,
+                                                                 int index) const override {
+    return Seed<internal::MixedJet>(values, index, internal::MakeMixedJet);
+  }
 
  private:
+  template <class S, class Make>
+  internal::ExpressionJetData<S> Seed(const internal::ExpressionPhaseData& values, int index, Make make) const {
+    internal::ExpressionJetData<S> d;
+    d.base = &values;
+    d.parameters.reserve(data_->values.size());
+    for (int i = 0; i < static_cast<int>(data_->values.size()); ++i) {
+      d.parameters.push_back(make(data_->values[i], i == index ? 1.0 : 0.0));
+    }
+    return d;
+  }
+
   std::unique_ptr<ExpressionModelData> data_;
 };
 
@@ -42,43 +94,26 @@ HybridModel BuildExpressionModel(ExpressionModelSpec spec, std::shared_ptr<const
   if (data->compiled && static_cast<int>(data->compiled->entries.size()) != expected_entries) {
     throw std::invalid_argument("model '" + spec.name + "': compiled code does not match the model");
   }
-  const auto entry = [&](int phase, ProgramKind kind) -> const std::array<CompiledProgramFn, kNumScalarKinds>* {
-    if (!data->compiled) return nullptr;
-    return &data->compiled->entries[5 * phase + static_cast<int>(kind)];
-  };
-  data->phase_data.resize(m + 1);
-  for (int i = 0; i < m; ++i) {
-    internal::ExpressionPhaseData& d = data->phase_data[i];
-    ExpressionPhaseSpec& p = data->phases[i];
-    d.programs[0] = &p.vector_field;
-    d.programs[1] = &p.integrals;
-    d.programs[2] = &p.event;
-    d.programs[3] = &p.reset;
-    d.parameters = data->values.data();
-    for (int k = 0; k < 4; ++k) d.compiled[k] = entry(i, static_cast<ProgramKind>(k));
-  }
-  internal::ExpressionPhaseData& anchor = data->phase_data[m];
-  anchor.programs[static_cast<int>(ProgramKind::kAnchor)] = &data->anchor;
-  anchor.parameters = data->values.data();
-  anchor.compiled[static_cast<int>(ProgramKind::kAnchor)] = entry(m, ProgramKind::kAnchor);
+  BindPhaseData(data.get());
+  ExpressionModelData* view = data.get();
+  auto block = std::make_unique<ExpressionParameterBlock>(std::move(data));
 
+  using ExpressionPhase = internal::AutoDiffPhase<internal::ExpressionFunctions, internal::ExpressionPhaseData>;
+  using ExpressionAnchor = internal::AutoDiffAnchor<internal::ExpressionFunctions, internal::ExpressionPhaseData>;
   std::vector<std::unique_ptr<Phase>> phases;
   for (int i = 0; i < m; ++i) {
-    const ExpressionPhaseSpec& p = data->phases[i];
+    const ExpressionPhaseSpec& p = view->phases[i];
     const int n = static_cast<int>(p.state_names.size());
     if (n < 1 || n > kMaxPhaseDim) {
       throw std::invalid_argument("model '" + spec.name + "', phase '" + p.name + "': " + std::to_string(n) +
                                   " states, outside [1, " + std::to_string(kMaxPhaseDim) + "]");
     }
-    const int next_dim = static_cast<int>(data->phases[(i + 1) % m].state_names.size());
-    phases.push_back(std::make_unique<internal::AutoDiffPhase<internal::ExpressionFunctions, internal::ExpressionPhaseData>>(
-        p.name, p.state_names, next_dim, p.typical_state, &data->phase_data[i]));
+    const int next_dim = static_cast<int>(view->phases[(i + 1) % m].state_names.size());
+    phases.push_back(std::make_unique<ExpressionPhase>(p.name, p.state_names, next_dim, p.typical_state, block.get(), i));
   }
   internal::ValidatePhaseSizes(spec.name, phases);
-  auto anchor_fn = std::make_unique<internal::AutoDiffAnchor<internal::ExpressionFunctions, internal::ExpressionPhaseData>>(
-      &data->phase_data[m]);
-  HybridModel model(spec.name, spec.description, std::make_unique<ExpressionParameterBlock>(std::move(data)),
-                    std::move(phases), std::move(anchor_fn));
+  auto anchor_fn = std::make_unique<ExpressionAnchor>(block.get(), m);
+  HybridModel model(spec.name, spec.description, std::move(block), std::move(phases), std::move(anchor_fn));
   for (ModelSymmetry& s : spec.symmetries) model.AddSymmetry(std::move(s));
   model.SetSetup(std::move(spec.setup));
   return model;

@@ -101,8 +101,19 @@ int HybridModel::ParameterIndex(const std::string& name) const {
 
 double HybridModel::parameter(const std::string& name) const { return parameters_->Get(ParameterIndex(name)); }
 
-void HybridModel::SetParameter(const std::string& name, double value) {
-  const int index = ParameterIndex(name);
+int HybridModel::FindParameter(const std::string& name) const {
+  const auto& infos = parameters_->infos();
+  for (int i = 0; i < static_cast<int>(infos.size()); ++i) {
+    if (infos[i].name == name) return i;
+  }
+  return -1;
+}
+
+void HybridModel::SetParameter(const std::string& name, double value) { SetParameterValue(ParameterIndex(name), value); }
+
+void HybridModel::SetParameterValue(int index, double value) {
+  HYBRIDCONT_DEMAND(index >= 0 && index < static_cast<int>(parameters_->infos().size()));
+  const std::string& name = parameters_->infos()[index].name;
   if (!std::isfinite(value)) {
     throw std::invalid_argument("parameter '" + name + "' of model '" + name_ + "' must be finite, got " +
                                 std::to_string(value));
@@ -114,6 +125,54 @@ void HybridModel::SetParameter(const std::string& name, double value) {
                                 parameters_->infos()[index].description + ")");
   }
   parameters_->Set(index, value);
+}
+
+bool HybridModel::has_parameter_derivatives() const {
+  for (const auto& phase : phases_) {
+    if (!phase->has_parameter_derivatives()) return false;
+  }
+  return anchor_->has_parameter_derivatives();
+}
+
+bool HybridModel::is_cloneable() const {
+  std::unique_ptr<ParameterBlock> block = parameters_->Clone();
+  if (!block) return false;
+  for (const auto& phase : phases_) {
+    if (!phase->CloneWith(*block)) return false;
+  }
+  return anchor_->CloneWith(*block) != nullptr;
+}
+
+HybridModel HybridModel::Clone() const {
+  std::unique_ptr<ParameterBlock> block = parameters_->Clone();
+  HYBRIDCONT_DEMAND(block != nullptr);
+  std::vector<std::unique_ptr<Phase>> phases;
+  for (const auto& phase : phases_) {
+    phases.push_back(phase->CloneWith(*block));
+    HYBRIDCONT_DEMAND(phases.back() != nullptr);
+  }
+  std::unique_ptr<Anchor> anchor = anchor_->CloneWith(*block);
+  HYBRIDCONT_DEMAND(anchor != nullptr);
+  HybridModel copy(name_, description_, std::move(block), std::move(phases), std::move(anchor));
+  copy.symmetries_ = symmetries_;
+  copy.setup_ = setup_;
+  return copy;
+}
+
+void Phase::ParameterDerivatives(const Eigen::Ref<const Vector>&, int, Vector*, Vector*, double*, Vector*) const {
+  HYBRIDCONT_DEMAND(has_parameter_derivatives());  // callers ask only phases that have them
+  HYBRIDCONT_UNREACHABLE();
+}
+
+void Phase::UnfoldedFieldParameterDerivative(const Eigen::Ref<const Vector>&, const Eigen::Ref<const Vector>&, int,
+                                             Vector*, bool) const {
+  HYBRIDCONT_DEMAND(has_parameter_derivatives());  // callers ask only phases that have them
+  HYBRIDCONT_UNREACHABLE();
+}
+
+double Anchor::ParameterDerivative(const Eigen::Ref<const Vector>&, int) const {
+  HYBRIDCONT_DEMAND(has_parameter_derivatives());
+  HYBRIDCONT_UNREACHABLE();
 }
 
 std::string ParameterRange::ToString() const {

@@ -50,9 +50,9 @@ ModelSetup BallChainSetup(int num_phases) {
 
 HybridModel MakeBallChain(int num_phases) {
   if (num_phases < 1) throw std::invalid_argument("ball-chain: number of phases must be >= 1");
-  ModelBuilder<internal::BallParameters> b("ball-chain", "ball bouncing m times per period, one phase per bounce");
-  b.Parameter("m", &internal::BallParameters::m, "mass", ParameterRange::Positive())
-      .Parameter("g", &internal::BallParameters::g, "gravity", ParameterRange::Positive());
+  ModelBuilder<internal::BallParameters<double>> b("ball-chain", "ball bouncing m times per period, one phase per bounce");
+  b.Parameter("m", [](auto& p) -> auto& { return p.m; }, "mass", ParameterRange::Positive())
+      .Parameter("g", [](auto& p) -> auto& { return p.g; }, "gravity", ParameterRange::Positive());
   Vector typical(2);
   typical << 0.5, 0.3;
   for (int i = 0; i < num_phases; ++i) b.AddPhase<internal::BallFlight>("flight-" + std::to_string(i + 1), {"y", "dy"}, typical);

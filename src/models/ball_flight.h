@@ -8,29 +8,30 @@
 
 namespace hybridcont::internal {
 
+template <class T>
 struct BallParameters {
-  double m = 1.0;  // mass
-  double g = 1.0;  // gravity
+  T m = 1.0;  // mass
+  T g = 1.0;  // gravity
 };
 
 // x = [y, dy]
 struct BallFlight {
-  template <class T>
-  static StateVector<T> VectorField(const StateVector<T>& x, const BallParameters& p) {
+  template <class T, class Q>
+  static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
     StateVector<T> f(2);
     f << x(1), T(-p.g);
     return f;
   }
-  template <class T>
-  static T FirstIntegral(const StateVector<T>& x, const BallParameters& p) {
+  template <class T, class Q>
+  static T FirstIntegral(const StateVector<T>& x, const Q& p) {
     return 0.5 * p.m * x(1) * x(1) + p.m * p.g * x(0);
   }
-  template <class T>
-  static T Event(const StateVector<T>& x, const BallParameters&) {
+  template <class T, class Q>
+  static T Event(const StateVector<T>& x, const Q&) {
     return x(0);  // ground contact
   }
-  template <class T>
-  static StateVector<T> Reset(const StateVector<T>& x, const BallParameters&) {
+  template <class T, class Q>
+  static StateVector<T> Reset(const StateVector<T>& x, const Q&) {
     StateVector<T> y(2);
     y << x(0), -x(1);  // elastic impact
     return y;
@@ -38,16 +39,16 @@ struct BallFlight {
 };
 
 struct BallApex {
-  template <class T>
-  static T Anchor(const StateVector<T>& x, const BallParameters&) {
+  template <class T, class Q>
+  static T Anchor(const StateVector<T>& x, const Q&) {
     return x(1);
   }
 };
 
 // The builder with the two parameters registered.
-inline ModelBuilder<BallParameters> BallBuilder(const std::string& name, const std::string& description) {
-  ModelBuilder<BallParameters> b(name, description);
-  b.Parameter("m", &BallParameters::m, "mass").Parameter("g", &BallParameters::g, "gravity");
+inline ModelBuilder<BallParameters<double>> BallBuilder(const std::string& name, const std::string& description) {
+  ModelBuilder<BallParameters<double>> b(name, description);
+  b.Parameter("m", [](auto& p) -> auto& { return p.m; }, "mass").Parameter("g", [](auto& p) -> auto& { return p.g; }, "gravity");
   return b;
 }
 

@@ -6,9 +6,9 @@
 namespace hybridcont {
 
 HybridModel MakeBouncingBall() {
-  ModelBuilder<internal::BallParameters> b("bouncing-ball", "ball bouncing elastically on the ground (paper §4.1)");
-  b.Parameter("m", &internal::BallParameters::m, "mass", ParameterRange::Positive())
-      .Parameter("g", &internal::BallParameters::g, "gravity", ParameterRange::Positive());
+  ModelBuilder<internal::BallParameters<double>> b("bouncing-ball", "ball bouncing elastically on the ground (paper §4.1)");
+  b.Parameter("m", [](auto& p) -> auto& { return p.m; }, "mass", ParameterRange::Positive())
+      .Parameter("g", [](auto& p) -> auto& { return p.g; }, "gravity", ParameterRange::Positive());
   Vector typical(2);
   typical << 0.5, 0.3;
   b.AddPhase<internal::BallFlight>("flight", {"y", "dy"}, typical);

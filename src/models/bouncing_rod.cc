@@ -9,33 +9,34 @@
 namespace hybridcont {
 namespace {
 
+template <class T>
 struct RodParameters {
-  double m = 1.0;   // mass
-  double l0 = 1.0;  // length
-  double g = 1.0;   // gravity
-  double r = 0.01;  // radius of gyration
+  T m = 1.0;   // mass
+  T l0 = 1.0;  // length
+  T g = 1.0;   // gravity
+  T r = 0.01;  // radius of gyration
 };
 
 // Flight until the end on side `kSide` (-1: left, +1: right) hits the ground.
 template <int kSide>
 struct RodFlight {
-  template <class T>
-  static StateVector<T> VectorField(const StateVector<T>& x, const RodParameters& p) {
+  template <class T, class Q>
+  static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
     StateVector<T> f(4);
     f << x(2), x(3), T(-p.g), T(0.0);
     return f;
   }
-  template <class T>
-  static T FirstIntegral(const StateVector<T>& x, const RodParameters& p) {
+  template <class T, class Q>
+  static T FirstIntegral(const StateVector<T>& x, const Q& p) {
     return 0.5 * p.m * (x(2) * x(2) + p.r * p.r * x(3) * x(3)) + p.m * p.g * x(0);
   }
-  template <class T>
-  static T Event(const StateVector<T>& x, const RodParameters& p) {
+  template <class T, class Q>
+  static T Event(const StateVector<T>& x, const Q& p) {
     using std::sin;
     return x(0) + kSide * 0.5 * p.l0 * sin(x(1));  // height of that end
   }
-  template <class T>
-  static StateVector<T> Reset(const StateVector<T>& x, const RodParameters& p) {
+  template <class T, class Q>
+  static StateVector<T> Reset(const StateVector<T>& x, const Q& p) {
     using std::cos;
     const T c = cos(x(1));
     const T scale = 4.0 / (p.l0 * p.l0 * c * c + 4.0 * p.r * p.r);
@@ -47,8 +48,8 @@ struct RodFlight {
 };
 
 struct Apex {
-  template <class T>
-  static T Anchor(const StateVector<T>& x, const RodParameters&) {
+  template <class T, class Q>
+  static T Anchor(const StateVector<T>& x, const Q&) {
     return x(2);
   }
 };
@@ -96,12 +97,12 @@ ModelSetup RodSetup() {
 }  // namespace
 
 HybridModel MakeBouncingRod() {
-  ModelBuilder<RodParameters> b("bouncing-rod", "rod bouncing on its two ends (paper §4.3)");
-  b.Parameter("m", &RodParameters::m, "mass", ParameterRange::Positive())
-      .Parameter("l0", &RodParameters::l0, "length", ParameterRange::Positive())
-      .Parameter("g", &RodParameters::g, "gravity", ParameterRange::Positive())
+  ModelBuilder<RodParameters<double>> b("bouncing-rod", "rod bouncing on its two ends (paper §4.3)");
+  b.Parameter("m", [](auto& p) -> auto& { return p.m; }, "mass", ParameterRange::Positive())
+      .Parameter("l0", [](auto& p) -> auto& { return p.l0; }, "length", ParameterRange::Positive())
+      .Parameter("g", [](auto& p) -> auto& { return p.g; }, "gravity", ParameterRange::Positive())
       // r > 0: a rod without rotational inertia has no impact law (the reset divides by l0^2 cos^2 + 4 r^2).
-      .Parameter("r", &RodParameters::r, "radius of gyration", ParameterRange::Positive());
+      .Parameter("r", [](auto& p) -> auto& { return p.r; }, "radius of gyration", ParameterRange::Positive());
   Vector typical(4);
   typical << 0.3, 0.2, 0.1, 1.0;
   const std::vector<std::string> states = {"y", "alpha", "dy", "dalpha"};

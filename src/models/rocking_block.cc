@@ -11,32 +11,33 @@
 namespace hybridcont {
 namespace {
 
+template <class T>
 struct BlockParameters {
-  double m = 1.0;     // mass
-  double l0 = 1.0;    // half diagonal
-  double g = 1.0;     // gravity
-  double beta = 0.3;  // slenderness [rad]
+  T m = 1.0;     // mass
+  T l0 = 1.0;    // half diagonal
+  T g = 1.0;     // gravity
+  T beta = 0.3;  // slenderness [rad]
 };
 
 struct Rocking {
-  template <class T>
-  static StateVector<T> VectorField(const StateVector<T>& x, const BlockParameters& p) {
+  template <class T, class Q>
+  static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
     using std::sin;
     StateVector<T> f(2);
     f << x(1), -(3.0 * p.g / (4.0 * p.l0)) * sin(p.beta - x(0));
     return f;
   }
-  template <class T>
-  static T FirstIntegral(const StateVector<T>& x, const BlockParameters& p) {
+  template <class T, class Q>
+  static T FirstIntegral(const StateVector<T>& x, const Q& p) {
     using std::cos;
-    return (2.0 / 3.0) * p.m * p.l0 * p.l0 * x(1) * x(1) + (cos(x(0) - p.beta) - std::cos(p.beta)) * p.m * p.l0 * p.g;
+    return (2.0 / 3.0) * p.m * p.l0 * p.l0 * x(1) * x(1) + (cos(x(0) - p.beta) - cos(p.beta)) * p.m * p.l0 * p.g;
   }
-  template <class T>
-  static T Event(const StateVector<T>& x, const BlockParameters&) {
+  template <class T, class Q>
+  static T Event(const StateVector<T>& x, const Q&) {
     return x(0);
   }
-  template <class T>
-  static StateVector<T> Reset(const StateVector<T>& x, const BlockParameters&) {
+  template <class T, class Q>
+  static StateVector<T> Reset(const StateVector<T>& x, const Q&) {
     StateVector<T> y(2);
     y << x(0), -x(1);
     return y;
@@ -44,8 +45,8 @@ struct Rocking {
 };
 
 struct TurningPoint {
-  template <class T>
-  static T Anchor(const StateVector<T>& x, const BlockParameters&) {
+  template <class T, class Q>
+  static T Anchor(const StateVector<T>& x, const Q&) {
     return x(1);
   }
 };
@@ -107,12 +108,12 @@ ModelSetup BlockSetup() {
 }  // namespace
 
 HybridModel MakeRockingBlock() {
-  ModelBuilder<BlockParameters> b("rocking-block", "rectangular block rocking on its corners (paper §4.2)");
-  b.Parameter("m", &BlockParameters::m, "mass", ParameterRange::Positive())
-      .Parameter("l0", &BlockParameters::l0, "half diagonal", ParameterRange::Positive())
-      .Parameter("g", &BlockParameters::g, "gravity", ParameterRange::Positive())
+  ModelBuilder<BlockParameters<double>> b("rocking-block", "rectangular block rocking on its corners (paper §4.2)");
+  b.Parameter("m", [](auto& p) -> auto& { return p.m; }, "mass", ParameterRange::Positive())
+      .Parameter("l0", [](auto& p) -> auto& { return p.l0; }, "half diagonal", ParameterRange::Positive())
+      .Parameter("g", [](auto& p) -> auto& { return p.g; }, "gravity", ParameterRange::Positive())
       // beta = 0 is a block without width (it cannot stand), pi/2 one without height.
-      .Parameter("beta", &BlockParameters::beta, "slenderness angle [rad]", ParameterRange::Open(0.0, M_PI / 2));
+      .Parameter("beta", [](auto& p) -> auto& { return p.beta; }, "slenderness angle [rad]", ParameterRange::Open(0.0, M_PI / 2));
   Vector typical(2);
   typical << 0.1, 0.2;
   b.AddPhase<Rocking>("rocking", {"alpha", "dalpha"}, typical);

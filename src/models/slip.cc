@@ -8,17 +8,18 @@
 namespace hybridcont {
 namespace {
 
+template <class T>
 struct SlipParameters {
-  double m = 1.0;   // point mass
-  double l0 = 1.0;  // natural leg length
-  double g = 1.0;   // gravity
-  double k = 40.0;  // leg stiffness
-  double w2 = 5.0;  // squared swing frequency of the leg in flight
+  T m = 1.0;   // point mass
+  T l0 = 1.0;  // natural leg length
+  T g = 1.0;   // gravity
+  T k = 40.0;  // leg stiffness
+  T w2 = 5.0;  // squared swing frequency of the leg in flight
 };
 
 struct Stance {
-  template <class T>
-  static StateVector<T> VectorField(const StateVector<T>& x, const SlipParameters& p) {
+  template <class T, class Q>
+  static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
     using std::cos;
     using std::sin;
     const T& a = x(0);
@@ -29,19 +30,19 @@ struct Stance {
     f << da, dl, -2.0 * da * dl / l + p.g / l * sin(a), l * da * da - p.g * cos(a) - p.k / p.m * (l - p.l0);
     return f;
   }
-  template <class T>
-  static T FirstIntegral(const StateVector<T>& x, const SlipParameters& p) {
+  template <class T, class Q>
+  static T FirstIntegral(const StateVector<T>& x, const Q& p) {
     using std::cos;
     const T& l = x(1);
     return 0.5 * p.m * (x(2) * x(2) * l * l + x(3) * x(3)) + p.m * p.g * cos(x(0)) * l +
            0.5 * p.k * (l - p.l0) * (l - p.l0);
   }
-  template <class T>
-  static T Event(const StateVector<T>& x, const SlipParameters& p) {
+  template <class T, class Q>
+  static T Event(const StateVector<T>& x, const Q& p) {
     return p.l0 - x(1);  // lift-off at natural length
   }
-  template <class T>
-  static StateVector<T> Reset(const StateVector<T>& x, const SlipParameters&) {
+  template <class T, class Q>
+  static StateVector<T> Reset(const StateVector<T>& x, const Q&) {
     using std::cos;
     using std::sin;
     const T& a = x(0);
@@ -55,23 +56,23 @@ struct Stance {
 };
 
 struct Flight {
-  template <class T>
-  static StateVector<T> VectorField(const StateVector<T>& x, const SlipParameters& p) {
+  template <class T, class Q>
+  static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
     StateVector<T> f(5);
     f << x(3), x(4), T(0.0), T(-p.g), -x(1) * p.w2;
     return f;
   }
-  template <class T>
-  static T FirstIntegral(const StateVector<T>& x, const SlipParameters& p) {
+  template <class T, class Q>
+  static T FirstIntegral(const StateVector<T>& x, const Q& p) {
     return 0.5 * p.m * (x(2) * x(2) + x(3) * x(3)) + p.m * p.g * x(0);
   }
-  template <class T>
-  static T Event(const StateVector<T>& x, const SlipParameters& p) {
+  template <class T, class Q>
+  static T Event(const StateVector<T>& x, const Q& p) {
     using std::cos;
     return x(0) - p.l0 * cos(x(1));  // touch-down
   }
-  template <class T>
-  static StateVector<T> Reset(const StateVector<T>& x, const SlipParameters& p) {
+  template <class T, class Q>
+  static StateVector<T> Reset(const StateVector<T>& x, const Q& p) {
     using std::cos;
     using std::sin;
     const T& a = x(1);
@@ -82,8 +83,8 @@ struct Flight {
 };
 
 struct Nadir {
-  template <class T>
-  static T Anchor(const StateVector<T>& x, const SlipParameters&) {
+  template <class T, class Q>
+  static T Anchor(const StateVector<T>& x, const Q&) {
     return -x(3);
   }
 };
@@ -139,13 +140,13 @@ ModelSetup SlipSetup() {
 }  // namespace
 
 HybridModel MakeSlip() {
-  ModelBuilder<SlipParameters> b("slip", "spring-loaded inverted pendulum hopper with swing leg (paper §4.4)");
-  b.Parameter("m", &SlipParameters::m, "point mass", ParameterRange::Positive())
-      .Parameter("l0", &SlipParameters::l0, "natural leg length", ParameterRange::Positive())
-      .Parameter("g", &SlipParameters::g, "gravity", ParameterRange::Positive())
-      .Parameter("k", &SlipParameters::k, "leg stiffness", ParameterRange::Positive())
+  ModelBuilder<SlipParameters<double>> b("slip", "spring-loaded inverted pendulum hopper with swing leg (paper §4.4)");
+  b.Parameter("m", [](auto& p) -> auto& { return p.m; }, "point mass", ParameterRange::Positive())
+      .Parameter("l0", [](auto& p) -> auto& { return p.l0; }, "natural leg length", ParameterRange::Positive())
+      .Parameter("g", [](auto& p) -> auto& { return p.g; }, "gravity", ParameterRange::Positive())
+      .Parameter("k", [](auto& p) -> auto& { return p.k; }, "leg stiffness", ParameterRange::Positive())
       // w2 > 0: the leg swings about the vertical in flight (w2 <= 0 would let it fall away from it).
-      .Parameter("w2", &SlipParameters::w2, "squared swing frequency omega^2 of the leg in flight",
+      .Parameter("w2", [](auto& p) -> auto& { return p.w2; }, "squared swing frequency omega^2 of the leg in flight",
                  ParameterRange::Positive());
   Vector stance(4), flight(5);
   stance << 0.1, 0.9, 0.3, -0.4;

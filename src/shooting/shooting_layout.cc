@@ -1,8 +1,13 @@
 #include "hybridcont/shooting_layout.h"
 
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
 namespace hybridcont {
 
-ShootingLayout::ShootingLayout(const HybridModel& model) : k_(model.num_first_integrals()) {
+ShootingLayout::ShootingLayout(const HybridModel& model, const FreeParameters& free)
+    : k_(model.num_first_integrals()) {
   const int m = model.num_phases();
   dims_.resize(m + 1);
   for (int i = 0; i <= m; ++i) dims_[i] = model.phase(i).dim();
@@ -26,7 +31,47 @@ ShootingLayout::ShootingLayout(const HybridModel& model) : k_(model.num_first_in
   xi_index_ = col;
   for (int j = 0; j < k_; ++j) names_.push_back(k_ == 1 ? "xi" : "xi" + std::to_string(j + 1));
   names_.push_back("H");
+  H_index_ = col + k_;
   num_unknowns_ = col + k_ + 1;
+  for (const std::string& name : free.parameters) {
+    const int index = model.FindParameter(name);
+    if (index < 0) {
+      std::string known;
+      for (const ParameterInfo& p : model.parameters()) known += (known.empty() ? "" : ", ") + p.name;
+      throw std::invalid_argument("free parameter '" + name + "': model '" + model.name() +
+                                  "' has no such parameter (parameters: " + known + ")");
+    }
+    if (std::find(names_.begin(), names_.end(), name) != names_.end()) {
+      throw std::invalid_argument("free parameter '" + name + "': " +
+                                  (std::find(parameter_model_index_.begin(), parameter_model_index_.end(), index) !=
+                                           parameter_model_index_.end()
+                                       ? std::string("named twice")
+                                       : std::string("has the name of another unknown")));
+    }
+    parameter_model_index_.push_back(index);
+    names_.push_back(name);
+    ++num_unknowns_;
+  }
+  for (const auto& [name, value] : free.fixed) {
+    const auto it = std::find(names_.begin(), names_.end(), name);
+    if (it == names_.end()) {
+      throw std::invalid_argument("fixed unknown '" + name + "' is not an unknown of the problem (unknowns: H, xi, "
+                                  "t1..t" + std::to_string(m + 1) + ", x<i>_<state>, the free parameters)");
+    }
+    const int index = static_cast<int>(it - names_.begin());
+    if (std::find(fixed_index_.begin(), fixed_index_.end(), index) != fixed_index_.end()) {
+      throw std::invalid_argument("fixed unknown '" + name + "': fixed twice");
+    }
+    if (!std::isfinite(value)) throw std::invalid_argument("fixed unknown '" + name + "': value must be finite");
+    fixed_index_.push_back(index);
+    fixed_value_.push_back(value);
+  }
+  if (fixed_index_.size() != parameter_model_index_.size()) {
+    throw std::invalid_argument(std::to_string(parameter_model_index_.size()) + " free parameter(s) and " +
+                                std::to_string(fixed_index_.size()) +
+                                " fixed unknown(s): each free parameter needs one fixed unknown (e.g. --free k "
+                                "--fix H=1.5) so that the solutions form a curve");
+  }
 }
 
 double ShootingLayout::Period(const Vector& u) const {

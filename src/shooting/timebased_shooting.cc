@@ -9,14 +9,60 @@
 
 namespace hybridcont {
 
-TimeBasedShooting::TimeBasedShooting(const HybridModel& model, IntegratorOptions options)
-    : model_(&model), options_(options), threads_(std::max(1, static_cast<int>(std::thread::hardware_concurrency()))),
-      layout_(model),
+namespace {
+// The model evaluated on: the caller's, or with free parameters a copy of it (checked first).
+std::unique_ptr<HybridModel> OwnCopyIfFree(const HybridModel& model, const FreeParameters& free) {
+  if (free.parameters.empty()) return nullptr;
+  if (!model.has_parameter_derivatives()) {
+    throw std::invalid_argument("model '" + model.name() +
+                                "' cannot differentiate with respect to its parameters, so none can be free (a C++ "
+                                "model needs a parameter struct over the scalar type: model_builder.h)");
+  }
+  if (!model.is_cloneable()) {
+    throw std::invalid_argument("model '" + model.name() + "' has phases that cannot be copied, so none of its "
+                                "parameters can be free");
+  }
+  return std::make_unique<HybridModel>(model.Clone());
+}
+}  // namespace
+
+TimeBasedShooting::TimeBasedShooting(const HybridModel& model, IntegratorOptions options, FreeParameters free)
+    : own_model_(OwnCopyIfFree(model, free)),
+      model_(own_model_ ? own_model_.get() : &model),
+      options_(options),
+      free_(std::move(free)),
+      threads_(std::max(1, static_cast<int>(std::thread::hardware_concurrency()))),
+      layout_(model, free_),
       fixed_levels_(Vector::Zero(model.num_first_integrals() - 1)) {
   if (const std::string why = options.Validate(); !why.empty()) throw std::invalid_argument(why);
-  const int m = model.num_phases();
-  for (int i = 0; i <= m; ++i) integrators_.emplace_back(model.phase(i), options);
+  const int m = model_->num_phases();
+  std::vector<int> parameters;
+  for (int i = 0; i < layout_.num_free_parameters(); ++i) parameters.push_back(layout_.parameter_model_index(i));
+  for (int i = 0; i <= m; ++i) {
+    integrators_.emplace_back(model_->phase(i), options);
+    integrators_.back().set_free_parameters(parameters);
+  }
   flows_.resize(m + 1);
+}
+
+void TimeBasedShooting::SetFixedValue(int i, double value) {
+  layout_.set_fixed_value(i, value);
+  free_.fixed.at(i).second = value;
+  cache_valid_ = false;
+}
+
+EvaluationStatus TimeBasedShooting::SetParameters(const Vector& u) {
+  for (int i = 0; i < layout_.num_free_parameters(); ++i) {
+    const int index = layout_.parameter_model_index(i);
+    const double value = u(layout_.parameter_index(i));
+    if (value == model_->parameter_value(index)) continue;
+    try {
+      own_model_->SetParameterValue(index, value);
+    } catch (const std::invalid_argument& e) {
+      return EvaluationStatus::Failure(e.what());
+    }
+  }
+  return {};
 }
 
 TimeBasedShooting::~TimeBasedShooting() = default;
@@ -53,20 +99,36 @@ std::vector<Symmetry> TimeBasedShooting::symmetries() const {
     for (int j = 0; j < layout_.num_first_integrals(); ++j) signs(layout_.xi_index(j)) = time;
     generators.push_back({s.name, std::move(signs)});
   }
-  return SymmetryGroup(generators);
+  // An unknown held at c != 0 must not change sign: such an element maps solutions to u_j = -c.
+  std::vector<Symmetry> group = SymmetryGroup(generators);
+  std::erase_if(group, [&](const Symmetry& g) {
+    for (int i = 0; i < layout_.num_fixed(); ++i) {
+      if (g.signs(layout_.fixed_index(i)) < 0 && layout_.fixed_value(i) != 0.0) return true;
+    }
+    return false;
+  });
+  return group;
 }
 
 std::unique_ptr<ShootingProblem> TimeBasedShooting::CopyWithTolerances(double tolerance_factor) const {
   IntegratorOptions options = options_;
   options.rtol *= tolerance_factor;
   options.atol *= tolerance_factor;
-  auto copy = std::make_unique<TimeBasedShooting>(*model_, options);
+  auto copy = std::make_unique<TimeBasedShooting>(*model_, options, free_);
   copy->SetFixedLevels(fixed_levels_);
   copy->set_threads(1);
   return copy;
 }
 
 EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivities) {
+  if (EvaluationStatus status = SetParameters(u); !status.ok) {
+    cached_u_ = u;
+    cached_sensitivities_ = sensitivities;
+    cached_jacobian_tolerance_ = 0.0;
+    cache_valid_ = true;
+    cached_status_ = status;
+    return status;
+  }
   const int k = layout_.num_first_integrals();
   const auto xi = u.segment(layout_.xi_index(), k);
   const int segments = layout_.num_segments();
@@ -192,6 +254,7 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
 
   const int m = model_->num_phases();
   const int k = layout_.num_first_integrals();
+  const int q = layout_.num_free_parameters();
   const int N = layout_.num_equations();
   const auto xi = u.segment(layout_.xi_index(), k);
   if (r) r->resize(N);
@@ -229,10 +292,24 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
       const int ct = layout_.time_index(i);
       dr->Add(row, ct, D_ * f_tilde);
       dr->Add(row, ct + 1, D_ * flow.Phi);
-      dr->Add(row, layout_.xi_index(), D_ * flow.Psi);
+      dr->Add(row, layout_.xi_index(), D_ * flow.Psi.leftCols(k));
       dr->Add(row + n_out, ct, de_.dot(f_tilde));
       dr->Add(row + n_out, ct + 1, de_ * flow.Phi);
-      dr->Add(row + n_out, layout_.xi_index(), de_ * flow.Psi);
+      dr->Add(row + n_out, layout_.xi_index(), de_ * flow.Psi.leftCols(k));
+      // Free parameters: through the flow (D Psi_p, de Psi_p) and the reset/event (anchor) themselves.
+      for (int p = 0; p < q; ++p) {
+        const int col = layout_.parameter_index(p);
+        const int index = layout_.parameter_model_index(p);
+        double de_dp = 0.0;
+        if (i < m) {
+          phase.ParameterDerivatives(flow.x, index, nullptr, nullptr, &de_dp, &dp_out_);
+        } else {
+          dp_out_.setZero(n_out);
+          de_dp = model_->anchor().ParameterDerivative(flow.x, index);
+        }
+        dr->Add(row, col, D_ * flow.Psi.col(k + p) + dp_out_);
+        dr->Add(row + n_out, col, de_.dot(flow.Psi.col(k + p)) + de_dp);
+      }
       // C: -I on x̄_{i+1}
       dr->AddDiagonal(row, layout_.state_offset(next), n_out, -1.0);
     }
@@ -250,6 +327,15 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
   if (dr) {
     dr->Add(row, layout_.state_offset(0), dH_);
     dr->Add(row, layout_.H_index(), -1.0);
+    for (int p = 0; p < q; ++p) {
+      model_->phase(0).ParameterDerivatives(x1, layout_.parameter_model_index(p), nullptr, &dp_H_, nullptr, nullptr);
+      dr->Add(row, layout_.parameter_index(p), dp_H_);
+    }
+  }
+  // Fixing rows: u_j − c_j.
+  for (int i = 0; i < layout_.num_fixed(); ++i) {
+    if (r) (*r)(layout_.fixed_row(i)) = u(layout_.fixed_index(i)) - layout_.fixed_value(i);
+    if (dr) dr->Add(layout_.fixed_row(i), layout_.fixed_index(i), 1.0);
   }
   return {};
 }

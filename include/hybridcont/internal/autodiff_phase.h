@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -63,6 +64,63 @@ decltype(auto) DispatchOnDimension(int n, Fn&& fn) {
     default: return fn(std::integral_constant<int, Eigen::Dynamic>{});
   }
 }
+
+// Scalars for derivatives with respect to one model parameter p: ParamJet carries d/dp; MixedJet is the
+// second-order jet in two variables (one state x_i, variable 0, and p, variable 1) whose mixed entry is
+// ∂²H/∂x_i∂p (the ξ-term of ∂f~/∂p). Both convert implicitly from double, so parameter structs over them
+// keep their default member initializers.
+using ParamJet = Eigen::AutoDiffScalar<Eigen::Matrix<double, 1, 1>>;
+using MixedJet = HessianJet<2>;
+
+// The parameters a functor reads, over the scalar S. A parameter struct that is a template over its scalar
+// (template <class T> struct SlipParameters { T k = 40; ... }, used as SlipParameters<double>) becomes
+// SlipParameters<S>; the expression models specialize this for their data. Any other P has no `type`: its
+// model cannot differentiate with respect to its parameters.
+template <class P, class S>
+struct ParametersAs {};
+template <template <class> class PT, class S>
+struct ParametersAs<PT<double>, S> {
+  using type = PT<S>;
+};
+template <class P>
+concept DifferentiableParameters =
+    requires { typename ParametersAs<P, ParamJet>::type; typename ParametersAs<P, MixedJet>::type; };
+
+// Made by a model's parameter block: its parameters as ParamJets or MixedJets, the derivative seed on
+// parameter `index` (the others constant).
+template <class P>
+class ParameterSeeding {
+ public:
+  virtual ~ParameterSeeding() = default;
+  // False when some parameter cannot be seeded (registered by a member pointer of the double struct).
+  virtual bool can_seed() const = 0;
+  // `values` is the P the phase reads (ParameterBlock::BindingFor of its slot).
+  virtual typename ParametersAs<P, ParamJet>::type SeedParamJets(const P& values, int index) const = 0;
+  virtual typename ParametersAs<P, MixedJet>::type SeedMixedJets(const P& values, int index) const = 0;
+};
+struct NoParameterSeeding {};
+// ParametersAs<P, S>::type, or an empty placeholder for parameters that are not differentiable.
+struct NotDifferentiable {};
+template <class P, class S>
+using ParametersAsOr = typename std::conditional_t<DifferentiableParameters<P>, ParametersAs<P, S>,
+                                                   std::type_identity<NotDifferentiable>>::type;
+template <class P>
+using ParameterSeedingBase = std::conditional_t<DifferentiableParameters<P>, ParameterSeeding<P>, NoParameterSeeding>;
+
+// The functor F accepts the parameters as ParamJets (it is written over a generic parameter type): a
+// phase functor through its vector field, an anchor functor through its anchor.
+template <class F, class Q>
+concept TakesParameterJets = requires(const StateVector<ParamJet>& x, const Q& q) {
+  { F::template VectorField<ParamJet>(x, q) };
+} || requires(const StateVector<ParamJet>& x, const Q& q) {
+  { F::template Anchor<ParamJet>(x, q) };
+};
+
+// A ParamJet with value v and derivative `seed`; a MixedJet that is variable 1 (p) when seeded.
+inline ParamJet MakeParamJet(double v, double seed) {
+  return ParamJet(v, Eigen::Matrix<double, 1, 1>::Constant(seed));
+}
+inline MixedJet MakeMixedJet(double v, double seed) { return seed != 0.0 ? MixedJet::Variable(v, 1) : MixedJet(v); }
 
 // Seeds are written in place, each derivative vector by one wide copy of a unit vector: a seeded temporary
 // copied in, or a unit vector written entry by entry, stalled on store forwarding when the jets were read
@@ -167,8 +225,9 @@ concept HasScalarFirstIntegral = requires(const StateVector<double>& x, const P&
   { F::template FirstIntegral<double>(x, p) };
 };
 
-template <class F, class P, class T>
-StateVector<T> EvaluateFirstIntegrals(const StateVector<T>& x, const P& p) {
+// The first integrals of F at x, with the parameters q (P itself or P over a jet; P decides the form).
+template <class F, class P, class T, class Q = P>
+StateVector<T> EvaluateFirstIntegrals(const StateVector<T>& x, const Q& p) {
   if constexpr (HasScalarFirstIntegral<F, P>) {
     StateVector<T> h(1);
     h(0) = F::template FirstIntegral<T>(x, p);
@@ -178,15 +237,93 @@ StateVector<T> EvaluateFirstIntegrals(const StateVector<T>& x, const P& p) {
   }
 }
 
+// The parameters that phase or anchor `slot` of a model reads, from its block (ParameterBlock::BindingFor),
+// and the block's seeding when it has one.
+template <class P>
+struct ParameterBinding {
+  const P* values = nullptr;
+  const ParameterSeedingBase<P>* seeding = nullptr;
+  ParameterBinding(const ParameterBlock* block, int slot)
+      : values(static_cast<const P*>(block->BindingFor(slot))) {
+    if constexpr (DifferentiableParameters<P>) seeding = dynamic_cast<const ParameterSeeding<P>*>(block);
+  }
+  template <class F>
+  bool differentiable() const {
+    if constexpr (DifferentiableParameters<P>) {
+      if constexpr (TakesParameterJets<F, typename ParametersAs<P, ParamJet>::type>) {
+        return seeding != nullptr && seeding->can_seed();
+      }
+    }
+    return false;
+  }
+};
+
+// The ParamJet derivatives (d/dp) of a vector of ParamJets.
+inline void UnpackParameterDerivative(const StateVector<ParamJet>& y, Vector* out) {
+  out->resize(y.size());
+  for (int i = 0; i < y.size(); ++i) (*out)(i) = y(i).derivatives()(0);
+}
+
 template <class F, class P>
 class AutoDiffPhase final : public Phase {
  public:
+  // Reads its parameters from `block` (ParameterBlock::BindingFor(slot)); slot is the phase's index.
   AutoDiffPhase(std::string name, std::vector<std::string> state_names, int next_dim, Vector typical_state,
-                const P* params)
+                const ParameterBlock* block, int slot)
       : Phase(std::move(name), std::move(state_names), next_dim,
-              static_cast<int>(EvaluateFirstIntegrals<F, P, double>(StateVector<double>(typical_state), *params).size()),
+              static_cast<int>(EvaluateFirstIntegrals<F, P, double>(StateVector<double>(typical_state),
+                                                                    *ParameterBinding<P>(block, slot).values)
+                                   .size()),
               typical_state),
-        p_(params) {}
+        binding_(block, slot),
+        p_(binding_.values),
+        slot_(slot),
+        differentiable_(binding_.template differentiable<F>()) {}
+
+  std::unique_ptr<Phase> CloneWith(const ParameterBlock& parameters) const override {
+    return std::make_unique<AutoDiffPhase>(name(), state_names(), next_dim(), typical_state(), &parameters, slot_);
+  }
+
+  bool has_parameter_derivatives() const override { return differentiable_; }
+
+  void ParameterDerivatives(const Eigen::Ref<const Vector>& x, int parameter, Vector* field, Vector* integrals,
+                            double* event, Vector* reset) const override {
+    HYBRIDCONT_DEMAND(differentiable_);
+    if constexpr (DifferentiableParameters<P>) {
+      if constexpr (TakesParameterJets<F, typename ParametersAs<P, ParamJet>::type>) {
+        const auto q = binding_.seeding->SeedParamJets(*p_, parameter);
+        const StateVector<ParamJet> xs = x.template cast<ParamJet>();
+        if (field) UnpackParameterDerivative(F::template VectorField<ParamJet>(xs, q), field);
+        if (integrals) UnpackParameterDerivative(EvaluateFirstIntegrals<F, P, ParamJet>(xs, q), integrals);
+        if (event) *event = F::template Event<ParamJet>(xs, q).derivatives()(0);
+        if (reset) UnpackParameterDerivative(F::template Reset<ParamJet>(xs, q), reset);
+      }
+    }
+  }
+
+  void UnfoldedFieldParameterDerivative(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
+                                        int parameter, Vector* dfdp, bool include_mixed_term) const override {
+    HYBRIDCONT_DEMAND(differentiable_);
+    if constexpr (DifferentiableParameters<P>) {
+      if constexpr (TakesParameterJets<F, typename ParametersAs<P, ParamJet>::type>) {
+        const StateVector<ParamJet> xs = x.template cast<ParamJet>();
+        UnpackParameterDerivative(F::template VectorField<ParamJet>(xs, binding_.seeding->SeedParamJets(*p_, parameter)),
+                                  dfdp);
+        if (!include_mixed_term || (xi.array() == 0.0).all()) return;
+        // ∂²H_j/∂x_i∂p, one state at a time: x_i variable 0, p variable 1.
+        const int n = dim();
+        const auto q = binding_.seeding->SeedMixedJets(*p_, parameter);
+        StateVector<MixedJet> xm(n);
+        for (int i = 0; i < n; ++i) xm(i) = MixedJet(x(i));
+        for (int i = 0; i < n; ++i) {
+          xm(i) = MixedJet::Variable(x(i), 0);
+          const auto h = EvaluateFirstIntegrals<F, P, MixedJet>(xm, q);
+          for (int j = 0; j < h.size(); ++j) (*dfdp)(i) += xi(j) * h(j).hessian[MixedJet::Packed(0, 1)];
+          xm(i) = MixedJet(x(i));
+        }
+      }
+    }
+  }
 
   void VectorField(const Eigen::Ref<const Vector>& x, Vector* f, Matrix* df) const override {
     if (!df) {
@@ -339,13 +476,31 @@ class AutoDiffPhase final : public Phase {
     }
   }
 
+  ParameterBinding<P> binding_;
   const P* p_;
+  int slot_;
+  bool differentiable_;
 };
 
 template <class A, class P>
 class AutoDiffAnchor final : public Anchor {
  public:
-  explicit AutoDiffAnchor(const P* params) : p_(params) {}
+  AutoDiffAnchor(const ParameterBlock* block, int slot)
+      : binding_(block, slot), p_(binding_.values), slot_(slot), differentiable_(binding_.template differentiable<A>()) {}
+  std::unique_ptr<Anchor> CloneWith(const ParameterBlock& parameters) const override {
+    return std::make_unique<AutoDiffAnchor>(&parameters, slot_);
+  }
+  bool has_parameter_derivatives() const override { return differentiable_; }
+  double ParameterDerivative(const Eigen::Ref<const Vector>& x, int parameter) const override {
+    HYBRIDCONT_DEMAND(differentiable_);
+    if constexpr (DifferentiableParameters<P>) {
+      if constexpr (TakesParameterJets<A, typename ParametersAs<P, ParamJet>::type>) {
+        const StateVector<ParamJet> xs = x.template cast<ParamJet>();
+        return A::template Anchor<ParamJet>(xs, binding_.seeding->SeedParamJets(*p_, parameter)).derivatives()(0);
+      }
+    }
+    return 0.0;
+  }
   double Evaluate(const Eigen::Ref<const Vector>& x, RowVector* da) const override {
     if (!da) return A::template Anchor<double>(StateVector<double>(x), *p_);
     const int n = static_cast<int>(x.size());
@@ -362,25 +517,80 @@ class AutoDiffAnchor final : public Anchor {
   }
 
  private:
+  ParameterBinding<P> binding_;
   const P* p_;
+  int slot_;
+  bool differentiable_;
 };
 
+// The parameters of a ModelBuilder model: the values in a P, each registered parameter addressed by an
+// accessor that works on P and, when P is a template over its scalar, on P over the jets too.
 template <class P>
-class TypedParameterBlock final : public ParameterBlock {
+class TypedParameterBlock final : public ParameterBlock, public ParameterSeedingBase<P> {
  public:
+  // A parameter addressed by a member pointer of P: readable and settable; not seedable when P is a
+  // template (the member pointer names the double struct's member only).
   void Add(std::string name, double P::*member, std::string description, ParameterRange range) {
-    infos_.push_back({std::move(name), values_.*member, std::move(description), range});
-    members_.push_back(member);
+    Entry e;
+    e.get = [member](P& p) -> double& { return p.*member; };
+    if constexpr (DifferentiableParameters<P>) seedable_ = false;
+    Register(std::move(name), std::move(e), std::move(description), range);
+  }
+  // A parameter addressed by a generic accessor, e.g. [](auto& p) -> auto& { return p.k; }.
+  template <class Accessor>
+  void Add(std::string name, Accessor accessor, std::string description, ParameterRange range) {
+    Entry e;
+    e.get = [accessor](P& p) -> double& { return accessor(p); };
+    if constexpr (DifferentiableParameters<P>) {
+      e.seed = [accessor](const P& from, ParametersAsOr<P, ParamJet>& to, bool seed) {
+        accessor(to) = MakeParamJet(accessor(const_cast<P&>(from)), seed ? 1.0 : 0.0);
+      };
+      e.seed_mixed = [accessor](const P& from, ParametersAsOr<P, MixedJet>& to, bool seed) {
+        accessor(to) = MakeMixedJet(accessor(const_cast<P&>(from)), seed ? 1.0 : 0.0);
+      };
+    }
+    Register(std::move(name), std::move(e), std::move(description), range);
   }
   const std::vector<ParameterInfo>& infos() const override { return infos_; }
-  double Get(int index) const override { return values_.*members_[index]; }
-  void Set(int index, double value) override { values_.*members_[index] = value; }
+  double Get(int index) const override { return entries_[index].get(const_cast<P&>(values_)); }
+  void Set(int index, double value) override { entries_[index].get(values_) = value; }
+  std::unique_ptr<ParameterBlock> Clone() const override { return std::make_unique<TypedParameterBlock>(*this); }
+  const void* BindingFor(int) const override { return &values_; }
   const P& values() const { return values_; }
 
+  // ParameterSeeding<P> (its overriders when P is differentiable).
+  bool can_seed() const { return seedable_; }
+  ParametersAsOr<P, ParamJet> SeedParamJets(const P&, int index) const {
+    ParametersAsOr<P, ParamJet> q{};
+    for (int i = 0; i < static_cast<int>(entries_.size()); ++i) entries_[i].seed(values_, q, i == index);
+    return q;
+  }
+  ParametersAsOr<P, MixedJet> SeedMixedJets(const P&, int index) const {
+    ParametersAsOr<P, MixedJet> q{};
+    for (int i = 0; i < static_cast<int>(entries_.size()); ++i) entries_[i].seed_mixed(values_, q, i == index);
+    return q;
+  }
+
  private:
+  struct Empty {};
+  template <class S>
+  using SeedFn = std::conditional_t<DifferentiableParameters<P>,
+                                    std::function<void(const P&, ParametersAsOr<P, S>&, bool)>, Empty>;
+  struct Entry {
+    std::function<double&(P&)> get;
+    // Write the parameter into the struct over ParamJets / MixedJets, seeded or constant.
+    SeedFn<ParamJet> seed;
+    SeedFn<MixedJet> seed_mixed;
+  };
+  void Register(std::string name, Entry e, std::string description, ParameterRange range) {
+    const double value = e.get(values_);
+    infos_.push_back({std::move(name), value, std::move(description), range});
+    entries_.push_back(std::move(e));
+  }
   P values_{};
   std::vector<ParameterInfo> infos_;
-  std::vector<double P::*> members_;
+  std::vector<Entry> entries_;
+  bool seedable_ = true;
 };
 
 // Checks that every reset maps into the next phase's dimension and that all phases have the same number
