@@ -57,7 +57,8 @@
 // and pass the map, the fixing row's index and the free parameter's name (TraceSpecialPointCurve from a
 // SpecialPoint). Contract: the base Jacobian is requested dense; each evaluation of a fold curve with dr
 // costs three base Jacobians, of a branch-point curve five. Bad input (sizes, names, a fix_row that is
-// not a fixing row) is std::invalid_argument; numerical outcomes are statuses.
+// not a fixing row) is std::invalid_argument; numerical outcomes are statuses. Decisions and measurements:
+// docs/design/special-point-curves.md.
 #ifndef HYBRIDCONT_SPECIAL_POINT_CURVE_H_
 #define HYBRIDCONT_SPECIAL_POINT_CURVE_H_
 
