@@ -187,6 +187,47 @@ TEST(SpecialPointCurve, CuspFoldCurvesMatchTheClosedFormAndMeetAtTheCusp) {
   EXPECT_EQ(monitors, 2);
 }
 
+// f(x; a, b) = a + b x − (x − 0.3)³ + 0.1 sin x: fold curves b(x) = 3(x − 0.3)² − 0.1 cos x,
+// a(x) = −b(x) x + (x − 0.3)³ − 0.1 sin x, the cusp where f_xx = −6(x − 0.3) − 0.1 sin x = 0. Its fourth
+// derivative is nonzero, so the directional differences of Jacobians are not exact here.
+TEST(SpecialPointCurve, CuspOfANonPolynomialFamily) {
+  AlgebraicFamily family({"x", "a", "b"}, [](const Vector& u) {
+    return Vector::Constant(1, u(1) + u(2) * u(0) - std::pow(u(0) - 0.3, 3) + 0.1 * std::sin(u(0))); }, 2, 1.0);
+  family.jacobian_ = [](const Vector& u) {
+    Matrix j(1, 3);
+    j << u(2) - 3 * std::pow(u(0) - 0.3, 2) + 0.1 * std::cos(u(0)), 1, u(0);
+    return j;
+  };
+  auto b_of = [](double x) { return 3 * std::pow(x - 0.3, 2) - 0.1 * std::cos(x); };
+  auto a_of = [&](double x) { return -b_of(x) * x + std::pow(x - 0.3, 3) - 0.1 * std::sin(x); };
+  double cusp_x = 0.3;  // Newton on f_xx = 0
+  for (int k = 0; k < 50; ++k) cusp_x -= (-6 * (cusp_x - 0.3) - 0.1 * std::sin(cusp_x)) / (-6 - 0.1 * std::cos(cusp_x));
+  const double x0 = 1.0;
+  SpecialPointCurveOptions options = CurveOptions();
+  options.continuation.bounds = {{"x", -0.6, 1.2}};
+  const CurveDefinition fold{CurveKind::kFold, 1, "a", {}};
+  const SpecialPointCurve curve =
+      TraceSpecialPointCurve(&family, fold, Eigen::Vector3d(x0, a_of(x0), b_of(x0)), options);
+  SCOPED_TRACE(curve.FullReport());
+  ASSERT_EQ(curve.status, CurveStatus::kTraced);
+  double worst = 0;
+  for (const Vector& u : curve.points) {
+    worst = std::max({worst, std::abs(u(1) - a_of(u(0))), std::abs(u(2) - b_of(u(0)))});
+  }
+  EXPECT_LT(worst, 1e-10);
+  RecordProperty("nonpolynomial_fold_curve_error", Scientific(worst));
+  int cusps = 0;
+  for (const CodimTwoPoint& point : curve.codim_two_points) {
+    if (point.type != CodimTwoType::kCusp) continue;
+    ++cusps;
+    EXPECT_EQ(point.status, LocationStatus::kLocated);
+    EXPECT_NEAR(point.u(0), cusp_x, 1e-9);
+    EXPECT_NEAR(point.u(2), b_of(cusp_x), 1e-9);
+    RecordProperty("nonpolynomial_cusp_error", Scientific(std::abs(point.u(0) - cusp_x)));
+  }
+  EXPECT_EQ(cusps, 1);
+}
+
 TEST(SpecialPointCurve, FoldCurveFromALocatedTurningPoint) {
   // The one-parameter family at b = 2, traced in a: turning points at x = ±√(2/3).
   AlgebraicFamily cusp = Cusp(2.0);
