@@ -25,6 +25,7 @@
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/shooting_problem.h"
 #include "hybridcont/special_point.h"
+#include "hybridcont/special_point_curve.h"
 #include "hybridcont/statebased_shooting.h"
 #include "hybridcont/test_function_root.h"
 #include "hybridcont/timebased_shooting.h"
