@@ -40,6 +40,9 @@
 #ifndef HYBRIDCONT_PERIOD_DOUBLING_H_
 #define HYBRIDCONT_PERIOD_DOUBLING_H_
 
+#include <string>
+#include <vector>
+
 #include "hybridcont/exploration.h"
 #include "hybridcont/model.h"
 #include "hybridcont/shooting_layout.h"
@@ -53,6 +56,10 @@ HybridModel RepeatedModel(const HybridModel& model, int k);
 // u_k from a parent point u of `layout` (the parent's). Throws std::invalid_argument for a wrong size or
 // k < 1.
 Vector RepeatedOrbit(const ShootingLayout& layout, const Vector& u, int k);
+
+// The names of the k copies of the parent unknown `name` of `layout` in the k-fold layout ("t2" -> "t2",
+// "t5" for m = 2, k = 2); ξ, H̄ and names that are no unknown of `layout` map to themselves alone.
+std::vector<std::string> RepeatedNames(const ShootingLayout& layout, const std::string& name, int k);
 
 // Whether u_k (of the k-fold layout of `layout`) repeats its first cycle: every cycle within
 // tolerance · (1 + ||u_k||∞) of the first, componentwise.

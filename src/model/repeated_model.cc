@@ -1,4 +1,5 @@
 // The k-fold repeated model and its orbits (period_doubling.h).
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -122,6 +123,15 @@ Vector RepeatedOrbit(const ShootingLayout& layout, const Vector& u, int k) {
   for (int c = 0; c < k; ++c) u_k.segment(c * cycle, cycle) = u.head(cycle);
   u_k.tail(tail) = u.tail(tail);
   return u_k;
+}
+
+std::vector<std::string> RepeatedNames(const ShootingLayout& layout, const std::string& name, int k) {
+  RequireFold(k);
+  const std::vector<std::string>& names = layout.unknown_names();
+  if (std::find(names.begin(), names.begin() + layout.xi_index(0), name) == names.begin() + layout.xi_index(0)) {
+    return {name};
+  }
+  return CopyNames(name, layout.num_segments(), k);
 }
 
 bool IsRepeatedOrbit(const ShootingLayout& layout, const Vector& u_k, int k, double tolerance) {
