@@ -40,6 +40,7 @@ struct RunArguments {
   bool no_plots = false;
   bool no_symmetry = false;            // trace every half-branch instead of mapping images
   bool overwrite = false;              // replace another model's results in --out (refused otherwise)
+  bool period_doubling = false;        // explore the period-doubled family of every located PD point
 };
 void AddRunOptions(CLI::App* run, RunArguments* args);
 // Refuses an empty value ("--atol ''"): a mistake, not a request for the default. Returns option.

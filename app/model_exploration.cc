@@ -6,6 +6,7 @@
 #include "hybridcont/classification.h"
 #include "hybridcont/corrector.h"
 #include "hybridcont/internal/enum_names.h"
+#include "hybridcont/period_doubling.h"
 
 namespace hybridcont::app {
 
@@ -133,8 +134,41 @@ Vector ModelExploration::FindPhysicalStart(std::string* why) {
   return found;
 }
 
-BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {
+ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point) {
   ExplorationOptions options = options_;
+  ContinuationOptions& c = options.continuation;
+  if (c.stop_predicate) {  // the engine sees scaled unknowns; the predicate is written for model units
+    c.stop_predicate = [this, user = c.stop_predicate](const Vector& v) { return user(scaled_->FromScaled(v)); };
+  }
+  if (on_point) {
+    c.progress_components.clear();  // ProgressInfo::values = all of u
+    c.progress = [this, on_point](const ProgressInfo& info) {
+      const Vector v = Eigen::Map<const Vector>(info.values.data(), static_cast<Eigen::Index>(info.values.size()));
+      on_point(info, scaled_->FromScaled(v));
+    };
+  }
+  return options;
+}
+
+void ModelExploration::ToModelUnits(BifurcationDiagram* diagram) const {
+  for (Branch& b : diagram->branches) {
+    for (ContinuationPoint& p : b.points) {
+      p.u = scaled_->FromScaled(p.u);
+      p.tangent = scaled_->FromScaled(p.tangent).normalized();
+    }
+    for (SpecialPoint& sp : b.special_points) {
+      if (sp.u.size()) sp.u = scaled_->FromScaled(sp.u);
+      if (sp.interval_width.size()) sp.interval_width = scaled_->FromScaled(sp.interval_width);
+    }
+  }
+  for (SpecialPoint& sp : diagram->special_points) {
+    if (sp.u.size()) sp.u = scaled_->FromScaled(sp.u);
+    if (sp.interval_width.size()) sp.interval_width = scaled_->FromScaled(sp.interval_width);
+  }
+}
+
+BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {
+  ExplorationOptions options = EngineOptions(on_point);
   Vector start = scenario_.start;
   if (state_) {
     std::string why;
@@ -146,17 +180,6 @@ BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {
       return failed;
     }
     start = state_->FromTimeBased(physical);
-  }
-  ContinuationOptions& c = options.continuation;
-  if (c.stop_predicate) {  // the engine sees scaled unknowns; the predicate is written for model units
-    c.stop_predicate = [this, user = c.stop_predicate](const Vector& v) { return user(scaled_->FromScaled(v)); };
-  }
-  if (on_point) {
-    c.progress_components.clear();  // ProgressInfo::values = all of u
-    c.progress = [&](const ProgressInfo& info) {
-      const Vector v = Eigen::Map<const Vector>(info.values.data(), static_cast<Eigen::Index>(info.values.size()));
-      on_point(info, scaled_->FromScaled(v));
-    };
   }
   if (!state_ && model_.setup().start.kind == StartSpec::Kind::kGuess) {
     // An approximate orbit (StartSpec::kGuess): Newton at the guess's level H, then explore from the
@@ -176,20 +199,21 @@ BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {
     start = scaled_->FromScaled(corrected);
   }
   BifurcationDiagram diagram = Explore(scaled_.get(), scaled_->ToScaled(start), options);
-  for (Branch& b : diagram.branches) {
-    for (ContinuationPoint& p : b.points) {
-      p.u = scaled_->FromScaled(p.u);
-      p.tangent = scaled_->FromScaled(p.tangent).normalized();
-    }
-    for (SpecialPoint& sp : b.special_points) {
-      if (sp.u.size()) sp.u = scaled_->FromScaled(sp.u);
-      if (sp.interval_width.size()) sp.interval_width = scaled_->FromScaled(sp.interval_width);
-    }
-  }
-  for (SpecialPoint& sp : diagram.special_points) {
-    if (sp.u.size()) sp.u = scaled_->FromScaled(sp.u);
-    if (sp.interval_width.size()) sp.interval_width = scaled_->FromScaled(sp.interval_width);
-  }
+  ToModelUnits(&diagram);
+  return diagram;
+}
+
+BifurcationDiagram ModelExploration::RunPeriodDoubled(const ShootingLayout& parent, const Vector& u_pd,
+                                                      const PointCallback& on_point) {
+  if (state_) throw std::invalid_argument("period-doubled families: the time-based formulation only");
+  // The doubled scales repeat the parent's (RepeatedModel's set-up), so the parent's are the first cycle's.
+  const Vector& s2 = scaled_->scales();
+  const int cycle = parent.xi_index(0), tail = parent.num_unknowns() - cycle;
+  Vector s(parent.num_unknowns());
+  s << s2.head(cycle), s2.tail(tail);
+  BifurcationDiagram diagram =
+      ExplorePeriodDoubled(scaled_.get(), parent, u_pd.cwiseQuotient(s), EngineOptions(on_point));
+  ToModelUnits(&diagram);
   return diagram;
 }
 

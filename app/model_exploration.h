@@ -48,6 +48,12 @@ class ModelExploration {
   // status is kStartFailed with the corrector's message.
   BifurcationDiagram Run(const PointCallback& on_point = PointCallback());
 
+  // The period-doubled family born at the PD point u_pd (model units, the parent's layout `parent`) of the
+  // parent of this exploration's model, RepeatedModel(parent, 2) (time-based formulation):
+  // ExplorePeriodDoubled on the scaled problem, points reported and returned as by Run.
+  BifurcationDiagram RunPeriodDoubled(const ShootingLayout& parent, const Vector& u_pd,
+                                      const PointCallback& on_point = PointCallback());
+
   // The time-based map (also used by the state-based formulation to find its start).
   TimeBasedShooting& shooting() { return shooting_; }
   ZeroProblem& problem();
@@ -60,6 +66,10 @@ class ModelExploration {
   long num_evaluations() const;
 
  private:
+  // The run's options in scaled units with the callbacks converting to model units.
+  ExplorationOptions EngineOptions(const PointCallback& on_point);
+  // The diagram's points and special points from scaled to model units.
+  void ToModelUnits(BifurcationDiagram* diagram) const;
   // The first physical point of the time-based scenario, or an empty vector (message in *why).
   Vector FindPhysicalStart(std::string* why);
 

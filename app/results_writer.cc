@@ -132,31 +132,45 @@ bool ResultsWriter::WriteFailed(const fs::path& file) {
   return false;
 }
 
+void ResultsWriter::SetBranchModel(int branch_id, const HybridModel& model) {
+  branch_models_.insert_or_assign(branch_id, BranchModel{ShootingLayout(model), OrbitPresentation(model)});
+}
+
+void ResultsWriter::AnnotateBranch(int branch_id, const nlohmann::json& fields) {
+  for (nlohmann::json& b : summary_["branches"]) {
+    if (b["id"] == branch_id) b.update(fields);
+  }
+  WriteSummary();
+}
+
 void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
   if (!write_error_.empty()) return;  // a full disk: keep what is there, write nothing more
+  const auto other = branch_models_.find(branch_id);
+  const ShootingLayout& layout = other == branch_models_.end() ? layout_ : other->second.layout;
+  const OrbitPresentation& presentation = other == branch_models_.end() ? presentation_ : other->second.presentation;
   auto it = branch_files_.find(branch_id);
   if (it == branch_files_.end()) {
     it = branch_files_.emplace(branch_id, std::ofstream(dir_ / BranchFileName(branch_id))).first;
     std::ofstream& f = it->second;
     f << "index,H,T";
-    const auto& names = layout_.unknown_names();
-    for (int j = 0; j < layout_.num_first_integrals(); ++j) f << "," << names[layout_.xi_index(j)];
-    for (int i = 0; i < layout_.num_segments(); ++i) f << ",t" << i + 1;
-    for (int i = 0; i < layout_.num_segments(); ++i) {
-      for (int c = 0; c < layout_.dim(i); ++c) f << "," << names[layout_.state_offset(i) + c];
+    const auto& names = layout.unknown_names();
+    for (int j = 0; j < layout.num_first_integrals(); ++j) f << "," << names[layout.xi_index(j)];
+    for (int i = 0; i < layout.num_segments(); ++i) f << ",t" << i + 1;
+    for (int i = 0; i < layout.num_segments(); ++i) {
+      for (int c = 0; c < layout.dim(i); ++c) f << "," << names[layout.state_offset(i) + c];
     }
     f << ",physical,classification,residual,newton_iterations,step";
     for (const auto& [name, value] : p.extra) f << "," << name;
-    for (const std::string& name : presentation_.quantity_names()) f << "," << name;
+    for (const std::string& name : presentation.quantity_names()) f << "," << name;
     f << "\n";
   }
   std::ofstream& f = it->second;
   const Vector& u = p.u;
-  f << fmt::format("{},{:.17g},{:.17g}", p.index, u(layout_.H_index()), layout_.Period(u));
-  for (int j = 0; j < layout_.num_first_integrals(); ++j) f << fmt::format(",{:.17g}", u(layout_.xi_index(j)));
-  for (int i = 0; i < layout_.num_segments(); ++i) f << fmt::format(",{:.17g}", u(layout_.time_index(i)));
-  for (int i = 0; i < layout_.num_segments(); ++i) {
-    for (int c = 0; c < layout_.dim(i); ++c) f << fmt::format(",{:.17g}", u(layout_.state_offset(i) + c));
+  f << fmt::format("{},{:.17g},{:.17g}", p.index, u(layout.H_index()), layout.Period(u));
+  for (int j = 0; j < layout.num_first_integrals(); ++j) f << fmt::format(",{:.17g}", u(layout.xi_index(j)));
+  for (int i = 0; i < layout.num_segments(); ++i) f << fmt::format(",{:.17g}", u(layout.time_index(i)));
+  for (int i = 0; i < layout.num_segments(); ++i) {
+    for (int c = 0; c < layout.dim(i); ++c) f << fmt::format(",{:.17g}", u(layout.state_offset(i) + c));
   }
   f << fmt::format(",{},{},{:.3e},{},{:.6g}", p.classification.physical ? 1 : 0, ToString(p.classification.reason),
                    p.residual, p.newton_iterations, p.step);
@@ -164,7 +178,7 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
     if (std::isfinite(value)) f << fmt::format(",{:.10g}", value);
     else f << ",";  // not defined for this point (e.g. Floquet data of a non-physical orbit)
   }
-  for (const double value : presentation_.Quantities(u)) {
+  for (const double value : presentation.Quantities(u)) {
     if (std::isfinite(value)) f << fmt::format(",{:.17g}", value);
     else f << ",";
   }

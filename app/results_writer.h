@@ -55,6 +55,16 @@ struct PointRecord {
   std::vector<std::pair<std::string, double>> extra;
 };
 
+// The record of an accepted point u before its analysis: index, Newton iterations and step from `info`.
+inline PointRecord RecordOf(const ProgressInfo& info, const Vector& u) {
+  PointRecord record;
+  record.index = info.point_index;
+  record.u = u;
+  record.newton_iterations = info.newton_iterations;
+  record.step = info.step;
+  return record;
+}
+
 class ResultsWriter {
  public:
   // Creates dir if needed and checks that a file can be written in it. Throws std::invalid_argument
@@ -67,7 +77,13 @@ class ResultsWriter {
   // Throws ModelInputError for a model whose presentation does not evaluate (OrbitPresentation).
   ResultsWriter(std::filesystem::path dir, const HybridModel& model, nlohmann::json options);
 
+  // Branch `branch_id` is one of another model (a period-doubled family's, RepeatedModel(model, 2)): its
+  // CSV columns follow that model's layout and presentation. Call before its first point; `model` must
+  // outlive the writer.
+  void SetBranchModel(int branch_id, const HybridModel& model);
   void AddPoint(int branch_id, const PointRecord& point);
+  // Adds `fields` to the summary entry of branch `branch_id` (after EndBranch) and rewrites summary.json.
+  void AnnotateBranch(int branch_id, const nlohmann::json& fields);
   // Records the finished branch's metadata and rewrites summary.json.
   void EndBranch(const Branch& branch);
   void SetSpecialPoints(nlohmann::json special_points);
@@ -95,6 +111,11 @@ class ResultsWriter {
   ShootingLayout layout_;
   OrbitPresentation presentation_;
   nlohmann::json summary_;
+  struct BranchModel {
+    ShootingLayout layout;
+    OrbitPresentation presentation;
+  };
+  std::map<int, BranchModel> branch_models_;  // branches of another model (SetBranchModel)
   std::map<int, std::ofstream> branch_files_;
   std::map<int, int> points_per_branch_;
   std::string write_error_;

@@ -23,10 +23,12 @@
 #include "figure_script.h"
 #include "floquet_points.h"
 #include "hybridcont/exploration.h"
+#include "hybridcont/period_doubling.h"
 #include "hybridcont/timebased_shooting.h"
 #include "model_exploration.h"
 #include "model_options.h"
 #include "orbit_analysis.h"
+#include "period_doubled_families.h"
 #include "results_writer.h"
 #include "run_setup.h"
 #include "scenario.h"
@@ -65,6 +67,8 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
                "trace every half-branch, also those that are images of traced ones under the model's symmetries");
   run->add_flag("--overwrite", args->overwrite,
                 "replace the results of another model in --out (without it such a folder is refused)");
+  run->add_flag("--period-doubling", args->period_doubling,
+                "explore the period-doubled family of every located PD point (the phase sequence traversed twice)");
   run->add_flag("--quiet", args->quiet, "no progress lines");
   run->add_flag("--no-plots", args->no_plots, "do not draw figures");
 }
@@ -96,11 +100,7 @@ class PointStream {
       log_.physical[info.branch_id].push_back(false);
       return;
     }
-    PointRecord record;
-    record.index = info.point_index;
-    record.u = u;
-    record.newton_iterations = info.newton_iterations;
-    record.step = info.step;
+    PointRecord record = RecordOf(info, u);
     AnalyzePoint(model_, setup_.integrator, floquet_map_, replay_options_, &record);
     log_.bp_tests[info.branch_id].push_back(record.extra[kBpColumn].second);
     log_.pd_tests[info.branch_id].push_back(record.extra[kPdColumn].second);
@@ -248,9 +248,16 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   nlohmann::json special_points = SpecialPointsJson(diagram, layout);
   const std::string floquet_report = LocateFloquetPoints(diagram, stream.log().bp_tests, stream.log().pd_tests,
                                                          stream.floquet_map(), layout, &special_points);
+  std::string period_doubled;
+  const std::unique_ptr<HybridModel> doubled =
+      args.period_doubling ? std::make_unique<HybridModel>(RepeatedModel(model, 2)) : nullptr;
+  if (doubled) {
+    period_doubled = ExplorePeriodDoubledFamilies(model, *doubled, setup, diagram, &special_points, writer, out, args.quiet);
+  }
   writer.SetSpecialPoints(special_points);
   WriteKeyframeOrbits(diagram, stream.log(), model, setup, layout, writer);
-  const std::string report = RunReport(diagram, floquet_report, start_time, exploration, stream.floquet_map());
+  const std::string report =
+      RunReport(diagram, floquet_report + period_doubled, start_time, exploration, stream.floquet_map());
   writer.SetReport(report);
   out << report;
   return FinishAndDraw(args, diagram, writer, out, err);

@@ -156,18 +156,6 @@ TEST(Floquet, ZeroDurationTransitionAndEquilibriaAreStatuses) {
 }
 
 
-// Bisection on the sign of test(H) along the closed-form hopping-in-place orbits.
-double Bisect(const std::function<double(double)>& test, double a, double b) {
-  const double fa = test(a);
-  EXPECT_LT(fa * test(b), 0.0) << "no sign change in [" << a << ", " << b << "]";
-  double lo = a, hi = b;
-  while (hi - lo > 1e-13) {
-    const double mid = 0.5 * (lo + hi);
-    ((test(mid) < 0.0) == (fa < 0.0) ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
 TEST(Floquet, SlipHoppingInPlaceChangesStabilityAtTheSbPointsOfTheContinuation) {
   // The nontrivial pair is the leg-angle (alpha) mode; hopping in place at k = 40, w2 = 5.
   // Measured (rtol 1e-10): H = 1.1: mu = 1.70796, -0.350128 (unstable); H = 1.4: mu = 0.645354, -0.543768

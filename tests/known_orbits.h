@@ -1,8 +1,12 @@
-// Closed-form periodic orbits of the built-in models, in the time-based layout (shared by tests).
+// Closed-form periodic orbits of the built-in models, in the time-based layout, and a bisection along them
+// (shared by tests).
 #ifndef HYBRIDCONT_TESTS_KNOWN_ORBITS_H_
 #define HYBRIDCONT_TESTS_KNOWN_ORBITS_H_
 
+#include <gtest/gtest.h>
+
 #include <cmath>
+#include <functional>
 
 #include "hybridcont/model.h"
 #include "hybridcont/shooting_layout.h"
@@ -43,6 +47,18 @@ inline Vector SlipHoppingInPlace(const HybridModel& slip, const ShootingLayout& 
   u(layout.state_offset(2) + 3) = -dl_takeoff;
   u(layout.H_index()) = H;
   return u;
+}
+
+// Bisection to 1e-13 on the sign of test(H), e.g. a Floquet test function along closed-form orbits.
+inline double Bisect(const std::function<double(double)>& test, double a, double b) {
+  const double fa = test(a);
+  EXPECT_LT(fa * test(b), 0.0) << "no sign change in [" << a << ", " << b << "]";
+  double lo = a, hi = b;
+  while (hi - lo > 1e-13) {
+    const double mid = 0.5 * (lo + hi);
+    ((test(mid) < 0.0) == (fa < 0.0) ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 }  // namespace hybridcont

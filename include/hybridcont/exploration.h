@@ -31,6 +31,7 @@
 #define HYBRIDCONT_EXPLORATION_H_
 
 #include <algorithm>
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -77,6 +78,11 @@ struct ExplorationOptions {
   // Map half-branches through the problem's symmetries instead of tracing them: a mapped branch costs
   // two evaluations instead of a trace.
   bool use_symmetries = true;
+  // Half-branches known outside this exploration: one leaving point u along direction v (either sign of
+  // a line) for which this returns true is not traced (a switch counts it as already known). Called on
+  // the exploring thread; must depend on (u, v) only. Example: the parent family traversed twice, in the
+  // exploration of a period-doubled family (period_doubling.h). Empty: none.
+  std::function<bool(const Vector& u, const Vector& v)> known_ray;
 
   std::string Validate() const;
 };

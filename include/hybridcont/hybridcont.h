@@ -17,6 +17,7 @@
 #include "hybridcont/model_setup.h"
 #include "hybridcont/models.h"
 #include "hybridcont/orbit_trace.h"
+#include "hybridcont/period_doubling.h"
 #include "hybridcont/poincare_map.h"
 #include "hybridcont/replay.h"
 #include "hybridcont/saltation.h"

@@ -103,6 +103,7 @@ std::unique_ptr<Explorer::Group> Explorer::SingularStart(const Vector& u0) {
   group->kind = Group::Kind::kSingularStart;
   for (const Vector& line : diagram_.start.directions) {
     for (const int d : {+1, -1}) {
+      if (options_.known_ray && options_.known_ray(u0, d * line)) continue;
       group->halves.push_back(FromPoint(id, d * line, d));
       group->halves.back()->job.depth = 1;
     }
@@ -134,6 +135,10 @@ std::unique_ptr<Explorer::Group> Explorer::SwitchGroup(const SpecialPoint& point
   const BranchSwitch& result = group->record.result;
   if (result.status == BranchSwitchStatus::kOk || result.status == BranchSwitchStatus::kFallback) {
     for (const int d : {+1, -1}) {
+      if (options_.known_ray && options_.known_ray(point.u, d * result.direction)) {
+        ++group->record.skipped;
+        continue;
+      }
       group->halves.push_back(FromPoint(point.u, d * result.direction, d));
       group->halves.back()->job.depth = depth;
     }

@@ -1,0 +1,163 @@
+#include "period_doubled_families.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <map>
+#include <vector>
+
+#include "floquet_points.h"
+#include "hybridcont/floquet.h"
+#include "hybridcont/period_doubling.h"
+#include "hybridcont/timebased_shooting.h"
+#include "model_exploration.h"
+#include "orbit_analysis.h"
+#include "scenario.h"
+#include "summary_json.h"
+
+namespace hybridcont::app {
+namespace {
+
+// The run's continuation options on the doubled layout: a bound or target on an unknown applies to each
+// of its copies, a sum bound to the sum over all copies (twice the parent's on repeated orbits).
+ExplorationOptions DoubledOptions(const ExplorationOptions& run, const ShootingLayout& parent) {
+  ExplorationOptions o = run;
+  ContinuationOptions& c = o.continuation;
+  c.bounds.clear();
+  for (const ComponentBound& b : run.continuation.bounds) {
+    for (const std::string& name : RepeatedNames(parent, b.component, 2)) c.bounds.push_back({name, b.lower, b.upper});
+  }
+  c.targets.clear();
+  for (const ComponentTarget& t : run.continuation.targets) {
+    for (const std::string& name : RepeatedNames(parent, t.component, 2)) c.targets.push_back({name, t.value});
+  }
+  c.sum_bounds.clear();
+  for (const SumBound& b : run.continuation.sum_bounds) {
+    SumBound doubled{{}, 2 * b.lower, 2 * b.upper};
+    for (const std::string& component : b.components) {
+      for (const std::string& name : RepeatedNames(parent, component, 2)) doubled.components.push_back(name);
+    }
+    c.sum_bounds.push_back(doubled);
+  }
+  o.start_conditions.clear();
+  return o;
+}
+
+// Ids of a diagram explored on its own, moved after the run's: branches by branch_offset, special points
+// by point_offset.
+void Renumber(int branch_offset, int point_offset, BifurcationDiagram* d) {
+  const auto branch = [&](int* id) { *id = *id >= 0 ? *id + branch_offset : *id; };
+  const auto point = [&](int* id) { *id = *id >= 0 ? *id + point_offset : *id; };
+  const auto special = [&](SpecialPoint* sp) { point(&sp->id), branch(&sp->branch_id), point(&sp->duplicate_of); };
+  for (Branch& b : d->branches) {
+    branch(&b.id), branch(&b.image_of), branch(&b.reflected_from), point(&b.parent_special_point);
+    for (SpecialPoint& sp : b.special_points) special(&sp);
+  }
+  for (SpecialPoint& sp : d->special_points) special(&sp);
+}
+
+// What the family's accepted points said, per branch id of the run.
+struct FamilyLog {
+  std::map<int, std::vector<double>> bp, pd, stable, H;
+};
+
+std::string Multipliers(const FloquetResult& f) {
+  std::string text;
+  for (const std::complex<double>& mu : f.nontrivial) {
+    text += fmt::format("{}{:.10g}{}", text.empty() ? "" : ", ", mu.real(),
+                        mu.imag() == 0 ? "" : fmt::format("{:+.3g}i", mu.imag()));
+  }
+  return text;
+}
+
+}  // namespace
+
+std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridModel& doubled, const RunSetup& setup,
+                                         const BifurcationDiagram& diagram, nlohmann::json* special_points,
+                                         ResultsWriter& writer, std::ostream& out, bool quiet) {
+  const ShootingLayout parent(model), layout(doubled);
+  const ExplorationOptions options = DoubledOptions(setup.exploration, parent);
+  const Scenario scenario = DefaultScenario(doubled);
+  TimeBasedShooting parent_map(model, setup.integrator), floquet_map(doubled, setup.integrator);
+  const ReplayOptions replay = ReplayOptionsFor(setup.integrator);
+  std::string report = "Period-doubled families (the phase sequence traversed twice, model " + doubled.name() + "):\n";
+  int next_branch = static_cast<int>(diagram.branches.size());
+  const nlohmann::json run_points = *special_points;
+  int families = 0;
+  for (const nlohmann::json& p : run_points) {
+    if (p["type"] != "PD" || p["status"] != "located") continue;
+    const std::vector<double> values = p["u"].get<std::vector<double>>();
+    const Vector u_pd = Eigen::Map<const Vector>(values.data(), static_cast<Eigen::Index>(values.size()));
+    const int pd_id = p["id"].get<int>();
+    const int offset = next_branch;
+    FamilyLog log;
+    ModelExploration exploration(doubled, scenario, setup.integrator, options);
+    BifurcationDiagram d = exploration.RunPeriodDoubled(parent, u_pd, [&](const ProgressInfo& info, const Vector& u) {
+      const int id = info.branch_id + offset;
+      if (log.H.find(id) == log.H.end()) writer.SetBranchModel(id, doubled);
+      PointRecord record = RecordOf(info, u);
+      AnalyzePoint(doubled, setup.integrator, floquet_map, replay, &record);
+      log.bp[id].push_back(record.extra[kBpColumn].second);
+      log.pd[id].push_back(record.extra[kPdColumn].second);
+      log.stable[id].push_back(record.extra[1].second);
+      log.H[id].push_back(u(layout.H_index()));
+      writer.AddPoint(id, record);
+      if (!quiet) {
+        out << fmt::format("  b{:<3} #{:<4} H = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {} (period-doubled)\n", id,
+                           info.point_index, u(layout.H_index()), layout.Period(u), info.step, info.newton_iterations,
+                           ToString(record.classification.reason));
+      }
+    });
+    const FloquetResult at_pd = ComputeFloquet(parent_map, u_pd);
+    report += fmt::format("  from PD #{} at H = {:.12f} (parent period {:.12f}, multipliers {}):\n", pd_id,
+                          u_pd(parent.H_index()), parent.Period(u_pd), at_pd.ok() ? Multipliers(at_pd) : "-");
+    if (d.status == ExplorationStatus::kStartFailed) {
+      report += "    not started: " + d.message + "\n";
+      continue;
+    }
+    ++families;
+    Renumber(offset, static_cast<int>(special_points->size()), &d);
+    for (SpecialPoint& sp : d.special_points) sp.message += " [period-doubled family of PD #" + std::to_string(pd_id) + "]";
+    for (nlohmann::json& j : SpecialPointsJson(d, layout)) {
+      j["period_doubled_from"] = pd_id;
+      special_points->push_back(j);
+    }
+    for (const Branch& b : d.branches) {
+      writer.EndBranch(b);
+      nlohmann::json changes = nlohmann::json::array();
+      const std::vector<double>& stable = log.stable[b.id];
+      double previous = std::nan("");
+      for (size_t i = 0; i < stable.size(); ++i) {
+        if (!std::isfinite(stable[i])) continue;
+        if (std::isfinite(previous) && stable[i] != previous) {
+          changes.push_back({{"after_point", i - 1}, {"H", log.H[b.id][i]}, {"stable", stable[i] == 1}});
+        }
+        previous = stable[i];
+      }
+      writer.AnnotateBranch(b.id, {{"period_doubled_from", pd_id},
+                                   {"model", doubled.name()},
+                                   {"unknowns", layout.unknown_names()},
+                                   {"stability_changes", changes}});
+      const Vector& start = b.points.empty() ? u_pd : b.points.front().u;
+      const FloquetResult f = b.points.empty() ? FloquetResult{} : ComputeFloquet(floquet_map, start);
+      std::string flips;
+      for (const nlohmann::json& c : changes) {
+        flips += fmt::format("{}H = {:.10f} ({})", flips.empty() ? "" : ", ", c["H"].get<double>(),
+                             c["stable"].get<bool>() ? "stable" : "unstable");
+      }
+      report += fmt::format("    branch {}: {} points, {}; start T = {:.12f} (2x parent {:.12f}), multipliers {}; "
+                            "stability changes: {}\n",
+                            b.id, b.points.size(), ToString(b.termination),
+                            b.points.empty() ? std::nan("") : layout.Period(start), 2 * parent.Period(u_pd),
+                            f.ok() ? Multipliers(f) : "-", flips.empty() ? "none" : flips);
+    }
+    for (const SpecialPoint& sp : d.special_points) report += "    " + sp.BriefReport(layout.unknown_names()) + "\n";
+    std::string floquet = LocateFloquetPoints(d, log.bp, log.pd, floquet_map, layout, special_points);
+    report += floquet.substr(floquet.find('\n') + 1);
+    next_branch += static_cast<int>(d.branches.size());
+  }
+  if (families == 0 && report.find("from PD") == std::string::npos) report += "  none (no located PD point)\n";
+  return report;
+}
+
+}  // namespace hybridcont::app
