@@ -29,6 +29,15 @@ class PhaseView : public Phase {
   void Reset(const Eigen::Ref<const Vector>& x, Vector* x_next, Matrix* D) const override {
     target_.Reset(x, x_next, D);
   }
+  bool has_parameter_derivatives() const override { return target_.has_parameter_derivatives(); }
+  void ParameterDerivatives(const Eigen::Ref<const Vector>& x, int parameter, Vector* field, Vector* integrals,
+                            double* event, Vector* reset) const override {
+    target_.ParameterDerivatives(x, parameter, field, integrals, event, reset);
+  }
+  void UnfoldedFieldParameterDerivative(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
+                                        int parameter, Vector* dfdp, bool include_mixed_term) const override {
+    target_.UnfoldedFieldParameterDerivative(x, xi, parameter, dfdp, include_mixed_term);
+  }
 
  protected:
   PhaseView(const Phase& target, int next_dim)
@@ -57,6 +66,15 @@ class SectionPhaseView : public PhaseView {
     if (x_next != nullptr) *x_next = x;
     if (D != nullptr) D->setIdentity(x.size(), x.size());
   }
+  bool has_parameter_derivatives() const override {
+    return PhaseView::has_parameter_derivatives() && anchor_.has_parameter_derivatives();
+  }
+  void ParameterDerivatives(const Eigen::Ref<const Vector>& x, int parameter, Vector* field, Vector* integrals,
+                            double* event, Vector* reset) const override {
+    PhaseView::ParameterDerivatives(x, parameter, field, integrals, nullptr, nullptr);
+    if (event != nullptr) *event = anchor_.ParameterDerivative(x, parameter);
+    if (reset != nullptr) reset->setZero(x.size());
+  }
 
  private:
   const Anchor& anchor_;
@@ -67,6 +85,10 @@ class AnchorView : public Anchor {
  public:
   explicit AnchorView(const Anchor& target) : target_(target) {}
   double Evaluate(const Eigen::Ref<const Vector>& x, RowVector* da) const override { return target_.Evaluate(x, da); }
+  bool has_parameter_derivatives() const override { return target_.has_parameter_derivatives(); }
+  double ParameterDerivative(const Eigen::Ref<const Vector>& x, int parameter) const override {
+    return target_.ParameterDerivative(x, parameter);
+  }
 
  private:
   const Anchor& target_;
