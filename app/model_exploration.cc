@@ -5,6 +5,7 @@
 
 #include "hybridcont/classification.h"
 #include "hybridcont/corrector.h"
+#include "hybridcont/floquet_test_functions.h"
 #include "hybridcont/internal/enum_names.h"
 #include "hybridcont/period_doubling.h"
 
@@ -29,6 +30,38 @@ namespace {
 constexpr internal::EnumName<Formulation> kFormulationNames[] = {
     {Formulation::kTimeBased, "time"},
     {Formulation::kStateBased, "state"},
+};
+
+// The Floquet test functions of the time-based map on the engine's unknowns: scaled u ./ s back to model
+// units, and for the state-based formulation expanded into the time-based layout (ToTimeBased on a map of
+// its own: each stepper evaluates on its own thread).
+class EngineFloquetTests : public TestFunctions {
+ public:
+  EngineFloquetTests(std::unique_ptr<TestFunctions> floquet, Vector scales, const StateBasedShooting* state)
+      : floquet_(std::move(floquet)), scales_(std::move(scales)), state_prototype_(state) {
+    if (state != nullptr) state_.reset(static_cast<StateBasedShooting*>(state->Clone().release()));
+  }
+  std::vector<SpecialPointType> types() const override { return floquet_->types(); }
+  void Evaluate(const Vector& v, bool branch_point, Vector* values) override {
+    Vector u = v.cwiseProduct(scales_);
+    if (state_ && !state_->ToTimeBased(Vector(u), &u).ok) {
+      *values = Vector::Constant(static_cast<Eigen::Index>(types().size()), std::nan(""));
+      return;
+    }
+    floquet_->Evaluate(u, branch_point, values);
+  }
+  std::unique_ptr<TestFunctions> Clone() const override {
+    return std::make_unique<EngineFloquetTests>(floquet_->Clone(), scales_, state_prototype_);
+  }
+  std::unique_ptr<TestFunctions> Refined(double factor) const override {
+    return std::make_unique<EngineFloquetTests>(floquet_->Refined(factor), scales_, state_prototype_);
+  }
+
+ private:
+  std::unique_ptr<TestFunctions> floquet_;
+  Vector scales_;
+  const StateBasedShooting* state_prototype_;  // the exploration's map, cloned per copy
+  std::unique_ptr<StateBasedShooting> state_;
 };
 
 }  // namespace
@@ -94,6 +127,8 @@ ModelExploration::ModelExploration(const HybridModel& model, const Scenario& sce
     }
   }
   if (const std::string why = options_.Validate(); !why.empty()) throw std::invalid_argument(why);
+  c.test_functions = std::make_shared<EngineFloquetTests>(std::make_unique<FloquetTestFunctions>(model_, integrator_),
+                                                           scales, state_.get());
 }
 
 ZeroProblem& ModelExploration::problem() {
