@@ -256,7 +256,9 @@ std::vector<SpecialPointDetector::CurveSample> SpecialPointDetector::StepSamples
   CurveSample end;
   end.point = b;
   end.step = index + 1;
-  if (cuts.size() > 2) {
+  // Where no function is defined at both branch points, none is in between: no samples to take.
+  const bool any_defined = (a.test_values.array().isFinite() && b.test_values.array().isFinite()).any();
+  if (cuts.size() > 2 && any_defined) {
     for (size_t i = 0; i + 1 < cuts.size(); ++i) {
       CurveSample mid;
       if (cuts[i + 1] > cuts[i] && CurvePoint(samples[0], end, 0.5 * (cuts[i] + cuts[i + 1]), &mid)) {
@@ -387,12 +389,29 @@ void SpecialPointDetector::DetectTestFunctions(size_t index, bool from_singular,
 
 void SpecialPointDetector::RedetectTestFunctions(size_t from, Branch* branch) {
   if (!functions_) return;
+  // Sampled anew; where every value is the mapped one (the symmetry leaves the functions invariant, e.g.
+  // a mirror that keeps the multipliers), the mapped zeros stand.
+  bool invariant = true;
+  for (size_t i = from; i < branch->points.size(); ++i) {
+    ContinuationPoint& p = branch->points[i];
+    const Vector mapped = p.test_values;
+    Sample(&p);
+    if (mapped.size() != p.test_values.size()) {
+      invariant = false;
+      continue;
+    }
+    for (Eigen::Index j = 0; j < mapped.size(); ++j) {
+      const double x = mapped(j), y = p.test_values(j);
+      const bool same = (std::isnan(x) && std::isnan(y)) || std::abs(x - y) <= kInvariantTolerance * std::abs(x);
+      invariant = invariant && same;
+    }
+  }
+  if (invariant) return;
   std::erase_if(branch->special_points, [from](const SpecialPoint& sp) {
     const bool test_zero = sp.type != SpecialPointType::kSimpleBifurcation &&
                            sp.type != SpecialPointType::kTurningPoint && sp.type != SpecialPointType::kSingularStart;
     return test_zero && sp.index >= static_cast<int>(from);
   });
-  for (size_t i = from; i < branch->points.size(); ++i) Sample(&branch->points[i]);
   for (size_t i = from; i + 1 < branch->points.size(); ++i) {
     DetectTestFunctions(i, i == 0 && branch->parent_special_point >= 0, branch);
   }

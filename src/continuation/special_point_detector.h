@@ -49,6 +49,9 @@ class SpecialPointDetector {
   static constexpr double kStartNoise = 1e-3;
   // Evaluations of the minimization that looks for a pair of zeros at a local minimum of |g|.
   static constexpr int kPairSearchEvaluations = 24;
+  // Relative agreement of a branch point's test values with the mapped ones at which a symmetry counts as
+  // leaving the test functions invariant (integration noise of the mapped and the image's evaluation).
+  static constexpr double kInvariantTolerance = 1e-6;
 
   // A turning point this close to an SB point of the same step, relative to the step, is taken to be at
   // it (docs/design/continuation.md, "Turning point at an SB point").
