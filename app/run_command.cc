@@ -218,17 +218,22 @@ std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayou
 }
 
 // The diagram's report, the Floquet points' and the wall time and work of the whole computation
-// (exploration, classification and replays, Floquet multipliers and their crossings, key-frame orbits, and
-// the branch and orbit files written on the way), before the summary, report and figures.
+// (exploration, classification and replays, Floquet multipliers, key-frame orbits, and the branch and orbit
+// files written on the way), before the summary, report and figures; the Floquet test functions' work on a
+// line of its own (ModelExploration::test_function_work: not the continuation's).
 std::string RunReport(const BifurcationDiagram& diagram, const std::string& floquet_report,
                       std::chrono::steady_clock::time_point start_time, const ModelExploration& exploration,
                       const TimeBasedShooting& floquet_map) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  const TestFunctionWork tests = exploration.test_function_work();
   return diagram.FullReport() + floquet_report +
          fmt::format("\nwall time {:.3f} s, {} right-hand-side evaluations in {} map evaluations; Floquet multipliers "
-                     "and their crossings: {} right-hand-side evaluations in {} map evaluations\n",
+                     "of the accepted points: {} right-hand-side evaluations in {} map evaluations\n"
+                     "Floquet test functions (BP and PD): {} right-hand-side evaluations in {} map evaluations, {} of "
+                     "them for curve points between branch points and the location of their zeros\n",
                      seconds, exploration.counters().rhs_evaluations, exploration.num_evaluations(),
-                     floquet_map.counters().rhs_evaluations, floquet_map.num_evaluations());
+                     floquet_map.counters().rhs_evaluations, floquet_map.num_evaluations(),
+                     tests.counters.rhs_evaluations, tests.evaluations, tests.curve_evaluations);
 }
 
 // Completes summary.json and draws the figures; the exit code of the run.

@@ -63,6 +63,9 @@ class FloquetTestFunctions : public TestFunctions {
 
   // Whether the orbit at u is physical and replays (what a branch point is checked for).
   bool Physical(const Vector& u) const;
+  // The map the multipliers and PeriodDoublingTest are computed with: its counters are this object's work
+  // (the classification and replay of branch points not included).
+  const TimeBasedShooting& shooting() const { return shooting_; }
 
  private:
   const HybridModel* model_;

@@ -32,6 +32,7 @@
 
 #include "hybridcont/special_point.h"
 #include "hybridcont/types.h"
+#include "hybridcont/zero_problem.h"
 
 namespace hybridcont {
 
@@ -54,6 +55,11 @@ class TestFunctions {
     (void)factor;
     return nullptr;
   }
+  // The work of the copy of the continued problem (ZeroProblem::Clone) on which a stepper found the curve
+  // points these functions needed (samples inside a step, the location of their zeros), handed over once,
+  // when that stepper is done. It is the test functions' work and is never counted as the continued
+  // problem's; a provider that reports its work adds it to its own counters (the default drops it).
+  virtual void AddCurveWork(const ZeroProblem& copy) { (void)copy; }
 };
 
 }  // namespace hybridcont

@@ -21,7 +21,8 @@ SpecialPointDetector::SpecialPointDetector(ZeroProblem* problem, Corrector* corr
       detect_bifurcations_(options.detect_bifurcations),
       check_integration_error_(options.check_integration_error),
       location_tolerance_(options.location_tolerance),
-      max_location_iterations_(options.max_location_iterations) {
+      max_location_iterations_(options.max_location_iterations),
+      corrector_options_(options.corrector) {
   std::vector<std::string> turning = options.turning_point_components;
   if (turning.empty() && !problem_->family_parameter().empty()) turning.push_back(problem_->family_parameter());
   for (const std::string& name : turning) {
@@ -32,6 +33,19 @@ SpecialPointDetector::SpecialPointDetector(ZeroProblem* problem, Corrector* corr
     functions_ = options.test_functions->Clone();
     function_types_ = functions_->types();
   }
+}
+
+SpecialPointDetector::~SpecialPointDetector() {
+  if (functions_ && test_problem_) functions_->AddCurveWork(*test_problem_);
+}
+
+SpecialPointDetector::Curve SpecialPointDetector::TestCurve() {
+  if (!test_problem_) {
+    test_problem_ = problem_->Clone();
+    if (!test_problem_) return ContinuationCurve();  // a serial problem: its work stays the problem's
+    test_corrector_ = std::make_unique<Corrector>(test_problem_.get(), corrector_options_);
+  }
+  return {test_problem_.get(), test_corrector_.get(), &test_solver_};
 }
 
 void SpecialPointDetector::Sample(ContinuationPoint* point) {
@@ -77,14 +91,14 @@ void SpecialPointDetector::Insert(std::vector<SpecialPoint> found, Branch* branc
 
 SpecialPoint SpecialPointDetector::Locate(SpecialPointType type, int k, const Test& test, size_t index,
                                           Branch* branch, std::vector<SpecialPoint>* bracket_only) {
-  return LocateOn(branch->points[index], branch->points[index + 1], type, k, test, nullptr, index, branch,
+  return LocateOn(ContinuationCurve(), branch->points[index], branch->points[index + 1], type, k, test, nullptr, index, branch,
                   bracket_only);
 }
 
-SpecialPoint SpecialPointDetector::LocateOn(const ContinuationPoint& a, const ContinuationPoint& b,
+SpecialPoint SpecialPointDetector::LocateOn(const Curve& curve, const ContinuationPoint& a, const ContinuationPoint& b,
                                             SpecialPointType type, int k, const Test& test, const Test* refined_test,
                                             size_t index, Branch* branch, std::vector<SpecialPoint>* bracket_only) {
-  Segment segment(corrector_, solver_, problem_, a, b, type == SpecialPointType::kSimpleBifurcation);
+  Segment segment(curve.corrector, curve.solver, curve.problem, a, b, type == SpecialPointType::kSimpleBifurcation);
   const RootLocation root = LocateRoot(&segment, test, location_tolerance_, max_location_iterations_);
   SpecialPoint point;
   point.type = type;
@@ -118,7 +132,7 @@ SpecialPoint SpecialPointDetector::LocateOn(const ContinuationPoint& a, const Co
   };
   cover(&point);
   bracket_only->push_back(point);
-  if (check_integration_error_) AddIntegrationError(&segment, root, test, refined_test ? *refined_test : test, &point);
+  if (check_integration_error_) AddIntegrationError(curve.problem, &segment, root, test, refined_test ? *refined_test : test, &point);
   cover(&point);
   branch->located_iterations += root.iterations;
   return point;
@@ -130,24 +144,24 @@ SpecialPoint SpecialPointDetector::LocateOn(const ContinuationPoint& a, const Co
 // from the computed one (δs, along the branch), the refined Newton correction how far the exact curve
 // may lie from the point (δu). Where δs or δu exceed the bracket, the interval and the componentwise
 // widths grow to cover them, and the message says so.
-void SpecialPointDetector::AddIntegrationError(Segment* segment, const RootLocation& root, const Test& test,
+void SpecialPointDetector::AddIntegrationError(ZeroProblem* problem, Segment* segment, const RootLocation& root, const Test& test,
                                                const Test& refined_test, SpecialPoint* point) {
   (void)test;
   constexpr double kFactor = ContinuationOptions::kIntegrationErrorFactor;
   constexpr double kScale = ContinuationOptions::kIntegrationErrorScale;
-  const std::unique_ptr<ZeroProblem> refined = problem_->Refined(kFactor);
+  const std::unique_ptr<ZeroProblem> refined = problem->Refined(kFactor);
   if (refined == nullptr) return;  // exact to rounding: the bracket is the precision
   const auto not_estimated = [point](const std::string& why) {
     if (!point->message.empty()) point->message += "; ";
     point->message += "integration error not estimated (" + why + "): the precision is the bracket's";
   };
-  if (root.estimate.u.size() != problem_->num_unknowns() || !(root.slope != 0)) {
+  if (root.estimate.u.size() != problem->num_unknowns() || !(root.slope != 0)) {
     return not_estimated("no test function slope");
   }
   Segment::Probe fine;
   Vector du;
   const bool ok = segment->RefinedProbe(refined.get(), root.estimate, &fine, &du);
-  problem_->AddWorkOf(*refined);
+  problem->AddWorkOf(*refined);
   if (!ok) return not_estimated("the evaluation at 0.1x the tolerances failed");
   const double change = std::abs(refined_test(fine) - root.test), refined_step = du.norm();
   du *= kScale;
@@ -219,7 +233,8 @@ double SpecialPointDetector::TestValue(int j, const Vector& u) {
 // A point of the curve inside the interval l–r: the cubic Hermite interpolant of the two samples at σ
 // (τ_lᵀ(u − u_l) = σ), corrected on that hyperplane (Segment::Evaluate).
 bool SpecialPointDetector::CurvePoint(const CurveSample& l, const CurveSample& r, double sigma, CurveSample* out) {
-  Segment segment(corrector_, solver_, problem_, l.point, r.point, false);
+  const Curve curve = TestCurve();
+  Segment segment(curve.corrector, curve.solver, curve.problem, l.point, r.point, false);
   Segment::Probe pl, pr, probe;
   std::string message;
   if (!segment.EndProbe(false, &pl, &message) || !segment.EndProbe(true, &pr, &message)) return false;
@@ -285,7 +300,7 @@ SpecialPoint SpecialPointDetector::LocateTestZero(int j, const CurveSample& l, c
     return values_(j);
   };
   std::vector<SpecialPoint> unused;
-  SpecialPoint point = LocateOn(l.point, r.point, function_types_[j], j, test, &refined, l.step, branch, &unused);
+  SpecialPoint point = LocateOn(TestCurve(), l.point, r.point, function_types_[j], j, test, &refined, l.step, branch, &unused);
   point.tangent_before = l.point.tangent;
   point.tangent_after = r.point.tangent;
   return point;

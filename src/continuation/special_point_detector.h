@@ -2,7 +2,10 @@
 // sign changes of the SB test and of the tangent components τ_k between two consecutive branch points,
 // each located by the root finder (branch_geometry.h), its integration error estimated, and a turning
 // point at an SB point of the same step given that point's precision; then the zeros of the test
-// functions (test_function.h) in that step, also pairs of them inside it.
+// functions (test_function.h) in that step, also pairs of them inside it. The curve points the test
+// functions need (samples inside a step, the location of their zeros) are found on a copy of the problem
+// of their own (ZeroProblem::Clone), whose work is handed to the test functions (TestFunctions::
+// AddCurveWork) when the detector is done: it is theirs, not the continued problem's.
 //
 //   SpecialPointDetector detector(&problem, &corrector, &solver, options);
 //   detector.Sample(&point);                               // test functions at each branch point
@@ -30,6 +33,10 @@ class SpecialPointDetector {
   // problem (ContinuationOptions::ValidateFor).
   SpecialPointDetector(ZeroProblem* problem, Corrector* corrector, BorderedSolver* solver,
                        const ContinuationOptions& options);
+  // Hands the test functions' copy of the problem to them (TestFunctions::AddCurveWork).
+  ~SpecialPointDetector();
+  SpecialPointDetector(const SpecialPointDetector&) = delete;
+  SpecialPointDetector& operator=(const SpecialPointDetector&) = delete;
 
   // The test functions at a branch point into point->test_values (left empty without test functions).
   void Sample(ContinuationPoint* point);
@@ -58,18 +65,29 @@ class SpecialPointDetector {
   static constexpr double kCoincidence = 1e-4;
 
  private:
+  // A problem with the corrector and solver that find points on its curve.
+  struct Curve {
+    ZeroProblem* problem;
+    Corrector* corrector;
+    BorderedSolver* solver;
+  };
+  // The continued problem's (SB and turning points).
+  Curve ContinuationCurve() { return {problem_, corrector_, solver_}; }
+  // The test functions' copy, made at its first use; the continued problem's if that has no Clone().
+  Curve TestCurve();
+
   // The special point of `type` where `test` changes sign between a and b (k: the turning component, or
   // −1), as its root finder left it (*bracket_only) and with its integration error (the result).
   SpecialPoint Locate(SpecialPointType type, int k, const Test& test, size_t index, Branch* branch,
                       std::vector<SpecialPoint>* bracket_only);
-  // The same between two points a, b of the curve inside step `index` (test functions: refined_test
-  // evaluates the test with the more accurate copy).
-  SpecialPoint LocateOn(const ContinuationPoint& a, const ContinuationPoint& b, SpecialPointType type, int k,
+  // The same between two points a, b of the curve inside step `index` on `curve` (test functions:
+  // refined_test evaluates the test with the more accurate copy).
+  SpecialPoint LocateOn(const Curve& curve, const ContinuationPoint& a, const ContinuationPoint& b, SpecialPointType type, int k,
                         const Test& test, const Test* refined_test, size_t index, Branch* branch,
                         std::vector<SpecialPoint>* bracket_only);
   // special_point.h, "Integration error": widens point's interval and componentwise widths by the
   // change the problem's refined copy shows at the root, and says so in its message.
-  void AddIntegrationError(Segment* segment, const RootLocation& root, const Test& test, const Test& refined_test,
+  void AddIntegrationError(ZeroProblem* problem, Segment* segment, const RootLocation& root, const Test& test, const Test& refined_test,
                            SpecialPoint* point);
   // A sample of the test functions on the curve: a branch point or a corrected point inside a step.
   struct CurveSample {
@@ -103,6 +121,10 @@ class SpecialPointDetector {
   int max_location_iterations_;
   std::unique_ptr<TestFunctions> functions_;  // the options' test functions (own copy), or nullptr
   std::unique_ptr<TestFunctions> refined_functions_;  // made at the first located zero
+  CorrectorOptions corrector_options_;
+  std::unique_ptr<ZeroProblem> test_problem_;  // the test functions' copy of problem_ (TestCurve)
+  std::unique_ptr<Corrector> test_corrector_;
+  BorderedSolver test_solver_;
   std::vector<SpecialPointType> function_types_;
   Vector values_;  // scratch
 };
