@@ -1,10 +1,12 @@
 #include "model_exploration.h"
 
 #include <algorithm>
+#include <mutex>
 #include <stdexcept>
 
 #include "hybridcont/classification.h"
 #include "hybridcont/corrector.h"
+#include "hybridcont/floquet_test_functions.h"
 #include "hybridcont/internal/enum_names.h"
 #include "hybridcont/period_doubling.h"
 
@@ -29,6 +31,86 @@ namespace {
 constexpr internal::EnumName<Formulation> kFormulationNames[] = {
     {Formulation::kTimeBased, "time"},
     {Formulation::kStateBased, "state"},
+};
+
+}  // namespace
+
+// Where every copy of the Floquet test functions leaves its work when it is done (the copies live on the
+// tracing threads): their maps' counters, and the curve copies' of the engine's scaled problem through a
+// scaling of a clone of the formulation's map (ScaledProblem::AddWorkOf forwards to it).
+class ModelExploration::TestWorkSink {
+ public:
+  TestWorkSink(const ZeroProblem& base, const Vector& scales) : inner_(base.Clone()), curve_(inner_.get(), scales) {}
+  void AddCurveWork(const ZeroProblem& copy) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    curve_.AddWorkOf(copy);
+  }
+  void AddMapWork(const ShootingProblem& map) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    work_.counters += map.counters();
+    work_.evaluations += map.num_evaluations();
+  }
+  TestFunctionWork work() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const auto& curve = dynamic_cast<const ShootingProblem&>(*inner_);  // a clone of a shooting map
+    TestFunctionWork w = work_;
+    w.counters += curve.counters();
+    w.evaluations += curve.num_evaluations();
+    w.curve_evaluations = curve.num_evaluations();
+    return w;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::unique_ptr<ZeroProblem> inner_;
+  ScaledProblem curve_;
+  TestFunctionWork work_;
+};
+
+namespace {
+
+// The Floquet test functions of the time-based map on the engine's unknowns: scaled u ./ s back to model
+// units, and for the state-based formulation expanded into the time-based layout (ToTimeBased on a map of
+// its own: each stepper evaluates on its own thread). Each copy leaves its work in `sink` when destroyed.
+class EngineFloquetTests : public TestFunctions {
+ public:
+  EngineFloquetTests(std::unique_ptr<TestFunctions> floquet, Vector scales, const StateBasedShooting* state,
+                     std::shared_ptr<ModelExploration::TestWorkSink> sink)
+      : floquet_(static_cast<FloquetTestFunctions*>(floquet.release())),  // Clone and Refined keep the type
+        scales_(std::move(scales)),
+        state_prototype_(state),
+        sink_(std::move(sink)) {
+    if (state != nullptr) state_.reset(static_cast<StateBasedShooting*>(state->Clone().release()));
+  }
+  ~EngineFloquetTests() override {
+    sink_->AddMapWork(floquet_->shooting());
+    if (state_) sink_->AddMapWork(*state_);
+  }
+  EngineFloquetTests(const EngineFloquetTests&) = delete;
+  EngineFloquetTests& operator=(const EngineFloquetTests&) = delete;
+  std::vector<SpecialPointType> types() const override { return floquet_->types(); }
+  void Evaluate(const Vector& v, bool branch_point, Vector* values) override {
+    Vector u = v.cwiseProduct(scales_);
+    if (state_ && !state_->ToTimeBased(Vector(u), &u).ok) {
+      *values = Vector::Constant(static_cast<Eigen::Index>(types().size()), std::nan(""));
+      return;
+    }
+    floquet_->Evaluate(u, branch_point, values);
+  }
+  std::unique_ptr<TestFunctions> Clone() const override {
+    return std::make_unique<EngineFloquetTests>(floquet_->Clone(), scales_, state_prototype_, sink_);
+  }
+  std::unique_ptr<TestFunctions> Refined(double factor) const override {
+    return std::make_unique<EngineFloquetTests>(floquet_->Refined(factor), scales_, state_prototype_, sink_);
+  }
+  void AddCurveWork(const ZeroProblem& copy) override { sink_->AddCurveWork(copy); }
+
+ private:
+  std::unique_ptr<FloquetTestFunctions> floquet_;
+  Vector scales_;
+  const StateBasedShooting* state_prototype_;  // the exploration's map, cloned per copy
+  std::unique_ptr<StateBasedShooting> state_;
+  std::shared_ptr<ModelExploration::TestWorkSink> sink_;
 };
 
 }  // namespace
@@ -94,6 +176,9 @@ ModelExploration::ModelExploration(const HybridModel& model, const Scenario& sce
     }
   }
   if (const std::string why = options_.Validate(); !why.empty()) throw std::invalid_argument(why);
+  test_work_ = std::make_shared<TestWorkSink>(base, scales);
+  c.test_functions = std::make_shared<EngineFloquetTests>(std::make_unique<FloquetTestFunctions>(model_, integrator_),
+                                                           scales, state_.get(), test_work_);
 }
 
 ZeroProblem& ModelExploration::problem() {
@@ -114,6 +199,8 @@ FlowCounters ModelExploration::counters() const { return state_ ? state_->counte
 long ModelExploration::num_evaluations() const {
   return state_ ? state_->num_evaluations() : shooting_.num_evaluations();
 }
+
+TestFunctionWork ModelExploration::test_function_work() const { return test_work_->work(); }
 
 Vector ModelExploration::FindPhysicalStart(std::string* why) {
   // Trace the time-based scenario's branches from its start until a point is physical.

@@ -28,6 +28,16 @@ std::string ToString(Formulation f);
 // "time" / "state"; false for anything else.
 bool FromString(const std::string& text, Formulation* f);
 
+// The work of the Floquet test functions (floquet_test_functions.h) of a run, summed over the copies of
+// every stepper: their own maps' (multipliers, PD test) and that of their copies of the engine's problem
+// (curve points inside a step, the location of BP and PD points). It is not the continuation's: as the
+// Floquet map's was before the test functions moved into the continuation, it is counted on its own.
+struct TestFunctionWork {
+  FlowCounters counters;
+  long evaluations = 0;        // map evaluations, both kinds
+  long curve_evaluations = 0;  // of which of the copies of the engine's problem
+};
+
 // Bounds, step sizes, depth and branch limits of the scenario.
 ExplorationOptions ScenarioExplorationOptions(const Scenario& scenario);
 
@@ -64,6 +74,10 @@ class ModelExploration {
   // Work of the formulation's map (RHS evaluations, map evaluations).
   FlowCounters counters() const;
   long num_evaluations() const;
+  // Work of the Floquet test functions so far (complete once Run has returned).
+  TestFunctionWork test_function_work() const;
+
+  class TestWorkSink;  // where the test functions' copies leave their work (model_exploration.cc)
 
  private:
   // The run's options in scaled units with the callbacks converting to model units.
@@ -82,6 +96,7 @@ class ModelExploration {
   std::unique_ptr<ScaledProblem> scaled_;
   ExplorationOptions options_;  // in scaled units
   ExplorationOptions time_options_;  // the time-based scenario's (model units), to find a state start
+  std::shared_ptr<TestWorkSink> test_work_;
 };
 
 }  // namespace hybridcont::app

@@ -6,7 +6,6 @@
 #include <map>
 #include <vector>
 
-#include "floquet_points.h"
 #include "hybridcont/floquet.h"
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/timebased_shooting.h"
@@ -58,7 +57,7 @@ void Renumber(int branch_offset, int point_offset, BifurcationDiagram* d) {
 
 // What the family's accepted points said, per branch id of the run.
 struct FamilyLog {
-  std::map<int, std::vector<double>> bp, pd, stable, H;
+  std::map<int, std::vector<double>> stable, H;
 };
 
 std::string Multipliers(const FloquetResult& f) {
@@ -82,13 +81,12 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
   const ReplayOptions replay = ReplayOptionsFor(setup.integrator);
   std::string report = "Period-doubled families (the phase sequence traversed twice, model " + doubled.name() + "):\n";
   int next_branch = static_cast<int>(diagram.branches.size());
-  const nlohmann::json run_points = *special_points;
   int families = 0;
-  for (const nlohmann::json& p : run_points) {
-    if (p["type"] != "PD" || p["status"] != "located") continue;
-    const std::vector<double> values = p["u"].get<std::vector<double>>();
-    const Vector u_pd = Eigen::Map<const Vector>(values.data(), static_cast<Eigen::Index>(values.size()));
-    const int pd_id = p["id"].get<int>();
+  for (const SpecialPoint& pd : diagram.special_points) {
+    const bool located_pd = pd.type == SpecialPointType::kPeriodDoubling && pd.status == LocationStatus::kLocated;
+    if (!located_pd || pd.duplicate_of >= 0 || pd.u.size() == 0) continue;
+    const Vector& u_pd = pd.u;
+    const int pd_id = pd.id;
     const int offset = next_branch;
     FamilyLog log;
     ModelExploration exploration(doubled, scenario, setup.integrator, options);
@@ -97,8 +95,6 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
       if (log.H.find(id) == log.H.end()) writer.SetBranchModel(id, doubled);
       PointRecord record = RecordOf(info, u);
       AnalyzePoint(doubled, setup.integrator, floquet_map, replay, &record);
-      log.bp[id].push_back(record.extra[kBpColumn].second);
-      log.pd[id].push_back(record.extra[kPdColumn].second);
       log.stable[id].push_back(record.extra[1].second);
       log.H[id].push_back(u(layout.H_index()));
       writer.AddPoint(id, record);
@@ -152,8 +148,6 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
                             f.ok() ? Multipliers(f) : "-", flips.empty() ? "none" : flips);
     }
     for (const SpecialPoint& sp : d.special_points) report += "    " + sp.BriefReport(layout.unknown_names()) + "\n";
-    std::string floquet = LocateFloquetPoints(d, log.bp, log.pd, floquet_map, layout, special_points);
-    report += floquet.substr(floquet.find('\n') + 1);
     next_branch += static_cast<int>(d.branches.size());
   }
   if (families == 0 && report.find("from PD") == std::string::npos) report += "  none (no located PD point)\n";

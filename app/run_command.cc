@@ -6,7 +6,7 @@
 // --threads > 1: branch by branch as the exploration merges them, in the order of --threads 1).
 //
 // The command's steps live in files of their own: run_setup.h (options -> validated set-up),
-// orbit_analysis.h (each accepted point), floquet_points.h (BP and PD points), summary_json.h (the
+// orbit_analysis.h (each accepted point), summary_json.h (the
 // options and special points in summary.json), figure_script.h (the figures).
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -21,7 +21,6 @@
 
 #include "commands.h"
 #include "figure_script.h"
-#include "floquet_points.h"
 #include "hybridcont/exploration.h"
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/timebased_shooting.h"
@@ -75,10 +74,9 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
 
 namespace {
 
-// The Floquet test functions and the physicality of the accepted points, per branch id and in the order of
-// the points (NaN and false where a point could not be converted to the time-based layout).
+// The physicality of the accepted points, per branch id and in the order of the points (false where a point
+// could not be converted to the time-based layout).
 struct PointLog {
-  std::map<int, std::vector<double>> bp_tests, pd_tests;
   std::map<int, std::vector<bool>> physical;
 };
 
@@ -95,15 +93,11 @@ class PointStream {
   void Add(const ProgressInfo& info, const Vector& u_problem) {
     Vector u;
     if (!exploration_.ToTimeBased(u_problem, &u).ok) {
-      log_.bp_tests[info.branch_id].push_back(std::nan(""));  // keep per-point alignment
-      log_.pd_tests[info.branch_id].push_back(std::nan(""));
-      log_.physical[info.branch_id].push_back(false);
+      log_.physical[info.branch_id].push_back(false);  // keep per-point alignment
       return;
     }
     PointRecord record = RecordOf(info, u);
     AnalyzePoint(model_, setup_.integrator, floquet_map_, replay_options_, &record);
-    log_.bp_tests[info.branch_id].push_back(record.extra[kBpColumn].second);
-    log_.pd_tests[info.branch_id].push_back(record.extra[kPdColumn].second);
     writer_.AddPoint(info.branch_id, record);
     log_.physical[info.branch_id].push_back(record.classification.physical);
     if (!args_.quiet) PrintProgress(info, record);
@@ -203,18 +197,43 @@ void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log,
   }
 }
 
+// The Floquet crossings among the diagram's special points (located by the exploration as test functions,
+// floquet_test_functions.h), one line each, BP before PD.
+std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayout& layout) {
+  std::string report = "Floquet special points (multiplier crossings on physical orbits):\n";
+  int count = 0;
+  for (const auto& [type, code] : {std::pair{SpecialPointType::kFloquetBranchPoint, "BP"},
+                                   std::pair{SpecialPointType::kPeriodDoubling, "PD"}}) {
+    for (const SpecialPoint& sp : diagram.special_points) {
+      if (sp.type != type || sp.u.size() == 0) continue;
+      const double precision = sp.interval_width.size() ? sp.interval_width.norm() : sp.precision();
+      report += fmt::format("  {} on branch {} after point {}: H = {:.12f}, T = {:.12f} ({}, precision {:.1e}){}\n", code,
+                            sp.branch_id, sp.index, sp.u(layout.H_index()), layout.Period(sp.u), ToString(sp.status),
+                            precision, sp.message.empty() ? "" : " " + sp.message);
+      ++count;
+    }
+  }
+  if (count == 0) report += "  none\n";
+  return report;
+}
+
 // The diagram's report, the Floquet points' and the wall time and work of the whole computation
-// (exploration, classification and replays, Floquet multipliers and their crossings, key-frame orbits, and
-// the branch and orbit files written on the way), before the summary, report and figures.
+// (exploration, classification and replays, Floquet multipliers, key-frame orbits, and the branch and orbit
+// files written on the way), before the summary, report and figures; the Floquet test functions' work on a
+// line of its own (ModelExploration::test_function_work: not the continuation's).
 std::string RunReport(const BifurcationDiagram& diagram, const std::string& floquet_report,
                       std::chrono::steady_clock::time_point start_time, const ModelExploration& exploration,
                       const TimeBasedShooting& floquet_map) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  const TestFunctionWork tests = exploration.test_function_work();
   return diagram.FullReport() + floquet_report +
          fmt::format("\nwall time {:.3f} s, {} right-hand-side evaluations in {} map evaluations; Floquet multipliers "
-                     "and their crossings: {} right-hand-side evaluations in {} map evaluations\n",
+                     "of the accepted points: {} right-hand-side evaluations in {} map evaluations\n"
+                     "Floquet test functions (BP and PD): {} right-hand-side evaluations in {} map evaluations, {} of "
+                     "them for curve points between branch points and the location of their zeros\n",
                      seconds, exploration.counters().rhs_evaluations, exploration.num_evaluations(),
-                     floquet_map.counters().rhs_evaluations, floquet_map.num_evaluations());
+                     floquet_map.counters().rhs_evaluations, floquet_map.num_evaluations(),
+                     tests.counters.rhs_evaluations, tests.evaluations, tests.curve_evaluations);
 }
 
 // Completes summary.json and draws the figures; the exit code of the run.
@@ -246,8 +265,7 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   if (formulation == Formulation::kStateBased) ConvertToTimeBased(exploration, layout, &diagram);
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
   nlohmann::json special_points = SpecialPointsJson(diagram, layout);
-  const std::string floquet_report = LocateFloquetPoints(diagram, stream.log().bp_tests, stream.log().pd_tests,
-                                                         stream.floquet_map(), layout, &special_points);
+  const std::string floquet_report = FloquetReport(diagram, layout);
   std::string period_doubled;
   const std::unique_ptr<HybridModel> doubled =
       args.period_doubling ? std::make_unique<HybridModel>(RepeatedModel(model, 2)) : nullptr;

@@ -13,6 +13,9 @@ std::string SpecialPointTypeCode(SpecialPointType type) {
     case SpecialPointType::kSimpleBifurcation: return "SB";
     case SpecialPointType::kTurningPoint: return "TP";
     case SpecialPointType::kSingularStart: return "start";
+    case SpecialPointType::kFloquetBranchPoint: return "BP";
+    case SpecialPointType::kPeriodDoubling: return "PD";
+    case SpecialPointType::kUserTestFunction: return "test";
   }
   return "?";
 }
@@ -60,8 +63,7 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
   for (const SpecialPoint& sp : d.special_points) {
     const double H = sp.u.size() ? sp.u(layout.H_index()) : std::nan("");
     const double precision_H = sp.interval_width.size() ? sp.interval_width(layout.H_index()) : std::nan("");
-    // "precision": the width of the interval that holds the point, as a distance in u (model units), like
-    // the Floquet points' (LocateFloquetPoints); state-based runs know the widths of their own unknowns
+    // "precision": the width of the interval that holds the point, as a distance in u (model units); state-based runs know the widths of their own unknowns
     // only (x̄_1, ξ, H̄; NaN for the rest). "precision_arclength": the same interval along the branch in
     // the engine's scaled arclength (SpecialPoint::precision()).
     const double precision_u =
@@ -85,28 +87,6 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
     list.push_back(j);
   }
   return list;
-}
-
-nlohmann::json FloquetPointJson(int id, const std::string& type, int branch, int index, const TestFunctionRoot& root,
-                                const ShootingLayout& layout) {
-  nlohmann::json j = {{"id", id},
-                      {"type", type},
-                      {"branch", branch},
-                      {"index", index},
-                      {"H", root.u(layout.H_index())},
-                      {"T", layout.Period(root.u)},
-                      {"status", root.located ? "located" : "bracketed"},
-                      {"precision", root.precision},
-                      // the same fields as the continuation's points: the width in H is bounded by the
-                      // distance in u; an arclength, residual and component they do not have
-                      {"precision_arclength", nullptr},
-                      {"precision_H", root.precision},
-                      {"residual", nullptr},
-                      {"component", ""},
-                      {"duplicate_of", -1},
-                      {"message", root.message}};
-  j["u"] = std::vector<double>(root.u.data(), root.u.data() + root.u.size());
-  return j;
 }
 
 }  // namespace hybridcont::app

@@ -1,6 +1,6 @@
 // The JSON that `hybridcont run` writes into summary.json beyond the writer's own: the effective options
-// and the special points, both the continuation's (SB, TP, start) and the Floquet crossings (BP, PD), with
-// one set of fields for every special point:
+// and the special points of the continuation (SB, TP, start, and the Floquet crossings BP and PD located
+// as test functions, floquet_test_functions.h), with one set of fields for every special point:
 //   {"id", "type", "branch", "index", "H", "T", "status", "precision", "precision_arclength",
 //    "precision_H", "residual", "component", "duplicate_of", "message", "u"}
 #ifndef HYBRIDCONT_APP_SUMMARY_JSON_H_
@@ -12,7 +12,6 @@
 #include "commands.h"
 #include "hybridcont/exploration.h"
 #include "hybridcont/shooting_layout.h"
-#include "hybridcont/test_function_root.h"
 #include "run_setup.h"
 
 namespace hybridcont::app {
@@ -23,10 +22,6 @@ nlohmann::json OptionsJson(const RunArguments& args, const RunSetup& setup);
 
 // The continuation's special points of `d` (u in the time-based layout described by `layout`).
 nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayout& layout);
-
-// A Floquet crossing ("BP" or "PD") located after point `index` of branch `branch`, numbered `id`.
-nlohmann::json FloquetPointJson(int id, const std::string& type, int branch, int index, const TestFunctionRoot& root,
-                                const ShootingLayout& layout);
 
 }  // namespace hybridcont::app
 

@@ -38,6 +38,7 @@
 
 #include "hybridcont/corrector.h"
 #include "hybridcont/special_point.h"
+#include "hybridcont/test_function.h"
 #include "hybridcont/types.h"
 #include "hybridcont/zero_problem.h"
 
@@ -102,6 +103,8 @@ struct ContinuationPoint {
   // Hadamard-normalized det([dr; τᵀ]) ∈ [−1, 1] (special_point.h); its sign flips across SB points.
   // 0 at a singular start point.
   double sb_test = 0;
+  // ContinuationOptions::test_functions at u (NaN where undefined); empty without test functions.
+  Vector test_values;
 };
 
 // What the progress callback sees after every accepted point (the library itself never prints).
@@ -149,6 +152,10 @@ struct ContinuationOptions {
   // problem's family parameter (ZeroProblem::family_parameter: "H", the level of a first integral, or
   // the free model parameter at fixed H̄), and none when it has none.
   std::vector<std::string> turning_point_components;
+  // Test (monitor) functions whose zeros are detected and located as special points (test_function.h):
+  // each stepper evaluates its own Clone(), so options stay copyable and threads share nothing mutable.
+  // nullptr: none.
+  std::shared_ptr<const TestFunctions> test_functions;
   // Width of the final root-finder bracket (in arclength) at which a special point counts as located.
   // 1e-11 makes located components exact to ~1e-11 (turning-point values to ~1e-20) when the
   // residual allows.

@@ -41,6 +41,10 @@ enum class SpecialPointType {
   kSimpleBifurcation,  // sign change of det([dr; τᵀ]); branches cross here (paper: SB point)
   kTurningPoint,       // sign change of the tangent component τ_k: the component has an extremum
   kSingularStart,      // a start point where dr has a kernel of dimension >= 2 (e.g. an equilibrium)
+  // Zeros of test functions (test_function.h), located on the branch like the two above:
+  kFloquetBranchPoint,  // a further Floquet multiplier crosses +1 (BP; floquet_test_functions.h)
+  kPeriodDoubling,      // a Floquet multiplier crosses −1 (PD; floquet_test_functions.h)
+  kUserTestFunction,    // a zero of a caller's test function
 };
 std::string ToString(SpecialPointType type);
 
@@ -58,12 +62,12 @@ struct SpecialPoint {
   int index = -1;              // lies between branch points [index] and [index + 1]
   double arclength = 0;        // arclength coordinate on the branch (from the branch start)
   std::string component;       // turning points: the unknown that turns; empty otherwise
-  int component_index = -1;
+  int component_index = -1;    // turning points: index of that unknown; test functions: index of the function
   Vector u;                    // best estimate of the point
   Vector tangent;              // tangent of the branch at u (SB points: see "Tangent of an SB point")
   Vector tangent_before;       // tangent at branch point [index]
   Vector tangent_after;        // tangent at branch point [index + 1]
-  double test_value = 0;       // test function at u (normalized determinant or τ_k)
+  double test_value = 0;       // test function at u (normalized determinant, τ_k or the test function's g)
   // Interval in the arclength coordinate (absolute on the branch) that holds the special point: the final
   // bracket, widened by the integration error where that is larger ("Integration error" above), and the
   // componentwise width of u over it: the honest precision of every component of u.

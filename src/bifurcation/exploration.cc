@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "bifurcation/explorer.h"
+#include "continuation/special_point_detector.h"
 #include "hybridcont/internal/enum_names.h"
 #include "hybridcont/internal/options_check.h"
 #include "hybridcont/invariant.h"
@@ -272,6 +273,9 @@ Branch Explorer::Traced(HalfBranch* half, int id) {
     Recall(half, /*wait=*/true);  // traced ahead for nothing
     half->progress.clear();
     if (options_.continuation.progress) images_.ReportImage(*image, &half->progress);
+    // A symmetry need not leave the test functions invariant (time reversal maps physical orbits to
+    // non-physical ones): their zeros on the image are found on the image.
+    RedetectTestFunctions(evaluator_, options_.continuation, 0, &*image);
     return std::move(*image);
   }
   if (half->job.with_worker) return TakeWorkerResult(half, id);

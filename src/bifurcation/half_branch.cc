@@ -3,6 +3,7 @@
 
 #include "bifurcation/branch_registry.h"
 #include "bifurcation/loop_reflection.h"
+#include "continuation/special_point_detector.h"
 #include "continuation/progress_report.h"
 #include "hybridcont/invariant.h"
 
@@ -49,8 +50,14 @@ class HalfBranchTrace {
  private:
   void PublishNewSbPoints() {
     if (!half_->job.publish) return;
-    for (const auto& specials = stepper_.branch().special_points; published_ < specials.size(); ++published_) {
-      if (specials[published_].type == SpecialPointType::kSimpleBifurcation) half_->job.publish(specials[published_]);
+    // Counted by kind: the test functions' zeros are inserted in arclength order, before earlier points.
+    size_t seen = 0;
+    for (const SpecialPoint& point : stepper_.branch().special_points) {
+      if (point.type != SpecialPointType::kSimpleBifurcation) continue;
+      if (seen++ == published_) {
+        half_->job.publish(point);
+        ++published_;
+      }
     }
   }
 
@@ -69,11 +76,17 @@ class HalfBranchTrace {
 
   // Every special point not yet looked at, as the midpoint of a loop reflected by a reversing symmetry.
   StepStatus CheckReflections() {
-    for (const auto& specials = stepper_.branch().special_points; checked_ < specials.size(); ++checked_) {
+    // SB and turning points only, counted by kind (test-function zeros are inserted before earlier points).
+    const auto& specials = stepper_.branch().special_points;
+    size_t seen = 0;
+    for (size_t m = 0; m < specials.size(); ++m) {
+      const SpecialPointType type = specials[m].type;
+      if (type != SpecialPointType::kSimpleBifurcation && type != SpecialPointType::kTurningPoint) continue;
+      if (seen++ < checked_) continue;
+      ++checked_;
       for (const Symmetry* g : reversing_) {
-        if (FindReflection(problem_, stepper_.branch(), static_cast<int>(checked_), *g, exploration_, &reflection_)) {
+        if (FindReflection(problem_, stepper_.branch(), static_cast<int>(m), *g, exploration_, &reflection_)) {
           stepper_.Terminate(TerminationReason::kClosedLoop, "");
-          ++checked_;
           return StepStatus::kFinished;
         }
       }
@@ -88,8 +101,8 @@ class HalfBranchTrace {
   std::vector<const Symmetry*> reversing_;
   ContinuationStepper stepper_;
   Reflection reflection_;
-  size_t checked_ = 0;    // special points looked at as midpoints
-  size_t published_ = 0;  // special points handed to job.publish
+  size_t checked_ = 0;    // SB and turning points looked at as midpoints
+  size_t published_ = 0;  // SB points handed to job.publish
 };
 
 }  // namespace
@@ -105,6 +118,8 @@ void TraceHalfBranch(ZeroProblem* problem, const ExplorationOptions& exploration
   const Reflection reflection = trace.Run();
   if (reflection.g == nullptr) return;
   CompleteByReflection(reflection, &half->branch);
+  // The reflected half's test functions: the reversing symmetry need not leave them invariant.
+  RedetectTestFunctions(problem, options, static_cast<size_t>(half->branch.reflected_from - 1), &half->branch);
   if (options.progress) ReportReflectedPoints(half->branch, ProgressIndices(half->options, *problem), &half->progress);
 }
 

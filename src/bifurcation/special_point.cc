@@ -12,6 +12,9 @@ constexpr internal::EnumName<SpecialPointType> kSpecialPointTypeNames[] = {
     {SpecialPointType::kSimpleBifurcation, "simple-bifurcation"},
     {SpecialPointType::kTurningPoint, "turning-point"},
     {SpecialPointType::kSingularStart, "singular-start"},
+    {SpecialPointType::kFloquetBranchPoint, "floquet-branch-point"},
+    {SpecialPointType::kPeriodDoubling, "period-doubling"},
+    {SpecialPointType::kUserTestFunction, "test-function-zero"},
 };
 
 constexpr internal::EnumName<LocationStatus> kLocationStatusNames[] = {

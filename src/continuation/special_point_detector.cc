@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <utility>
@@ -20,21 +21,49 @@ SpecialPointDetector::SpecialPointDetector(ZeroProblem* problem, Corrector* corr
       detect_bifurcations_(options.detect_bifurcations),
       check_integration_error_(options.check_integration_error),
       location_tolerance_(options.location_tolerance),
-      max_location_iterations_(options.max_location_iterations) {
+      max_location_iterations_(options.max_location_iterations),
+      corrector_options_(options.corrector) {
   std::vector<std::string> turning = options.turning_point_components;
   if (turning.empty() && !problem_->family_parameter().empty()) turning.push_back(problem_->family_parameter());
   for (const std::string& name : turning) {
     turning_.push_back(problem_->UnknownIndex(name));
     HYBRIDCONT_DEMAND(turning_.back() >= 0);  // ValidateFor checked the names
   }
+  if (options.test_functions) {
+    functions_ = options.test_functions->Clone();
+    function_types_ = functions_->types();
+  }
 }
 
-void SpecialPointDetector::Detect(size_t index, Branch* branch) {
+SpecialPointDetector::~SpecialPointDetector() {
+  if (functions_ && test_problem_) functions_->AddCurveWork(*test_problem_);
+}
+
+SpecialPointDetector::Curve SpecialPointDetector::TestCurve() {
+  if (!test_problem_) {
+    test_problem_ = problem_->Clone();
+    if (!test_problem_) return ContinuationCurve();  // a serial problem: its work stays the problem's
+    test_corrector_ = std::make_unique<Corrector>(test_problem_.get(), corrector_options_);
+  }
+  return {test_problem_.get(), test_corrector_.get(), &test_solver_};
+}
+
+void SpecialPointDetector::Sample(ContinuationPoint* point) {
+  if (!functions_) return;
+  functions_->Evaluate(point->u, true, &point->test_values);
+  HYBRIDCONT_DEMAND(point->test_values.size() == static_cast<Eigen::Index>(function_types_.size()));
+}
+
+void SpecialPointDetector::Detect(size_t index, bool from_singular, Branch* branch) {
   HYBRIDCONT_DEMAND(index + 1 < branch->points.size());
   const ContinuationPoint& a = branch->points[index];
   const ContinuationPoint& b = branch->points[index + 1];
   std::vector<SpecialPoint> found;
   std::vector<SpecialPoint> bracket_only;  // each found point as its root finder left it
+  if (from_singular) {
+    DetectTestFunctions(index, true, branch);
+    return;
+  }
   if (detect_bifurcations_ && a.sb_test != 0 && b.sb_test != 0 && std::signbit(a.sb_test) != std::signbit(b.sb_test)) {
     found.push_back(Locate(SpecialPointType::kSimpleBifurcation, -1,
                            [](const Segment::Probe& p) { return p.sb_test; }, index, branch, &bracket_only));
@@ -46,19 +75,30 @@ void SpecialPointDetector::Detect(size_t index, Branch* branch) {
     }
   }
   PlaceTurningPointsAtSbPoints(b.arclength - a.arclength, bracket_only, &found);
-  std::sort(found.begin(), found.end(),
-            [](const SpecialPoint& x, const SpecialPoint& y) { return x.arclength < y.arclength; });
+  Insert(std::move(found), branch);
+  DetectTestFunctions(index, false, branch);
+}
+
+void SpecialPointDetector::Insert(std::vector<SpecialPoint> found, Branch* branch) {
+  std::vector<SpecialPoint>& list = branch->special_points;
   for (SpecialPoint& point : found) {
-    point.id = static_cast<int>(branch->special_points.size());
-    branch->special_points.push_back(std::move(point));
+    const auto at = std::upper_bound(list.begin(), list.end(), point.arclength,
+                                     [](double s, const SpecialPoint& p) { return s < p.arclength; });
+    list.insert(at, std::move(point));
   }
+  for (size_t i = 0; i < list.size(); ++i) list[i].id = static_cast<int>(i);
 }
 
 SpecialPoint SpecialPointDetector::Locate(SpecialPointType type, int k, const Test& test, size_t index,
                                           Branch* branch, std::vector<SpecialPoint>* bracket_only) {
-  const ContinuationPoint& a = branch->points[index];
-  const ContinuationPoint& b = branch->points[index + 1];
-  Segment segment(corrector_, solver_, problem_, a, b, type == SpecialPointType::kSimpleBifurcation);
+  return LocateOn(ContinuationCurve(), branch->points[index], branch->points[index + 1], type, k, test, nullptr, index, branch,
+                  bracket_only);
+}
+
+SpecialPoint SpecialPointDetector::LocateOn(const Curve& curve, const ContinuationPoint& a, const ContinuationPoint& b,
+                                            SpecialPointType type, int k, const Test& test, const Test* refined_test,
+                                            size_t index, Branch* branch, std::vector<SpecialPoint>* bracket_only) {
+  Segment segment(curve.corrector, curve.solver, curve.problem, a, b, type == SpecialPointType::kSimpleBifurcation);
   const RootLocation root = LocateRoot(&segment, test, location_tolerance_, max_location_iterations_);
   SpecialPoint point;
   point.type = type;
@@ -67,7 +107,7 @@ SpecialPoint SpecialPointDetector::Locate(SpecialPointType type, int k, const Te
   point.index = static_cast<int>(index);
   point.arclength = a.arclength + root.sigma;
   point.component_index = k;
-  if (k >= 0) point.component = names_[k];
+  if (k >= 0 && type == SpecialPointType::kTurningPoint) point.component = names_[k];
   point.u = root.estimate.u;
   point.tangent = root.estimate.tangent;
   if (type == SpecialPointType::kSimpleBifurcation) {
@@ -92,7 +132,7 @@ SpecialPoint SpecialPointDetector::Locate(SpecialPointType type, int k, const Te
   };
   cover(&point);
   bracket_only->push_back(point);
-  if (check_integration_error_) AddIntegrationError(&segment, root, test, &point);
+  if (check_integration_error_) AddIntegrationError(curve.problem, &segment, root, test, refined_test ? *refined_test : test, &point);
   cover(&point);
   branch->located_iterations += root.iterations;
   return point;
@@ -104,25 +144,26 @@ SpecialPoint SpecialPointDetector::Locate(SpecialPointType type, int k, const Te
 // from the computed one (δs, along the branch), the refined Newton correction how far the exact curve
 // may lie from the point (δu). Where δs or δu exceed the bracket, the interval and the componentwise
 // widths grow to cover them, and the message says so.
-void SpecialPointDetector::AddIntegrationError(Segment* segment, const RootLocation& root, const Test& test,
-                                               SpecialPoint* point) {
+void SpecialPointDetector::AddIntegrationError(ZeroProblem* problem, Segment* segment, const RootLocation& root, const Test& test,
+                                               const Test& refined_test, SpecialPoint* point) {
+  (void)test;
   constexpr double kFactor = ContinuationOptions::kIntegrationErrorFactor;
   constexpr double kScale = ContinuationOptions::kIntegrationErrorScale;
-  const std::unique_ptr<ZeroProblem> refined = problem_->Refined(kFactor);
+  const std::unique_ptr<ZeroProblem> refined = problem->Refined(kFactor);
   if (refined == nullptr) return;  // exact to rounding: the bracket is the precision
   const auto not_estimated = [point](const std::string& why) {
     if (!point->message.empty()) point->message += "; ";
     point->message += "integration error not estimated (" + why + "): the precision is the bracket's";
   };
-  if (root.estimate.u.size() != problem_->num_unknowns() || !(root.slope != 0)) {
+  if (root.estimate.u.size() != problem->num_unknowns() || !(root.slope != 0)) {
     return not_estimated("no test function slope");
   }
   Segment::Probe fine;
   Vector du;
   const bool ok = segment->RefinedProbe(refined.get(), root.estimate, &fine, &du);
-  problem_->AddWorkOf(*refined);
+  problem->AddWorkOf(*refined);
   if (!ok) return not_estimated("the evaluation at 0.1x the tolerances failed");
-  const double change = std::abs(test(fine) - root.test), refined_step = du.norm();
+  const double change = std::abs(refined_test(fine) - root.test), refined_step = du.norm();
   du *= kScale;
   const double ds = kScale * change / std::abs(root.slope);
   if (!std::isfinite(ds)) return not_estimated("not finite");
@@ -179,6 +220,223 @@ void SpecialPointDetector::PlaceTurningPointsAtSbPoints(double step, const std::
       tp.message = bracket.message.empty() ? text.str() : bracket.message + "; " + text.str();
     }
   }
+}
+
+
+// ---- Test functions (test_function.h)
+
+double SpecialPointDetector::TestValue(int j, const Vector& u) {
+  functions_->Evaluate(u, false, &values_);
+  return values_(j);
+}
+
+// A point of the curve inside the interval l–r: the cubic Hermite interpolant of the two samples at σ
+// (τ_lᵀ(u − u_l) = σ), corrected on that hyperplane (Segment::Evaluate).
+bool SpecialPointDetector::CurvePoint(const CurveSample& l, const CurveSample& r, double sigma, CurveSample* out) {
+  const Curve curve = TestCurve();
+  Segment segment(curve.corrector, curve.solver, curve.problem, l.point, r.point, false);
+  Segment::Probe pl, pr, probe;
+  std::string message;
+  if (!segment.EndProbe(false, &pl, &message) || !segment.EndProbe(true, &pr, &message)) return false;
+  if (!segment.Evaluate(sigma, pl, 0, pr, segment.sigma_b(), &probe, &message)) return false;
+  out->point.u = probe.u;
+  out->point.tangent = probe.tangent.normalized();
+  out->point.arclength = l.point.arclength + (probe.u - l.point.u).norm();
+  out->point.sb_test = 0;
+  functions_->Evaluate(probe.u, false, &out->point.test_values);
+  out->step = l.step;
+  return true;
+}
+
+// The samples of step `index`: its two branch points and, when SB or turning points were located inside
+// it, the curve between them at the midpoints of the intervals they divide the step into (a fold and an
+// SB point in one step may hold a whole excursion of the multipliers between them).
+std::vector<SpecialPointDetector::CurveSample> SpecialPointDetector::StepSamples(size_t index, const Branch& branch) {
+  const ContinuationPoint& a = branch.points[index];
+  const ContinuationPoint& b = branch.points[index + 1];
+  std::vector<double> cuts = {0.0};
+  const double sigma_b = a.tangent.dot(b.u - a.u);
+  for (const SpecialPoint& sp : branch.special_points) {
+    const bool continuation_point =
+        sp.type == SpecialPointType::kSimpleBifurcation || sp.type == SpecialPointType::kTurningPoint;
+    if (!continuation_point || sp.index != static_cast<int>(index) || sp.u.size() != a.u.size()) continue;
+    const double sigma = a.tangent.dot(sp.u - a.u);
+    if (sigma > 0 && sigma < sigma_b) cuts.push_back(sigma);
+  }
+  cuts.push_back(sigma_b);
+  std::sort(cuts.begin(), cuts.end());
+  std::vector<CurveSample> samples(1);
+  samples[0].point = a;
+  samples[0].step = index;
+  CurveSample end;
+  end.point = b;
+  end.step = index + 1;
+  // Where no function is defined at both branch points, none is in between: no samples to take.
+  const bool any_defined = (a.test_values.array().isFinite() && b.test_values.array().isFinite()).any();
+  if (cuts.size() > 2 && any_defined) {
+    for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+      CurveSample mid;
+      if (cuts[i + 1] > cuts[i] && CurvePoint(samples[0], end, 0.5 * (cuts[i] + cuts[i + 1]), &mid)) {
+        mid.step = index;
+        // A function undefined at either branch point (a non-physical orbit) is undefined in between.
+        Vector& g = mid.point.test_values;
+        g = (a.test_values.array().isFinite() && b.test_values.array().isFinite()).select(g, std::nan(""));
+        samples.push_back(std::move(mid));
+      }
+    }
+  }
+  samples.push_back(std::move(end));
+  return samples;
+}
+
+SpecialPoint SpecialPointDetector::LocateTestZero(int j, const CurveSample& l, const CurveSample& r, Branch* branch) {
+  if (!refined_functions_ && check_integration_error_) {
+    refined_functions_ = functions_->Refined(ContinuationOptions::kIntegrationErrorFactor);
+  }
+  const Test test = [this, j](const Segment::Probe& p) { return TestValue(j, p.u); };
+  const Test refined = [this, j, &test](const Segment::Probe& p) {
+    if (!refined_functions_) return test(p);
+    refined_functions_->Evaluate(p.u, false, &values_);
+    return values_(j);
+  };
+  std::vector<SpecialPoint> unused;
+  SpecialPoint point = LocateOn(TestCurve(), l.point, r.point, function_types_[j], j, test, &refined, l.step, branch, &unused);
+  point.tangent_before = l.point.tangent;
+  point.tangent_after = r.point.tangent;
+  return point;
+}
+
+// Golden-section search for the minimum of sign·g_j on each of the intervals l–m and m–r (the one the
+// parabola through the three samples points to first), stopped at the first sample of the other sign.
+bool SpecialPointDetector::FindOtherSign(int j, double sign, const CurveSample& l, const CurveSample& m,
+                                         const CurveSample& r, CurveSample* found, bool* left) {
+  const auto value = [&](const CurveSample& c) { return sign * c.point.test_values(j); };
+  const double s0 = 0, s1 = (m.point.u - l.point.u).norm(), s2 = s1 + (r.point.u - m.point.u).norm();
+  const double g0 = value(l), g1 = value(m), g2 = value(r);
+  // Vertex of the parabola through the three samples (in chord length): which side to search first.
+  const double d1 = (g1 - g0) / (s1 - s0), d2 = (g2 - g1) / (s2 - s1);
+  const double curvature = (d2 - d1) / (s2 - s0);
+  const double vertex = curvature > 0 ? 0.5 * (s0 + s1) - d1 / (2 * curvature) : s1;
+  int budget = kPairSearchEvaluations;
+  for (const bool on_left : {vertex < s1, !(vertex < s1)}) {
+    const CurveSample& lo = on_left ? l : m;
+    const CurveSample& hi = on_left ? m : r;
+    const double width = lo.point.tangent.dot(hi.point.u - lo.point.u);
+    if (!(width > 0)) continue;
+    // Golden section on σ ∈ [0, width] of this interval, the minimum bracketed by the samples' values.
+    constexpr double kGolden = 0.6180339887498949;
+    double a = 0, b = width;
+    double x1 = b - kGolden * (b - a), x2 = a + kGolden * (b - a);
+    CurveSample c1, c2;
+    const auto eval = [&](double x, CurveSample* c) {
+      if (budget-- <= 0 || !CurvePoint(lo, hi, x, c)) return std::numeric_limits<double>::quiet_NaN();
+      return value(*c);
+    };
+    double f1 = eval(x1, &c1), f2 = eval(x2, &c2);
+    while (std::isfinite(f1) && std::isfinite(f2)) {
+      if (f1 < 0 || f2 < 0) {
+        *found = f1 < f2 ? c1 : c2;
+        *left = on_left;
+        return true;
+      }
+      if (b - a < 1e-6 * width) break;
+      if (f1 < f2) {
+        b = x2, x2 = x1, f2 = f1, c2 = c1;
+        x1 = b - kGolden * (b - a);
+        f1 = eval(x1, &c1);
+      } else {
+        a = x1, x1 = x2, f1 = f2, c1 = c2;
+        x2 = a + kGolden * (b - a);
+        f2 = eval(x2, &c2);
+      }
+    }
+  }
+  return false;
+}
+
+void SpecialPointDetector::DetectTestFunctions(size_t index, bool from_singular, Branch* branch) {
+  if (!functions_) return;
+  const std::vector<ContinuationPoint>& points = branch->points;
+  const int n = static_cast<int>(function_types_.size());
+  if (points[index].test_values.size() != n || points[index + 1].test_values.size() != n) return;
+  std::vector<CurveSample> samples = StepSamples(index, *branch);
+  // The previous branch point: a local minimum of |g| at this step's start spans both steps.
+  const bool with_previous = index >= 1 && points[index - 1].test_values.size() == n;
+  if (with_previous) {
+    CurveSample previous;
+    previous.point = points[index - 1];
+    previous.step = index - 1;
+    samples.insert(samples.begin(), std::move(previous));
+  }
+  const size_t first = with_previous ? 1 : 0;  // samples[first] is points[index]
+  std::vector<SpecialPoint> found;
+  for (int j = 0; j < n; ++j) {
+    const auto g = [&](size_t k) { return samples[k].point.test_values(j); };
+    const auto defined = [&](size_t k) { return std::isfinite(g(k)) && g(k) != 0; };
+    // The first interval from a bifurcation point: a test that vanishes there marks the parent's point.
+    const bool skip_first = from_singular && samples.size() > first + 1 && defined(first + 1) &&
+                            !(std::abs(g(first)) > kStartNoise * std::abs(g(first + 1)));
+    for (size_t k = first; k + 1 < samples.size(); ++k) {
+      if (k == first && skip_first) continue;
+      if (defined(k) && defined(k + 1) && std::signbit(g(k)) != std::signbit(g(k + 1))) {
+        found.push_back(LocateTestZero(j, samples[k], samples[k + 1], branch));
+      }
+    }
+    // Two zeros between samples: at a local minimum of |g| of one sign, minimize on the curve.
+    for (size_t k = std::max<size_t>(first, 1); k + 1 < samples.size(); ++k) {
+      if (!(defined(k - 1) && defined(k) && defined(k + 1))) continue;
+      const bool one_sign = std::signbit(g(k - 1)) == std::signbit(g(k)) && std::signbit(g(k)) == std::signbit(g(k + 1));
+      if (!one_sign || !(std::abs(g(k)) < std::abs(g(k - 1)) && std::abs(g(k)) <= std::abs(g(k + 1)))) continue;
+      CurveSample probe;
+      bool left = false;
+      if (!FindOtherSign(j, std::signbit(g(k)) ? -1.0 : 1.0, samples[k - 1], samples[k], samples[k + 1], &probe, &left)) {
+        continue;
+      }
+      const CurveSample& lo = left ? samples[k - 1] : samples[k];
+      const CurveSample& hi = left ? samples[k] : samples[k + 1];
+      probe.step = lo.step;
+      found.push_back(LocateTestZero(j, lo, probe, branch));
+      found.push_back(LocateTestZero(j, probe, hi, branch));
+    }
+  }
+  Insert(std::move(found), branch);
+}
+
+void SpecialPointDetector::RedetectTestFunctions(size_t from, Branch* branch) {
+  if (!functions_) return;
+  // Sampled anew; where every value is the mapped one (the symmetry leaves the functions invariant, e.g.
+  // a mirror that keeps the multipliers), the mapped zeros stand.
+  bool invariant = true;
+  for (size_t i = from; i < branch->points.size(); ++i) {
+    ContinuationPoint& p = branch->points[i];
+    const Vector mapped = p.test_values;
+    Sample(&p);
+    if (mapped.size() != p.test_values.size()) {
+      invariant = false;
+      continue;
+    }
+    for (Eigen::Index j = 0; j < mapped.size(); ++j) {
+      const double x = mapped(j), y = p.test_values(j);
+      const bool same = (std::isnan(x) && std::isnan(y)) || std::abs(x - y) <= kInvariantTolerance * std::abs(x);
+      invariant = invariant && same;
+    }
+  }
+  if (invariant) return;
+  std::erase_if(branch->special_points, [from](const SpecialPoint& sp) {
+    const bool test_zero = sp.type != SpecialPointType::kSimpleBifurcation &&
+                           sp.type != SpecialPointType::kTurningPoint && sp.type != SpecialPointType::kSingularStart;
+    return test_zero && sp.index >= static_cast<int>(from);
+  });
+  for (size_t i = from; i + 1 < branch->points.size(); ++i) {
+    DetectTestFunctions(i, i == 0 && branch->parent_special_point >= 0, branch);
+  }
+}
+
+void RedetectTestFunctions(ZeroProblem* problem, const ContinuationOptions& options, size_t from, Branch* branch) {
+  if (!options.test_functions) return;
+  Corrector corrector(problem, options.corrector);
+  BorderedSolver solver;
+  SpecialPointDetector(problem, &corrector, &solver, options).RedetectTestFunctions(from, branch);
 }
 
 }  // namespace hybridcont::internal

@@ -123,11 +123,12 @@ class ContinuationStepper::Impl {
       reason = TerminationReason::kClosedLoop;
       message = "the branch returned to its start point";
     }
+    if (reason != TerminationReason::kClosedLoop) detector_.Sample(&b);  // a closed loop's b is its start
     branch_.points.push_back(std::move(b));  // a is invalid from here on
     const size_t count = branch_.points.size();
     // The first interval of a branch from a singular point starts at the bifurcation point itself.
     const bool from_singular = start_singular_ && (count == 2 || reason == TerminationReason::kClosedLoop);
-    if (!from_singular) detector_.Detect(count - 2, &branch_);
+    detector_.Detect(count - 2, from_singular, &branch_);
     controller_.set_h(next_h);
     if (reason == TerminationReason::kNotFinished) {
       if (options_.stop_predicate && options_.stop_predicate(branch_.points.back().u)) {
@@ -156,6 +157,7 @@ class ContinuationStepper::Impl {
   StepStatus Begin(ContinuationPoint start, bool singular) {
     HYBRIDCONT_DEMAND(branch_.points.empty());  // one Start* per stepper
     start_singular_ = singular;
+    detector_.Sample(&start);
     branch_.points.push_back(std::move(start));
     Report();
     for (const LinearStop& stop : stops_.stops()) {

@@ -1,0 +1,80 @@
+// Floquet multipliers crossing +1 (BP) and −1 (PD) as test functions of the continuation
+// (test_function.h), on the time-based shooting map (timebased_shooting.h), and the smooth PD test
+// function of that map's Jacobian, which also serves as a defining equation of curves of PD points.
+//
+// PD test from the Jacobian (paper eq. `multishootJacobian`). A multiplier −1 means a solution of the
+// linearized problem that returns with its sign flipped after one period: the periodicity block
+// r_p = phi_1(t_{m+1}, x̄_{m+1}) − x̄_1 becomes phi_1 + x̄_1, i.e. its coupling C = [0 −I] becomes [0 +I].
+// A_+(u) is dr(u) with that flip, restricted to the rows of the m+1 blocks (shooting, event, periodicity,
+// anchor: the first-integral rows dropped) and the columns of the durations and states (ξ, H̄ and any
+// further free unknowns dropped): a square matrix of size Σn_i + m + 1. Eliminating the durations by the
+// event and anchor rows gives the saltation-chained return map P to the section (its eigenvalues: 0 along
+// f, the multipliers of the energy level and the trivial +1 of the energy direction), so
+//     det A_+(u) = c(u) · det(I + P) = c(u) · 2 ∏ (1 + μ_j)   over the nontrivial multipliers μ_j,
+// c(u) = ± ∏ de_i f~_i^- · (da f~) ≠ 0 on a transversal orbit. It vanishes exactly where a multiplier is
+// −1, smoothly (a polynomial in the entries of dr), with a regular zero where one real multiplier crosses
+// −1 (or a symplectic pair collides there). The normalization divides by the product of A_+'s row norms
+// (Hadamard: |value| <= 1), a smooth positive factor, so zeros and signs are those of det A_+.
+//
+// Contract of PeriodDoublingTest(dr, layout): dr is the N x (N+1) Jacobian of the time-based map at u (any
+// further columns after H̄ are ignored); the value is det A_+ / ∏ ||rows of A_+||, computed by an LU
+// factorization as a sign and a sum of logarithms; NaN if a row of A_+ is zero. A two-parameter defining
+// system for PD points takes r(u) = 0 and PeriodDoublingTest = 0 (or a bordered system on
+// PeriodDoublingMatrix).
+//
+// BP test: bp_test = ∏ (μ_j − 1) of the deflated monodromy (floquet.h): det of the reduced matrix minus I,
+// smooth; it changes sign where a real multiplier crosses +1 or a reciprocal pair collides at +1.
+//
+//   ContinuationOptions options;
+//   options.test_functions = std::make_shared<FloquetTestFunctions>(model, IntegratorOptions{});
+//   Branch b = TraceBranch(&shooting, u0, options);   // kFloquetBranchPoint / kPeriodDoubling points
+#ifndef HYBRIDCONT_FLOQUET_TEST_FUNCTIONS_H_
+#define HYBRIDCONT_FLOQUET_TEST_FUNCTIONS_H_
+
+#include <memory>
+#include <vector>
+
+#include "hybridcont/floquet.h"
+#include "hybridcont/shooting_layout.h"
+#include "hybridcont/test_function.h"
+#include "hybridcont/timebased_shooting.h"
+
+namespace hybridcont {
+
+// A_+(u) from dr (see above).
+Matrix PeriodDoublingMatrix(const Matrix& dr, const ShootingLayout& layout);
+// det A_+ / ∏ ||rows of A_+|| (see above).
+double PeriodDoublingTest(const Matrix& dr, const ShootingLayout& layout);
+
+// Test functions {kFloquetBranchPoint: bp_test, kPeriodDoubling: PeriodDoublingTest} at time-based points
+// u. With physical_only, a branch point whose orbit is not physical (classification.h) or whose
+// event-driven replay does not return (replay.h) has NaN values: the multipliers of a non-physical orbit
+// mean nothing for the mechanical system. Trial points between two branch points are not classified.
+class FloquetTestFunctions : public TestFunctions {
+ public:
+  // Keeps a reference to model (it must outlive this object and its clones).
+  FloquetTestFunctions(const HybridModel& model, const IntegratorOptions& integrator, bool physical_only = true);
+
+  std::vector<SpecialPointType> types() const override;
+  void Evaluate(const Vector& u, bool branch_point, Vector* values) override;
+  std::unique_ptr<TestFunctions> Clone() const override;
+  // The integrator tolerances times factor.
+  std::unique_ptr<TestFunctions> Refined(double factor) const override;
+
+  // Whether the orbit at u is physical and replays (what a branch point is checked for).
+  bool Physical(const Vector& u) const;
+  // The map the multipliers and PeriodDoublingTest are computed with: its counters are this object's work
+  // (the classification and replay of branch points not included).
+  const TimeBasedShooting& shooting() const { return shooting_; }
+
+ private:
+  const HybridModel* model_;
+  IntegratorOptions integrator_;
+  bool physical_only_;
+  TimeBasedShooting shooting_;
+  Matrix dr_;
+};
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_FLOQUET_TEST_FUNCTIONS_H_

@@ -1,0 +1,87 @@
+#include "hybridcont/floquet_test_functions.h"
+
+#include <Eigen/LU>
+#include <cmath>
+#include <limits>
+
+#include "hybridcont/classification.h"
+#include "hybridcont/orbit_trace.h"
+#include "hybridcont/replay.h"
+
+namespace hybridcont {
+
+Matrix PeriodDoublingMatrix(const Matrix& dr, const ShootingLayout& layout) {
+  const int rows = layout.first_integral_row(), cols = layout.xi_index();
+  HYBRIDCONT_DEMAND(rows == cols && dr.rows() >= rows && dr.cols() >= cols);
+  Matrix a = dr.topLeftCorner(rows, cols);
+  // The periodicity rows of block m+1 against x̄_1: −I becomes +I.
+  const int last = layout.num_segments() - 1;
+  a.block(layout.block_row(last), layout.state_offset(0), layout.dim(0), layout.dim(0)) *= -1.0;
+  return a;
+}
+
+double PeriodDoublingTest(const Matrix& dr, const ShootingLayout& layout) {
+  const Matrix a = PeriodDoublingMatrix(dr, layout);
+  double log_rows = 0;
+  for (Eigen::Index i = 0; i < a.rows(); ++i) {
+    const double norm = a.row(i).norm();
+    if (!(norm > 0)) return std::numeric_limits<double>::quiet_NaN();
+    log_rows += std::log(norm);
+  }
+  const Eigen::PartialPivLU<Matrix> lu(a);
+  const Matrix& lu_matrix = lu.matrixLU();
+  double sign = lu.permutationP().determinant();
+  double log_det = 0;
+  for (Eigen::Index i = 0; i < a.rows(); ++i) {
+    const double pivot = lu_matrix(i, i);
+    if (pivot == 0) return 0.0;
+    if (pivot < 0) sign = -sign;
+    log_det += std::log(std::abs(pivot));
+  }
+  return sign * std::exp(log_det - log_rows);
+}
+
+FloquetTestFunctions::FloquetTestFunctions(const HybridModel& model, const IntegratorOptions& integrator,
+                                           bool physical_only)
+    : model_(&model), integrator_(integrator), physical_only_(physical_only), shooting_(model, integrator) {
+  shooting_.set_threads(1);  // a stepper's own copy works on the stepper's thread
+}
+
+std::vector<SpecialPointType> FloquetTestFunctions::types() const {
+  return {SpecialPointType::kFloquetBranchPoint, SpecialPointType::kPeriodDoubling};
+}
+
+bool FloquetTestFunctions::Physical(const Vector& u) const {
+  Classification c;
+  if (!ClassifyByUnknowns(*model_, u, ClassificationOptions{}, &c)) {
+    const OrbitTrace trace(*model_, u, integrator_);
+    c = ClassifyOrbit(*model_, u, trace, ClassificationOptions{});
+  }
+  if (!c.physical) return false;
+  ReplayOptions replay;
+  replay.poincare.event.integrator.rtol = integrator_.rtol;
+  replay.poincare.event.integrator.atol = integrator_.atol;
+  return ReplayOrbit(*model_, u, replay).physical();
+}
+
+void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* values) {
+  *values = Vector::Constant(2, std::numeric_limits<double>::quiet_NaN());
+  if (branch_point && physical_only_ && !Physical(u)) return;
+  const FloquetResult floquet = ComputeFloquet(shooting_, u);
+  if (!floquet.ok()) return;
+  (*values)(0) = floquet.bp_test;
+  if (shooting_.Evaluate(u, nullptr, &dr_).ok) (*values)(1) = PeriodDoublingTest(dr_, shooting_.layout());
+}
+
+std::unique_ptr<TestFunctions> FloquetTestFunctions::Clone() const {
+  return std::make_unique<FloquetTestFunctions>(*model_, integrator_, physical_only_);
+}
+
+std::unique_ptr<TestFunctions> FloquetTestFunctions::Refined(double factor) const {
+  IntegratorOptions refined = integrator_;
+  refined.rtol *= factor;
+  refined.atol *= factor;
+  return std::make_unique<FloquetTestFunctions>(*model_, refined, physical_only_);
+}
+
+}  // namespace hybridcont
