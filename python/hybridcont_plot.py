@@ -521,6 +521,9 @@ class Results:
         self.phases = phases_of(self.summary)
         self.m = len(self.phases)
         self.unknowns = [u for u in (self.summary.get("unknowns") or []) if isinstance(u, str)]
+        # A run with a free parameter at fixed H: the parameter takes H's place in the generic figures.
+        free = (self.summary.get("options") or {}).get("free") or []
+        self.family = free[0] if free and isinstance(free[0], str) else "H"
         self.special_points = [sp for sp in (self.summary.get("special_points") or []) if isinstance(sp, dict)]
         self.branches = load_branches(results_dir, self.summary)
         for o in self.summary.get("orbits") or []:  # checked before anything is drawn
@@ -691,10 +694,10 @@ def save(fig, res, name, svg, written):
 
 def figure_h_t(res, svg, written):
     fig, ax = plt.subplots(figsize=(7.0, 4.8))
-    drawn, sp_styles = projection(ax, res, "T", "H")
+    drawn, sp_styles = projection(ax, res, "T", res.family)
     if not drawn:
         ax.text(0.5, 0.5, "no branch points", transform=ax.transAxes, ha="center", va="center", color="0.4")
-    ax.set_title(r"$\bar{H}$ over $T$: " + model_title(res), fontsize=10)
+    ax.set_title(column_symbol(res.family) + r" over $T$: " + model_title(res), fontsize=10)
     place_legend(fig, ax, legend_handles(res, drawn, sp_styles, res.has_stable()))
     save(fig, res, "H_T", svg, written)
 
@@ -713,17 +716,17 @@ def figure_h_t_xi(res, svg, written):
     drawn = []
     stable = res.has_stable()
     for b in res.branches:
-        xs, ys, zs = res.column(b, "T"), res.column(b, "xi"), res.column(b, "H")
+        xs, ys, zs = res.column(b, "T"), res.column(b, "xi"), res.column(b, res.family)
         if xs is None or ys is None or zs is None:
             continue
         t = b["table"]
         how = plot_runs(ax, xs, ys, t.num("physical"), t.num("stable") if stable else None, b["colour"], zs=zs)
         if how:
             drawn.append(dict(b, label=b["label"] + ("; a point here" if how == "point" else "")))
-    sp_styles = draw_special_points(ax, res, "T", "xi", zname="H")
+    sp_styles = draw_special_points(ax, res, "T", "xi", zname=res.family)
     ax.set_xlabel(axis_label("T"), fontsize=8)
     ax.set_ylabel(axis_label("xi"), fontsize=8)
-    ax.set_zlabel(axis_label("H"), fontsize=8)
+    ax.set_zlabel(axis_label(res.family), fontsize=8)
     ax.tick_params(labelsize=7)
     ax.view_init(elev=22, azim=-60)
     ax.set_title(r"$\bar{H}$ over $T$ and $\xi$: " + model_title(res), fontsize=10)
