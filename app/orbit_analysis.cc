@@ -30,6 +30,15 @@ void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator,
   record->residual = status.ok ? r.norm() : std::nan("");
 }
 
+bool IsPhysical(const HybridModel& model, const Vector& u, const IntegratorOptions& integrator) {
+  Classification c;
+  if (!ClassifyByUnknowns(model, u, ClassificationOptions{}, &c)) {
+    const OrbitTrace trace(model, u, integrator);
+    c = ClassifyOrbit(model, u, trace, ClassificationOptions{});
+  }
+  return c.physical;
+}
+
 void SetFreeParameters(const ShootingLayout& layout, const Vector& u, HybridModel* model) {
   for (int i = 0; i < layout.num_free_parameters(); ++i) {
     model->SetParameterValue(layout.parameter_model_index(i), u(layout.parameter_index(i)));

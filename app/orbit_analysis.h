@@ -28,6 +28,10 @@ ReplayOptions ReplayOptionsFor(const IntegratorOptions& integrator);
 void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator, TimeBasedShooting& floquet_map,
                   const ReplayOptions& replay_options, PointRecord* record);
 
+// Whether the time-based point u (the model's own layout) is a physical orbit of the model (classified by
+// its unknowns, or else along its trace).
+bool IsPhysical(const HybridModel& model, const Vector& u, const IntegratorOptions& integrator);
+
 // Sets the free parameters of `layout` on *model to their values in u.
 void SetFreeParameters(const ShootingLayout& layout, const Vector& u, HybridModel* model);
 // The orbit of a point u of `layout`: u without its free parameters (the model's own layout).

@@ -2,25 +2,12 @@
 
 #include <fmt/format.h>
 
-#include "hybridcont/classification.h"
 #include "hybridcont/corrector.h"
 #include "model_exploration.h"
+#include "orbit_analysis.h"
 
 namespace hybridcont::app {
 
-namespace {
-
-// Whether the time-based point u (the model's own layout) is a physical orbit of the model.
-bool IsPhysical(const HybridModel& model, const Vector& u, const IntegratorOptions& integrator) {
-  Classification c;
-  if (!ClassifyByUnknowns(model, u, ClassificationOptions{}, &c)) {
-    const OrbitTrace trace(model, u, integrator);
-    c = ClassifyOrbit(model, u, trace, ClassificationOptions{});
-  }
-  return c.physical;
-}
-
-}  // namespace
 
 ParameterStarts FindParameterStarts(const HybridModel& model, const RunSetup& setup, TimeBasedShooting& free_map) {
   ParameterStarts starts;

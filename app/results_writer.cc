@@ -103,7 +103,7 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
   // Remove the results of an earlier run in the same folder so that the folder describes this run only:
   // summary.json first (while the rest is removed the folder claims nothing), then the CSV files, the
   // figures (the generic ones and those the old summary declared) and the figure script's log.
-  std::set<std::string> figures = {"H_T", "H_T_xi", "keyframes"};
+  std::set<std::string> figures = {"H_T", "H_T_xi", "keyframes", "curves"};
   std::error_code ec;
   {
     std::ifstream f(dir_ / "summary.json");
@@ -121,7 +121,8 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
   for (const auto& entry : fs::directory_iterator(dir_, ec)) {
     const std::string name = entry.path().filename().string();
     const std::string ext = entry.path().extension().string();
-    const bool ours = ((name.rfind("branch-", 0) == 0 || name.rfind("orbit-", 0) == 0) && ext == ".csv") ||
+    const bool ours = ((name.rfind("branch-", 0) == 0 || name.rfind("orbit-", 0) == 0 || name.rfind("curve_", 0) == 0) &&
+                       ext == ".csv") ||
                       ((ext == ".png" || ext == ".svg") && figures.count(entry.path().stem().string())) ||
                       name == "plot.log" || name == "summary.json.tmp";
     if (ours && entry.is_regular_file(ec)) fs::remove(entry.path(), ec);

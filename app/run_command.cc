@@ -28,6 +28,7 @@
 #include "model_exploration.h"
 #include "model_options.h"
 #include "orbit_analysis.h"
+#include "parameter_curves.h"
 #include "parameter_starts.h"
 #include "period_doubled_families.h"
 #include "results_writer.h"
@@ -293,11 +294,16 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   if (doubled) {
     period_doubled = ExplorePeriodDoubledFamilies(model, *doubled, setup, diagram, &special_points, writer, out, args.quiet);
   }
+  std::string curves_report;
+  if (!setup.curve_parameter.empty()) {
+    writer.Annotate("curves", TraceParameterCurves(model, setup, diagram, writer.dir(), &curves_report));
+  }
   AddParameterValues(layout, &special_points);
   writer.SetSpecialPoints(special_points);
   WriteKeyframeOrbits(diagram, stream.log(), model, setup, layout, writer);
   const std::string report =
-      RunReport(diagram, starts_report + floquet_report + period_doubled, start_time, exploration, stream.floquet_map());
+      RunReport(diagram, starts_report + floquet_report + period_doubled + curves_report, start_time, exploration,
+                stream.floquet_map());
   writer.SetReport(report);
   out << report;
   return FinishAndDraw(args, diagram, writer, out, err);

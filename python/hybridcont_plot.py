@@ -1063,6 +1063,29 @@ def nice_length(s):
     return unit
 
 
+def figure_curves(res, svg, written):
+    """Two-parameter curves of special points (summary "curves") in the (parameter, H) plane."""
+    entries = [c for c in (res.summary.get("curves") or []) if isinstance(c, dict) and isinstance(c.get("file"), str)]
+    p = ((res.summary.get("options") or {}).get("curves") or {}).get("parameter")
+    if not entries or not isinstance(p, str):
+        return
+    fig, ax = plt.subplots(figsize=(7.0, 4.8))
+    for pos, c in enumerate(entries):
+        with open(os.path.join(res.dir, c["file"]), newline="") as f:
+            rows = list(csv.DictReader(f))
+        xs, ys = [to_float(r.get(p)) for r in rows], [to_float(r.get("H")) for r in rows]
+        ax.plot(xs, ys, color=branch_colour(pos), lw=1.6,
+                label="%s from special point %s" % (c.get("type"), c.get("special_point")))
+        for q in c.get("codim_two") or []:
+            ax.plot([to_float(q.get(p))], [to_float(q.get("H"))], "k*", ms=8)
+    ax.set_xlabel(axis_label(p), fontsize=9)
+    ax.set_ylabel(axis_label("H"), fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.set_title(r"special points in $(%s, \bar{H})$: " % p + model_title(res), fontsize=10)
+    ax.legend(fontsize=8)
+    save(fig, res, "curves", svg, written)
+
+
 def figure_keyframes(res, svg, written, n_frames=9):
     entries = [o for o in (res.summary.get("orbits") or []) if isinstance(o, dict)]
     if not entries:
@@ -1214,11 +1237,12 @@ def main(argv):
     jobs = [("H_T", lambda w: figure_h_t(res, args.svg, w))]
     if has_nonzero_xi(res):
         jobs.append(("H_T_xi", lambda w: figure_h_t_xi(res, args.svg, w)))
+    jobs.append(("curves", lambda w: figure_curves(res, args.svg, w)))
     if res.presentation is None:
         warn("%s has no 'presentation' (written by an older hybridcont): only the generic figures are drawn"
              % res.summary_path)
     else:
-        names = set(("H_T", "H_T_xi", "keyframes"))
+        names = set(("H_T", "H_T_xi", "keyframes", "curves"))
         for spec in res.presentation["figures"]:
             if spec["name"] in names:
                 warn("%s is declared twice or would overwrite a generic figure; skipped" % spec["file"])

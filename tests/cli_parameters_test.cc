@@ -2,6 +2,7 @@
 // (two-parameter curves of special points), against closed forms of the SLIP.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -99,6 +100,41 @@ TEST(CliParameters, SlipHoppingInPlaceInStiffnessMatchesTheClosedForm) {
     if (sp["type"] == "SB") sb = sp.contains("k") && sp["H"] == 1.5;
   }
   EXPECT_TRUE(sb);
+}
+
+// The SLIP's first SB point (H̄ = 1 + π²/40 at w2 = 5) continued in (w2, H̄) over [2, 10]: along the whole
+// curve H̄ = 1 + π²/(8 w2), the leg's swing half-period fitting the flight, whatever k.
+TEST(CliParameters, SlipFirstSbCurveInSwingFrequencyMatchesTheClosedForm) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_cli_curves_w2";
+  const CliResult r = RunTool({"run", "slip", "--curves", "w2", "--bound", "w2=2:10", "--out", dir.string(), "--quiet",
+                               "--threads", "1", "--overwrite"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json summary = ReadSummary(dir);
+  EXPECT_EQ(summary["options"]["curves"]["parameter"], "w2");
+  int first = -1;
+  for (const nlohmann::json& sp : summary["special_points"]) {
+    if (sp["type"] == "SB" && std::abs(sp["H"].get<double>() - (1 + M_PI * M_PI / 40)) < 1e-9 && first < 0) first = sp["id"];
+  }
+  ASSERT_GE(first, 0);
+  const nlohmann::json* curve = nullptr;
+  for (const nlohmann::json& c : summary["curves"]) {
+    if (c["special_point"] == first) curve = &c;
+  }
+  ASSERT_NE(curve, nullptr) << summary["curves"].dump();
+  EXPECT_EQ((*curve)["type"], "branch-point");
+  const auto columns = ReadColumns(dir / (*curve)["file"].get<std::string>());
+  const std::vector<double>&w2 = columns.at("w2"), &H = columns.at("H");
+  double worst = 0;
+  for (std::size_t i = 0; i < w2.size(); ++i) worst = std::max(worst, std::abs(H[i] - (1 + M_PI * M_PI / (8 * w2[i]))));
+  EXPECT_LT(worst, 1e-8);
+  EXPECT_NEAR(*std::min_element(w2.begin(), w2.end()), 2.0, 1e-9);
+  EXPECT_NEAR(*std::max_element(w2.begin(), w2.end()), 10.0, 1e-9);
+  EXPECT_GE(w2.size(), 10u);
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", worst);
+  RecordProperty("worst_deviation_from_closed_form", text);
+  RecordProperty("points", static_cast<int>(w2.size()));
+  EXPECT_TRUE(fs::exists(dir / "curves.png") || !r.err.empty());  // drawn where Python and matplotlib exist
 }
 
 }  // namespace
