@@ -41,6 +41,9 @@ struct RunArguments {
   bool no_symmetry = false;            // trace every half-branch instead of mapping images
   bool overwrite = false;              // replace another model's results in --out (refused otherwise)
   bool period_doubling = false;        // explore the period-doubled family of every located PD point
+  std::string free;                    // a model parameter continued as an unknown (needs `fix`)
+  std::string fix;                     // NAME=VALUE: the unknown held fixed while `free` varies, e.g. H=1.5
+  std::string curves;                  // a model parameter: trace special points in (H, it) after the run
 };
 void AddRunOptions(CLI::App* run, RunArguments* args);
 // Refuses an empty value ("--atol ''"): a mistake, not a request for the default. Returns option.

@@ -121,9 +121,12 @@ bool FromString(const std::string& text, Formulation* f) { return internal::Enum
 
 ModelExploration::ModelExploration(const HybridModel& model, const Scenario& scenario,
                                    const IntegratorOptions& integrator, ExplorationOptions options,
-                                   Formulation formulation)
+                                   Formulation formulation, FreeParameters free)
     : model_(model), scenario_(scenario), integrator_(integrator), formulation_(formulation),
-      shooting_(model, integrator), options_(std::move(options)), time_options_(options_) {
+      shooting_(model, integrator, free), options_(std::move(options)), time_options_(options_) {
+  if (!free.empty() && formulation_ == Formulation::kStateBased) {
+    throw std::invalid_argument("free parameters: the time-based formulation only");
+  }
   if (const std::string why = options_.continuation.ValidateFor(shooting_.unknown_names()); !why.empty()) {
     throw std::invalid_argument(why);
   }
@@ -177,7 +180,7 @@ ModelExploration::ModelExploration(const HybridModel& model, const Scenario& sce
   }
   if (const std::string why = options_.Validate(); !why.empty()) throw std::invalid_argument(why);
   test_work_ = std::make_shared<TestWorkSink>(base, scales);
-  c.test_functions = std::make_shared<EngineFloquetTests>(std::make_unique<FloquetTestFunctions>(model_, integrator_),
+  c.test_functions = std::make_shared<EngineFloquetTests>(std::make_unique<FloquetTestFunctions>(model_, integrator_, true, shooting_.free_parameters()),
                                                            scales, state_.get(), test_work_);
 }
 
@@ -221,7 +224,7 @@ Vector ModelExploration::FindPhysicalStart(std::string* why) {
   return found;
 }
 
-ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point) {
+ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point, int branch_offset) {
   ExplorationOptions options = options_;
   ContinuationOptions& c = options.continuation;
   if (c.stop_predicate) {  // the engine sees scaled unknowns; the predicate is written for model units
@@ -229,9 +232,11 @@ ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point
   }
   if (on_point) {
     c.progress_components.clear();  // ProgressInfo::values = all of u
-    c.progress = [this, on_point](const ProgressInfo& info) {
+    c.progress = [this, on_point, branch_offset](const ProgressInfo& info) {
       const Vector v = Eigen::Map<const Vector>(info.values.data(), static_cast<Eigen::Index>(info.values.size()));
-      on_point(info, scaled_->FromScaled(v));
+      ProgressInfo numbered = info;
+      numbered.branch_id += branch_offset;
+      on_point(numbered, scaled_->FromScaled(v));
     };
   }
   return options;
@@ -288,6 +293,94 @@ BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {
   BifurcationDiagram diagram = Explore(scaled_.get(), scaled_->ToScaled(start), options);
   ToModelUnits(&diagram);
   return diagram;
+}
+
+namespace {
+
+// Appends d to all, renumbering d's branches and special points after all's.
+void Append(BifurcationDiagram&& d, BifurcationDiagram* all) {
+  const int bo = static_cast<int>(all->branches.size()), so = static_cast<int>(all->special_points.size());
+  const auto renumber = [&](SpecialPoint& sp) {
+    sp.id += so, sp.branch_id += bo;
+    if (sp.duplicate_of >= 0) sp.duplicate_of += so;
+  };
+  for (Branch& b : d.branches) {
+    b.id += bo;
+    if (b.parent_special_point >= 0) b.parent_special_point += so;
+    if (b.image_of >= 0) b.image_of += bo;
+    for (SpecialPoint& sp : b.special_points) renumber(sp);
+    all->branches.push_back(std::move(b));
+  }
+  for (SpecialPoint& sp : d.special_points) renumber(sp), all->special_points.push_back(std::move(sp));
+  for (SwitchRecord& s : d.switches) {
+    if (s.special_point >= 0) s.special_point += so;
+    all->switches.push_back(std::move(s));
+  }
+  all->warnings.insert(all->warnings.end(), d.warnings.begin(), d.warnings.end());
+  if (d.status == ExplorationStatus::kMaxBranches) all->status = d.status;
+}
+
+}  // namespace
+
+bool ModelExploration::OnBranch(const BifurcationDiagram& d, const Vector& u) const {
+  const Vector& s = scaled_->scales();
+  const Vector x = u.cwiseQuotient(s);
+  // The chord sag of a step is a small fraction of it (curvature · step² / 8); a distinct family crosses a
+  // traced one at a visible angle, far from every chord but at the crossing itself.
+  constexpr double kSagFraction = 0.05;
+  for (const Branch& b : d.branches) {
+    for (std::size_t i = 0; i + 1 < b.points.size(); ++i) {
+      const Vector a = b.points[i].u.cwiseQuotient(s), c = b.points[i + 1].u.cwiseQuotient(s);
+      const Vector chord = c - a;
+      const double length2 = chord.squaredNorm();
+      const double t = length2 > 0 ? std::clamp((x - a).dot(chord) / length2, 0.0, 1.0) : 0.0;
+      const double distance = (x - a - t * chord).norm();
+      if (distance <= options_.known_branch_tolerance * (1 + x.norm()) + kSagFraction * std::sqrt(length2)) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+BifurcationDiagram ModelExploration::RunFromStarts(const std::vector<Vector>& starts, const PointCallback& on_point,
+                                                   int* skipped) {
+  BifurcationDiagram all;
+  all.unknown_names = problem().unknown_names();
+  *skipped = 0;
+  int started = 0;
+  std::string failures;
+  for (const Vector& start : starts) {
+    // A start whose image under a symmetry lies on a traced branch: its families are that branch's images,
+    // which the exploration maps where it maps images (use_symmetries), so they are not traced twice.
+    const std::vector<Symmetry> symmetries = options_.use_symmetries ? problem().symmetries() : std::vector<Symmetry>{};
+    const bool image_known = std::any_of(symmetries.begin(), symmetries.end(),
+                                         [&](const Symmetry& g) { return OnBranch(all, g.Apply(start)); });
+    if (OnBranch(all, start) || image_known) {
+      ++*skipped;
+      continue;
+    }
+    const int offset = static_cast<int>(all.branches.size());
+    if (offset >= options_.max_branches) {
+      all.status = ExplorationStatus::kMaxBranches;
+      break;
+    }
+    ExplorationOptions options = EngineOptions(on_point, offset);
+    options.max_branches = options_.max_branches - offset;
+    BifurcationDiagram d = Explore(scaled_.get(), scaled_->ToScaled(start), options);
+    if (d.status == ExplorationStatus::kStartFailed) {
+      failures += (failures.empty() ? "" : "; ") + d.message;
+      continue;
+    }
+    ToModelUnits(&d);
+    if (started++ == 0) all.start = d.start;
+    Append(std::move(d), &all);
+  }
+  if (started == 0) {
+    all.status = ExplorationStatus::kStartFailed;
+    all.message = starts.empty() ? "no start point" : "no start converged: " + failures;
+  }
+  return all;
 }
 
 BifurcationDiagram ModelExploration::RunPeriodDoubled(const ShootingLayout& parent, const Vector& u_pd,

@@ -48,8 +48,12 @@ class ModelExploration {
   // For the state-based formulation, bounds on components it lacks (durations) are dropped; the start
   // is the first physical point of the time-based scenario (the paper's singular starts with zero
   // durations are out of the state-based map's reach, Table `stateVStime`).
+  // With free parameters (time-based formulation only) the map's unknowns end with them and a fixing row
+  // holds the fixed unknown (shooting_layout.h, "Free parameters"); the families are explored from given
+  // starts (RunFromStarts).
   ModelExploration(const HybridModel& model, const Scenario& scenario, const IntegratorOptions& integrator,
-                   ExplorationOptions options, Formulation formulation = Formulation::kTimeBased);
+                   ExplorationOptions options, Formulation formulation = Formulation::kTimeBased,
+                   FreeParameters free = {});
 
   using PointCallback = std::function<void(const ProgressInfo& info, const Vector& u)>;
   // Explores from the start point; on_point sees every accepted point in model units and in the layout of
@@ -57,6 +61,15 @@ class ModelExploration {
   // guess (StartSpec::Kind::kGuess) is first corrected by Newton at its H; if that fails the diagram's
   // status is kStartFailed with the corrector's message.
   BifurcationDiagram Run(const PointCallback& on_point = PointCallback());
+
+  // Explores from each of `starts` (regular points, model units) in turn, one diagram: a start that lies on
+  // a branch traced (or mapped) from an earlier one, or whose image under one of the problem's symmetries
+  // does (with use_symmetries), is skipped (counted in *skipped): its families are already in the diagram,
+  // or are images of families in it. Branch and special-point ids run on from one start's exploration to the
+  // next, as on_point sees them; max_branches bounds the total. No starts, or none that converges, is
+  // kStartFailed.
+  BifurcationDiagram RunFromStarts(const std::vector<Vector>& starts, const PointCallback& on_point,
+                                   int* skipped);
 
   // The period-doubled family born at the PD point u_pd (model units, the parent's layout `parent`) of the
   // parent of this exploration's model, RepeatedModel(parent, 2) (time-based formulation):
@@ -81,7 +94,9 @@ class ModelExploration {
 
  private:
   // The run's options in scaled units with the callbacks converting to model units.
-  ExplorationOptions EngineOptions(const PointCallback& on_point);
+  ExplorationOptions EngineOptions(const PointCallback& on_point, int branch_offset = 0);
+  // Whether u (model units) lies on a branch of d: within the chord sag of one of its segments (scaled).
+  bool OnBranch(const BifurcationDiagram& d, const Vector& u) const;
   // The diagram's points and special points from scaled to model units.
   void ToModelUnits(BifurcationDiagram* diagram) const;
   // The first physical point of the time-based scenario, or an empty vector (message in *why).

@@ -17,17 +17,32 @@ ReplayOptions ReplayOptionsFor(const IntegratorOptions& integrator) {
 
 void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator, TimeBasedShooting& floquet_map,
                   const ReplayOptions& replay_options, PointRecord* record) {
-  const Vector& u = record->u;
+  const Vector u = OrbitPart(floquet_map.layout(), record->u);
   if (!ClassifyByUnknowns(model, u, ClassificationOptions{}, &record->classification)) {  // no trace needed
     const OrbitTrace trace(model, u, integrator);
     record->classification = ClassifyOrbit(model, u, trace, ClassificationOptions{});
   }
   // Floquet data first: its r + dr evaluation leaves r in the map's cache, so the residual below costs no
   // second integration on physical points.
-  AnalyzePhysicalOrbit(model, floquet_map, replay_options, u, record);
+  AnalyzePhysicalOrbit(model, floquet_map, replay_options, record->u, record);
   Vector r;
-  const EvaluationStatus status = floquet_map.Evaluate(u, &r, nullptr);
+  const EvaluationStatus status = floquet_map.Evaluate(record->u, &r, nullptr);
   record->residual = status.ok ? r.norm() : std::nan("");
+}
+
+bool IsPhysical(const HybridModel& model, const Vector& u, const IntegratorOptions& integrator) {
+  Classification c;
+  if (!ClassifyByUnknowns(model, u, ClassificationOptions{}, &c)) {
+    const OrbitTrace trace(model, u, integrator);
+    c = ClassifyOrbit(model, u, trace, ClassificationOptions{});
+  }
+  return c.physical;
+}
+
+void SetFreeParameters(const ShootingLayout& layout, const Vector& u, HybridModel* model) {
+  for (int i = 0; i < layout.num_free_parameters(); ++i) {
+    model->SetParameterValue(layout.parameter_model_index(i), u(layout.parameter_index(i)));
+  }
 }
 
 void AnalyzePhysicalOrbit(const HybridModel& model, TimeBasedShooting& floquet_map, const ReplayOptions& replay_options,
@@ -41,7 +56,7 @@ void AnalyzePhysicalOrbit(const HybridModel& model, TimeBasedShooting& floquet_m
     record->extra.push_back({"mu" + std::to_string(j + 1) + "_im", nan});
   }
   if (!record->classification.physical) return;
-  const ReplayResult replay = ReplayOrbit(model, u, replay_options);
+  const ReplayResult replay = ReplayOrbit(model, OrbitPart(floquet_map.layout(), u), replay_options);
   record->extra[0].second = replay.error;
   if (!replay.physical()) {
     record->classification = {false, OrbitClass::kReplayFailed, replay.message};

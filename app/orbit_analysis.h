@@ -20,10 +20,24 @@ constexpr int kPdColumn = 6;
 // Replay tolerances equal to the integrator's.
 ReplayOptions ReplayOptionsFor(const IntegratorOptions& integrator);
 
+// With free parameters in floquet_map's layout, record->u ends with their values: the orbit is the head of
+// u in the model's own layout, classified and replayed on `model`, which must carry those values
+// (SetFreeParameters); without, `model` is the map's model.
 // Classifies record->u (by its unknowns, or else along its trace), fills the extra columns
 // (AnalyzePhysicalOrbit) and the residual of floquet_map at u (NaN where it cannot be evaluated).
 void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator, TimeBasedShooting& floquet_map,
                   const ReplayOptions& replay_options, PointRecord* record);
+
+// Whether the time-based point u (the model's own layout) is a physical orbit of the model (classified by
+// its unknowns, or else along its trace).
+bool IsPhysical(const HybridModel& model, const Vector& u, const IntegratorOptions& integrator);
+
+// Sets the free parameters of `layout` on *model to their values in u.
+void SetFreeParameters(const ShootingLayout& layout, const Vector& u, HybridModel* model);
+// The orbit of a point u of `layout`: u without its free parameters (the model's own layout).
+inline Vector OrbitPart(const ShootingLayout& layout, const Vector& u) {
+  return u.head(layout.num_unknowns() - layout.num_free_parameters());
+}
 
 // Floquet multipliers, stability and the event-driven replay of a physical orbit. A physical point whose
 // replay does not return is reclassified "replay-failed". Columns of non-physical points stay empty

@@ -55,11 +55,14 @@ void ResultsWriter::PrepareDirectory(const fs::path& dir, const std::string& mod
 namespace {
 
 // What the figure script needs to know of the model's presentation (model_setup.h).
-nlohmann::json PresentationJson(const HybridModel& model, const OrbitPresentation& presentation) {
+nlohmann::json PresentationJson(const HybridModel& model, const OrbitPresentation& presentation,
+                                const FreeParameters& free) {
   const ModelSetup& setup = model.setup();
   nlohmann::json figures = nlohmann::json::array();
   for (const FigureSpec& f : setup.figures) {
-    figures.push_back({{"file", f.file}, {"title", f.title}, {"x", f.x}, {"y", f.y}, {"zoom", f.zoom_special_points}});
+    // At a fixed H the families vary in the free parameter: it takes H's place on the horizontal axis.
+    const std::string x = f.x == "H" && !free.parameters.empty() ? free.parameters.front() : f.x;
+    figures.push_back({{"file", f.file}, {"title", f.title}, {"x", x}, {"y", f.y}, {"zoom", f.zoom_special_points}});
   }
   nlohmann::json phases = nlohmann::json::object();
   for (const DrawingSpec::PhaseDrawing& d : setup.drawing.phases) {
@@ -76,8 +79,9 @@ nlohmann::json PresentationJson(const HybridModel& model, const OrbitPresentatio
 
 }  // namespace
 
-ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::json options)
-    : dir_(std::move(dir)), model_(model), layout_(model), presentation_(model) {
+ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::json options,
+                             const FreeParameters& free)
+    : dir_(std::move(dir)), model_(model), layout_(model, free), presentation_(model) {
   summary_["model"] = model.name();
   summary_["version"] = HYBRIDCONT_VERSION;
   summary_["description"] = model.description();
@@ -90,7 +94,7 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
   }
   summary_["phases"] = phases;
   summary_["unknowns"] = layout_.unknown_names();
-  summary_["presentation"] = PresentationJson(model, presentation_);
+  summary_["presentation"] = PresentationJson(model, presentation_, free);
   summary_["options"] = std::move(options);
   summary_["branches"] = nlohmann::json::array();
   summary_["special_points"] = nlohmann::json::array();
@@ -99,7 +103,7 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
   // Remove the results of an earlier run in the same folder so that the folder describes this run only:
   // summary.json first (while the rest is removed the folder claims nothing), then the CSV files, the
   // figures (the generic ones and those the old summary declared) and the figure script's log.
-  std::set<std::string> figures = {"H_T", "H_T_xi", "keyframes"};
+  std::set<std::string> figures = {"H_T", "H_T_xi", "keyframes", "curves"};
   std::error_code ec;
   {
     std::ifstream f(dir_ / "summary.json");
@@ -117,7 +121,8 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
   for (const auto& entry : fs::directory_iterator(dir_, ec)) {
     const std::string name = entry.path().filename().string();
     const std::string ext = entry.path().extension().string();
-    const bool ours = ((name.rfind("branch-", 0) == 0 || name.rfind("orbit-", 0) == 0) && ext == ".csv") ||
+    const bool ours = ((name.rfind("branch-", 0) == 0 || name.rfind("orbit-", 0) == 0 || name.rfind("curve_", 0) == 0) &&
+                       ext == ".csv") ||
                       ((ext == ".png" || ext == ".svg") && figures.count(entry.path().stem().string())) ||
                       name == "plot.log" || name == "summary.json.tmp";
     if (ours && entry.is_regular_file(ec)) fs::remove(entry.path(), ec);
@@ -154,6 +159,7 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
     std::ofstream& f = it->second;
     f << "index,H,T";
     const auto& names = layout.unknown_names();
+    for (int j = 0; j < layout.num_free_parameters(); ++j) f << "," << names[layout.parameter_index(j)];
     for (int j = 0; j < layout.num_first_integrals(); ++j) f << "," << names[layout.xi_index(j)];
     for (int i = 0; i < layout.num_segments(); ++i) f << ",t" << i + 1;
     for (int i = 0; i < layout.num_segments(); ++i) {
@@ -167,6 +173,7 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
   std::ofstream& f = it->second;
   const Vector& u = p.u;
   f << fmt::format("{},{:.17g},{:.17g}", p.index, u(layout.H_index()), layout.Period(u));
+  for (int j = 0; j < layout.num_free_parameters(); ++j) f << fmt::format(",{:.17g}", u(layout.parameter_index(j)));
   for (int j = 0; j < layout.num_first_integrals(); ++j) f << fmt::format(",{:.17g}", u(layout.xi_index(j)));
   for (int i = 0; i < layout.num_segments(); ++i) f << fmt::format(",{:.17g}", u(layout.time_index(i)));
   for (int i = 0; i < layout.num_segments(); ++i) {
@@ -178,7 +185,7 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
     if (std::isfinite(value)) f << fmt::format(",{:.10g}", value);
     else f << ",";  // not defined for this point (e.g. Floquet data of a non-physical orbit)
   }
-  for (const double value : presentation.Quantities(u)) {
+  for (const double value : presentation.Quantities(u.head(u.size() - layout.num_free_parameters()))) {
     if (std::isfinite(value)) f << fmt::format(",{:.17g}", value);
     else f << ",";
   }
@@ -212,6 +219,11 @@ void ResultsWriter::EndBranch(const Branch& b) {
     summary_["branches"].back()["reflected_from"] = b.reflected_from;
     summary_["branches"].back()["symmetry"] = b.symmetry;
   }
+  WriteSummary();
+}
+
+void ResultsWriter::Annotate(const std::string& key, nlohmann::json value) {
+  summary_[key] = std::move(value);
   WriteSummary();
 }
 

@@ -75,7 +75,12 @@ class ResultsWriter {
                                bool overwrite = false);
 
   // Throws ModelInputError for a model whose presentation does not evaluate (OrbitPresentation).
-  ResultsWriter(std::filesystem::path dir, const HybridModel& model, nlohmann::json options);
+  // With free parameters, points are in their layout: the CSV files have a column per parameter after T,
+  // and the model's figures that plot H on the horizontal axis plot the first parameter instead.
+  ResultsWriter(std::filesystem::path dir, const HybridModel& model, nlohmann::json options,
+                const FreeParameters& free = {});
+  // Sets a top-level field of summary.json (e.g. "curves") and rewrites it.
+  void Annotate(const std::string& key, nlohmann::json value);
 
   // Branch `branch_id` is one of another model (a period-doubled family's, RepeatedModel(model, 2)): its
   // CSV columns follow that model's layout and presentation. Call before its first point; `model` must

@@ -27,6 +27,8 @@
 #include "model_exploration.h"
 #include "model_options.h"
 #include "orbit_analysis.h"
+#include "parameter_curves.h"
+#include "parameter_starts.h"
 #include "period_doubled_families.h"
 #include "results_writer.h"
 #include "run_setup.h"
@@ -62,6 +64,14 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
                            "the other); the results do not depend on it"));
   NonEmpty(run->add_option("--formulation", args->formulation,
                            "time (default: time-based multiple shooting) or state (event-driven Poincare map)"));
+  NonEmpty(run->add_option("--free", args->free,
+                           "continue the families in a model parameter instead of H, e.g. k (needs --fix)"));
+  NonEmpty(run->add_option("--fix", args->fix,
+                           "the unknown held fixed while --free varies, NAME=VALUE, e.g. H=1.5; starts are the "
+                           "physical families' crossings of that value in the ordinary run"));
+  NonEmpty(run->add_option("--curves", args->curves,
+                           "after the run, continue every turning and SB point of the physical families in (H, "
+                           "PARAMETER), e.g. w2 (bounds: --bound PARAMETER=LO:HI)"));
   run->add_flag("--no-symmetry", args->no_symmetry,
                "trace every half-branch, also those that are images of traced ones under the model's symmetries");
   run->add_flag("--overwrite", args->overwrite,
@@ -88,7 +98,8 @@ class PointStream {
   PointStream(const RunArguments& args, const HybridModel& model, const RunSetup& setup, ModelExploration& exploration,
               ResultsWriter& writer, std::ostream& out)
       : args_(args), model_(model), setup_(setup), exploration_(exploration), writer_(writer), out_(out),
-        floquet_map_(model, setup.integrator), replay_options_(ReplayOptionsFor(setup.integrator)) {}
+        floquet_map_(model, setup.integrator, setup.free), replay_options_(ReplayOptionsFor(setup.integrator)),
+        point_model_(setup.free.empty() ? nullptr : std::make_unique<HybridModel>(model.Clone())) {}
 
   void Add(const ProgressInfo& info, const Vector& u_problem) {
     Vector u;
@@ -97,7 +108,8 @@ class PointStream {
       return;
     }
     PointRecord record = RecordOf(info, u);
-    AnalyzePoint(model_, setup_.integrator, floquet_map_, replay_options_, &record);
+    if (point_model_) SetFreeParameters(floquet_map_.layout(), u, point_model_.get());
+    AnalyzePoint(point_model_ ? *point_model_ : model_, setup_.integrator, floquet_map_, replay_options_, &record);
     writer_.AddPoint(info.branch_id, record);
     log_.physical[info.branch_id].push_back(record.classification.physical);
     if (!args_.quiet) PrintProgress(info, record);
@@ -114,8 +126,9 @@ class PointStream {
       out_ << fmt::format("branch {}\n", info.branch_id);
       current_branch_ = info.branch_id;
     }
-    out_ << fmt::format("  b{:<3} #{:<4} H = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {}\n", info.branch_id,
-                        info.point_index, record.u(layout.H_index()), layout.Period(record.u), info.step,
+    const int x = layout.num_free_parameters() > 0 ? layout.parameter_index(0) : layout.H_index();
+    out_ << fmt::format("  b{:<3} #{:<4} {} = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {}\n", info.branch_id,
+                        info.point_index, layout.unknown_names()[x], record.u(x), layout.Period(record.u), info.step,
                         info.newton_iterations, ToString(record.classification.reason));
   }
 
@@ -127,6 +140,7 @@ class PointStream {
   std::ostream& out_;
   TimeBasedShooting floquet_map_;
   const ReplayOptions replay_options_;
+  std::unique_ptr<HybridModel> point_model_;  // with free parameters: the model at the point's values
   PointLog log_;
   int current_branch_ = -1;
 };
@@ -191,7 +205,9 @@ void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log,
     const int best = KeyframePoint(b, flags == log.physical.end() ? none : flags->second, sc, layout);
     if (best < 0) continue;
     const Vector& u = b.points[best].u;
-    const OrbitTrace trace(model, u, setup.integrator);
+    HybridModel at_point = model.Clone();
+    SetFreeParameters(layout, u, &at_point);
+    const OrbitTrace trace(at_point, OrbitPart(layout, u), setup.integrator);
     writer.AddOrbit(trace, b.id, best, u(layout.H_index()), layout.Period(u), sc.describe(u));
     ++orbits;
   }
@@ -253,6 +269,16 @@ int FinishAndDraw(const RunArguments& args, const BifurcationDiagram& diagram, R
   return diagram.status == ExplorationStatus::kStartFailed ? 1 : 0;
 }
 
+// Each special point's free-parameter values as fields of their own, e.g. "k": 31.5 (also in "u").
+void AddParameterValues(const ShootingLayout& layout, nlohmann::json* special_points) {
+  for (nlohmann::json& sp : *special_points) {
+    if (!sp.contains("u") || !sp["u"].is_array() || sp["u"].size() != static_cast<size_t>(layout.num_unknowns())) continue;
+    for (int i = 0; i < layout.num_free_parameters(); ++i) {
+      sp[layout.unknown_names()[layout.parameter_index(i)]] = sp["u"][layout.parameter_index(i)];
+    }
+  }
+}
+
 // ---- 2. compute, streaming every accepted point; 3. summary, key-frame orbits, report, figures
 int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulation formulation,
                     const RunSetup& setup, ModelExploration& exploration, ResultsWriter& writer, std::ostream& out,
@@ -260,8 +286,22 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   const ShootingLayout& layout = exploration.shooting().layout();
   PointStream stream(args, model, setup, exploration, writer, out);
   const auto start_time = std::chrono::steady_clock::now();
-  BifurcationDiagram diagram =
-      exploration.Run([&](const ProgressInfo& info, const Vector& u_problem) { stream.Add(info, u_problem); });
+  const auto on_point = [&](const ProgressInfo& info, const Vector& u_problem) { stream.Add(info, u_problem); };
+  std::string starts_report;
+  BifurcationDiagram diagram;
+  if (setup.free.empty()) {
+    diagram = exploration.Run(on_point);
+  } else {
+    const ParameterStarts starts = FindParameterStarts(model, setup, exploration.shooting());
+    int skipped = 0;
+    diagram = exploration.RunFromStarts(starts.points, on_point, &skipped);
+    starts_report = starts.report + fmt::format("  {} of them on branches traced from earlier starts\n", skipped);
+    if (!args.quiet) out << starts_report;
+    writer.Annotate("starts", {{"crossings", starts.crossings},
+                               {"distinct", starts.points.size()},
+                               {"on_traced_branches", skipped},
+                               {"ordinary_half_branches", starts.ordinary_branches}});
+  }
   if (formulation == Formulation::kStateBased) ConvertToTimeBased(exploration, layout, &diagram);
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
   nlohmann::json special_points = SpecialPointsJson(diagram, layout);
@@ -272,10 +312,16 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   if (doubled) {
     period_doubled = ExplorePeriodDoubledFamilies(model, *doubled, setup, diagram, &special_points, writer, out, args.quiet);
   }
+  std::string curves_report;
+  if (!setup.curve_parameter.empty()) {
+    writer.Annotate("curves", TraceParameterCurves(model, setup, diagram, writer.dir(), &curves_report));
+  }
+  AddParameterValues(layout, &special_points);
   writer.SetSpecialPoints(special_points);
   WriteKeyframeOrbits(diagram, stream.log(), model, setup, layout, writer);
   const std::string report =
-      RunReport(diagram, floquet_report + period_doubled, start_time, exploration, stream.floquet_map());
+      RunReport(diagram, starts_report + floquet_report + period_doubled + curves_report, start_time, exploration,
+                stream.floquet_map());
   writer.SetReport(report);
   out << report;
   return FinishAndDraw(args, diagram, writer, out, err);
@@ -293,7 +339,8 @@ Formulation ParseFormulation(const std::string& text) {
 std::unique_ptr<ModelExploration> MakeExploration(const RunArguments& args, const HybridModel& model,
                                                   const RunSetup& setup, Formulation formulation) {
   try {
-    return std::make_unique<ModelExploration>(model, setup.scenario, setup.integrator, setup.exploration, formulation);
+    return std::make_unique<ModelExploration>(model, setup.scenario, setup.integrator, setup.exploration, formulation,
+                                              setup.free);
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(std::string(args.until.empty() && args.bounds.empty() ? "" : "--until/--bound: ") +
                                 e.what());
@@ -306,13 +353,20 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   // ---- 1. validate all input before anything is written
   HybridModel model = MakeModelWithOverrides(args.model, args.assignments, &err);
   const Formulation formulation = ParseFormulation(args.formulation);
+  if (!args.free.empty() && formulation == Formulation::kStateBased) {
+    throw std::invalid_argument("--formulation state: --free '" + args.free +
+                                "' needs the time-based formulation (the state-based map has no free parameters)");
+  }
+  if (!args.free.empty() && args.period_doubling) {
+    throw std::invalid_argument("--period-doubling: not with --free '" + args.free + "'");
+  }
   const RunSetup setup = MakeRunSetup(args, model);
   const nlohmann::json options_json = OptionsJson(args, setup);
   const std::unique_ptr<ModelExploration> exploration = MakeExploration(args, model, setup, formulation);
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / model.name() : fs::path(args.out_dir);
   ResultsWriter::PrepareDirectory(dir, model.name(), args.overwrite);
 
-  ResultsWriter writer(dir, model, options_json);
+  ResultsWriter writer(dir, model, options_json, setup.free);
   try {
     return ComputeAndWrite(args, model, formulation, setup, *exploration, writer, out, err);
   } catch (const std::exception& e) {

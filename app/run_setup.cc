@@ -102,18 +102,99 @@ void ApplyExplorationLimits(const RunArguments& args, ExplorationOptions* explor
   if (args.no_symmetry) exploration->use_symmetries = false;
 }
 
+// The default interval of a parameter p continued from its value v: its range within [v/4, 4v] (the
+// mirror interval for v < 0, [-1, 1] around 0): a factor of four either way covers the questions a run in
+// p answers (how a gait changes with stiffness, swing frequency) without reaching degenerate values.
+ComponentBound DefaultParameterBound(const HybridModel& model, const std::string& name) {
+  const ParameterInfo& info = model.parameters()[model.FindParameter(name)];
+  const double v = model.parameter(name);
+  double lower = v > 0 ? v / 4 : v < 0 ? 4 * v : -1.0, upper = v > 0 ? 4 * v : v < 0 ? v / 4 : 1.0;
+  lower = std::max(lower, info.range.lower);
+  upper = std::min(upper, info.range.upper);
+  return {name, lower, upper};
+}
+
+// The named parameter of the model, or std::invalid_argument naming the option and the value.
+void RequireParameter(const std::string& option, const HybridModel& model, const std::string& name) {
+  if (model.FindParameter(name) >= 0) return;
+  std::string known;
+  for (const ParameterInfo& info : model.parameters()) known += (known.empty() ? "" : ", ") + info.name;
+  throw std::invalid_argument(fmt::format("{} '{}': model '{}' has no such parameter (parameters: {})", option, name,
+                                          model.name(), known));
+}
+
+// --free/--fix: the parameter joins the unknowns (scale: its value, so that steps are relative to it), with
+// its default bound unless --bound names it. The ordinary run that gives the starts keeps the scenario's
+// options with an H bound widened to the fixed value.
+void ApplyFreeParameter(const RunArguments& args, const HybridModel& model, RunSetup* setup) {
+  setup->seed_exploration = setup->exploration;
+  if (args.free.empty() && args.fix.empty()) return;
+  if (args.free.empty()) throw std::invalid_argument("--fix '" + args.fix + "': needs --free PARAMETER");
+  if (args.fix.empty()) {
+    throw std::invalid_argument("--free '" + args.free + "': needs --fix NAME=VALUE (e.g. --fix H=1.5)");
+  }
+  RequireParameter("--free", model, args.free);
+  if (!model.has_parameter_derivatives()) {
+    throw std::invalid_argument(fmt::format("--free '{}': model '{}' has no parameter derivatives", args.free,
+                                            model.name()));
+  }
+  const auto [name, value] = ParseAssignment("--fix", args.fix);
+  if (name != "H") throw std::invalid_argument("--fix '" + args.fix + "': only H can be held fixed");
+  setup->free = FreeParameters{{args.free}, {{name, value}}};
+  ContinuationOptions& seed = setup->seed_exploration.continuation;
+  for (ComponentBound& b : seed.bounds) {
+    if (b.component == "H" && !(value >= b.lower && value <= b.upper)) {
+      throw std::invalid_argument(fmt::format("--fix '{}': outside the model's H bound [{:g}, {:g}]", args.fix, b.lower,
+                                              b.upper));
+    }
+  }
+  const double v = model.parameter(args.free);
+  setup->scenario.unknown_scales.push_back({args.free, v != 0 ? std::abs(v) : 1.0});
+  setup->scenario.bounds.push_back(DefaultParameterBound(model, args.free));
+  setup->exploration.continuation.bounds.push_back(setup->scenario.bounds.back());
+  setup->exploration.start_conditions.clear();  // the starts are regular points of the families
+}
+
+// --curves: the parameter and its bound (taken out of --bound, whose other names are the run's unknowns).
+void ApplyCurveParameter(const RunArguments& args, const HybridModel& model, RunArguments* run_args,
+                         RunSetup* setup) {
+  if (args.curves.empty()) return;
+  RequireParameter("--curves", model, args.curves);
+  if (!model.has_parameter_derivatives()) {
+    throw std::invalid_argument(fmt::format("--curves '{}': model '{}' has no parameter derivatives", args.curves,
+                                            model.name()));
+  }
+  if (!args.free.empty()) throw std::invalid_argument("--curves '" + args.curves + "': not with --free");
+  setup->curve_parameter = args.curves;
+  setup->curve_bound = DefaultParameterBound(model, args.curves);
+  std::erase_if(run_args->bounds, [&](const std::string& text) {
+    const BoundAssignment b = ParseBound("--bound", text);
+    if (b.name != args.curves) return false;
+    const double v = model.parameter(args.curves);
+    if (!(v >= b.lower && v <= b.upper)) {
+      throw std::invalid_argument(fmt::format("--bound '{}': excludes the model's {} = {:g}, where the curves start",
+                                              text, args.curves, v));
+    }
+    setup->curve_bound.lower = b.lower, setup->curve_bound.upper = b.upper;
+    return true;
+  });
+}
+
 }  // namespace
 
-RunSetup MakeRunSetup(const RunArguments& args, const HybridModel& model) {
+RunSetup MakeRunSetup(const RunArguments& given, const HybridModel& model) {
   RunSetup setup;
+  RunArguments args = given;
   ApplyTolerances(args, &setup.integrator);
   RefuseRepeats("--until", args.until);
   RefuseRepeats("--bound", args.bounds);
   setup.scenario = DefaultScenario(model);
   setup.exploration = ScenarioExplorationOptions(setup.scenario);
+  ApplyCurveParameter(given, model, &args, &setup);
+  ApplyExplorationLimits(args, &setup.exploration);
+  ApplyFreeParameter(args, model, &setup);
   ApplyTargetsAndBounds(args, model, &setup.exploration.continuation);
   WidenBoundsToTargets(args, &setup.exploration.continuation);
-  ApplyExplorationLimits(args, &setup.exploration);
   return setup;
 }
 

@@ -8,6 +8,7 @@
 #include "hybridcont/exploration.h"
 #include "hybridcont/flow.h"
 #include "hybridcont/model.h"
+#include "hybridcont/shooting_layout.h"
 #include "scenario.h"
 
 namespace hybridcont::app {
@@ -16,9 +17,20 @@ struct RunSetup {
   IntegratorOptions integrator;
   ExplorationOptions exploration;
   Scenario scenario;
+  // --free/--fix: the parameter continued as an unknown and the unknown held fixed (empty: families in H).
+  // exploration's bounds, targets and scales then include the parameter.
+  FreeParameters free;
+  // The options of the ordinary run in H that gives the starts of a run with free parameters (its
+  // families' crossings of the fixed value): the scenario's, with --max-branches, --threads, --no-symmetry
+  // and an H bound that contains the fixed value.
+  ExplorationOptions seed_exploration;
+  // --curves: the second parameter of the special-point curves and its bound (default: the parameter's
+  // range within [value/4, 4 value]).
+  std::string curve_parameter;
+  ComponentBound curve_bound;
 };
 
-// The model's default scenario with --rtol, --atol, --until, --bound, --max-branches, --threads and
+// The model's default scenario with --free, --fix, --curves, --rtol, --atol, --until, --bound, --max-branches, --threads and
 // --no-symmetry applied. Throws std::invalid_argument ("--OPTION VALUE: why") for a value the library
 // refuses or that makes no sense for a run (see the README, "Bad input").
 RunSetup MakeRunSetup(const RunArguments& args, const HybridModel& model);

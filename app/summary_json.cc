@@ -55,6 +55,15 @@ nlohmann::json OptionsJson(const RunArguments& args, const RunSetup& setup) {
   for (const auto& sc : setup.scenario.start_conditions) conditions.push_back(sc.description);
   j["start_conditions"] = conditions;
   for (const auto& [name, scale] : setup.scenario.unknown_scales) j["unknown_scales"][name] = scale;
+  if (!setup.free.empty()) {
+    j["free"] = setup.free.parameters;
+    for (const auto& [name, value] : setup.free.fixed) j["fixed"][name] = value;
+  }
+  if (!setup.curve_parameter.empty()) {
+    j["curves"] = {{"parameter", setup.curve_parameter},
+                   {"lower", setup.curve_bound.lower},
+                   {"upper", setup.curve_bound.upper}};
+  }
   return j;
 }
 

@@ -521,6 +521,9 @@ class Results:
         self.phases = phases_of(self.summary)
         self.m = len(self.phases)
         self.unknowns = [u for u in (self.summary.get("unknowns") or []) if isinstance(u, str)]
+        # A run with a free parameter at fixed H: the parameter takes H's place in the generic figures.
+        free = (self.summary.get("options") or {}).get("free") or []
+        self.family = free[0] if free and isinstance(free[0], str) else "H"
         self.special_points = [sp for sp in (self.summary.get("special_points") or []) if isinstance(sp, dict)]
         self.branches = load_branches(results_dir, self.summary)
         for o in self.summary.get("orbits") or []:  # checked before anything is drawn
@@ -691,10 +694,10 @@ def save(fig, res, name, svg, written):
 
 def figure_h_t(res, svg, written):
     fig, ax = plt.subplots(figsize=(7.0, 4.8))
-    drawn, sp_styles = projection(ax, res, "T", "H")
+    drawn, sp_styles = projection(ax, res, "T", res.family)
     if not drawn:
         ax.text(0.5, 0.5, "no branch points", transform=ax.transAxes, ha="center", va="center", color="0.4")
-    ax.set_title(r"$\bar{H}$ over $T$: " + model_title(res), fontsize=10)
+    ax.set_title(column_symbol(res.family) + r" over $T$: " + model_title(res), fontsize=10)
     place_legend(fig, ax, legend_handles(res, drawn, sp_styles, res.has_stable()))
     save(fig, res, "H_T", svg, written)
 
@@ -713,17 +716,17 @@ def figure_h_t_xi(res, svg, written):
     drawn = []
     stable = res.has_stable()
     for b in res.branches:
-        xs, ys, zs = res.column(b, "T"), res.column(b, "xi"), res.column(b, "H")
+        xs, ys, zs = res.column(b, "T"), res.column(b, "xi"), res.column(b, res.family)
         if xs is None or ys is None or zs is None:
             continue
         t = b["table"]
         how = plot_runs(ax, xs, ys, t.num("physical"), t.num("stable") if stable else None, b["colour"], zs=zs)
         if how:
             drawn.append(dict(b, label=b["label"] + ("; a point here" if how == "point" else "")))
-    sp_styles = draw_special_points(ax, res, "T", "xi", zname="H")
+    sp_styles = draw_special_points(ax, res, "T", "xi", zname=res.family)
     ax.set_xlabel(axis_label("T"), fontsize=8)
     ax.set_ylabel(axis_label("xi"), fontsize=8)
-    ax.set_zlabel(axis_label("H"), fontsize=8)
+    ax.set_zlabel(axis_label(res.family), fontsize=8)
     ax.tick_params(labelsize=7)
     ax.view_init(elev=22, azim=-60)
     ax.set_title(r"$\bar{H}$ over $T$ and $\xi$: " + model_title(res), fontsize=10)
@@ -1060,6 +1063,29 @@ def nice_length(s):
     return unit
 
 
+def figure_curves(res, svg, written):
+    """Two-parameter curves of special points (summary "curves") in the (parameter, H) plane."""
+    entries = [c for c in (res.summary.get("curves") or []) if isinstance(c, dict) and isinstance(c.get("file"), str)]
+    p = ((res.summary.get("options") or {}).get("curves") or {}).get("parameter")
+    if not entries or not isinstance(p, str):
+        return
+    fig, ax = plt.subplots(figsize=(7.0, 4.8))
+    for pos, c in enumerate(entries):
+        with open(os.path.join(res.dir, c["file"]), newline="") as f:
+            rows = list(csv.DictReader(f))
+        xs, ys = [to_float(r.get(p)) for r in rows], [to_float(r.get("H")) for r in rows]
+        ax.plot(xs, ys, color=branch_colour(pos), lw=1.6,
+                label="%s from special point %s" % (c.get("type"), c.get("special_point")))
+        for q in c.get("codim_two") or []:
+            ax.plot([to_float(q.get(p))], [to_float(q.get("H"))], "k*", ms=8)
+    ax.set_xlabel(axis_label(p), fontsize=9)
+    ax.set_ylabel(axis_label("H"), fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.set_title(r"special points in $(%s, \bar{H})$: " % p + model_title(res), fontsize=10)
+    ax.legend(fontsize=8)
+    save(fig, res, "curves", svg, written)
+
+
 def figure_keyframes(res, svg, written, n_frames=9):
     entries = [o for o in (res.summary.get("orbits") or []) if isinstance(o, dict)]
     if not entries:
@@ -1211,11 +1237,12 @@ def main(argv):
     jobs = [("H_T", lambda w: figure_h_t(res, args.svg, w))]
     if has_nonzero_xi(res):
         jobs.append(("H_T_xi", lambda w: figure_h_t_xi(res, args.svg, w)))
+    jobs.append(("curves", lambda w: figure_curves(res, args.svg, w)))
     if res.presentation is None:
         warn("%s has no 'presentation' (written by an older hybridcont): only the generic figures are drawn"
              % res.summary_path)
     else:
-        names = set(("H_T", "H_T_xi", "keyframes"))
+        names = set(("H_T", "H_T_xi", "keyframes", "curves"))
         for spec in res.presentation["figures"]:
             if spec["name"] in names:
                 warn("%s is declared twice or would overwrite a generic figure; skipped" % spec["file"])

@@ -52,8 +52,10 @@ double PeriodDoublingTest(const Matrix& dr, const ShootingLayout& layout);
 // mean nothing for the mechanical system. Trial points between two branch points are not classified.
 class FloquetTestFunctions : public TestFunctions {
  public:
-  // Keeps a reference to model (it must outlive this object and its clones).
-  FloquetTestFunctions(const HybridModel& model, const IntegratorOptions& integrator, bool physical_only = true);
+  // Keeps a reference to model (it must outlive this object and its clones). With free parameters
+  // (shooting_layout.h) u holds them, and orbits are classified and replayed at u's parameter values.
+  FloquetTestFunctions(const HybridModel& model, const IntegratorOptions& integrator, bool physical_only = true,
+                       FreeParameters free = {});
 
   std::vector<SpecialPointType> types() const override;
   void Evaluate(const Vector& u, bool branch_point, Vector* values) override;
@@ -71,7 +73,10 @@ class FloquetTestFunctions : public TestFunctions {
   const HybridModel* model_;
   IntegratorOptions integrator_;
   bool physical_only_;
+  FreeParameters free_;
   TimeBasedShooting shooting_;
+  int base_unknowns_;                            // u without the free parameters
+  std::unique_ptr<HybridModel> point_model_;     // with free parameters: set to u's values to classify
   Matrix dr_;
 };
 

@@ -1,5 +1,7 @@
 #include "hybridcont/floquet_test_functions.h"
 
+#include <stdexcept>
+
 #include <Eigen/LU>
 #include <cmath>
 #include <limits>
@@ -42,8 +44,14 @@ double PeriodDoublingTest(const Matrix& dr, const ShootingLayout& layout) {
 }
 
 FloquetTestFunctions::FloquetTestFunctions(const HybridModel& model, const IntegratorOptions& integrator,
-                                           bool physical_only)
-    : model_(&model), integrator_(integrator), physical_only_(physical_only), shooting_(model, integrator) {
+                                           bool physical_only, FreeParameters free)
+    : model_(&model),
+      integrator_(integrator),
+      physical_only_(physical_only),
+      free_(std::move(free)),
+      shooting_(model, integrator, free_),
+      base_unknowns_(ShootingLayout(model).num_unknowns()),
+      point_model_(free_.empty() ? nullptr : std::make_unique<HybridModel>(model.Clone())) {
   shooting_.set_threads(1);  // a stepper's own copy works on the stepper's thread
 }
 
@@ -51,17 +59,30 @@ std::vector<SpecialPointType> FloquetTestFunctions::types() const {
   return {SpecialPointType::kFloquetBranchPoint, SpecialPointType::kPeriodDoubling};
 }
 
-bool FloquetTestFunctions::Physical(const Vector& u) const {
+bool FloquetTestFunctions::Physical(const Vector& u_free) const {
+  const HybridModel* model = model_;
+  if (point_model_) {
+    const ShootingLayout& layout = shooting_.layout();
+    for (int i = 0; i < layout.num_free_parameters(); ++i) {
+      try {
+        point_model_->SetParameterValue(layout.parameter_model_index(i), u_free(layout.parameter_index(i)));
+      } catch (const std::invalid_argument&) {
+        return false;  // outside the parameter's range: no orbit of the model
+      }
+    }
+    model = point_model_.get();
+  }
+  const Vector u = u_free.head(base_unknowns_);
   Classification c;
-  if (!ClassifyByUnknowns(*model_, u, ClassificationOptions{}, &c)) {
-    const OrbitTrace trace(*model_, u, integrator_);
-    c = ClassifyOrbit(*model_, u, trace, ClassificationOptions{});
+  if (!ClassifyByUnknowns(*model, u, ClassificationOptions{}, &c)) {
+    const OrbitTrace trace(*model, u, integrator_);
+    c = ClassifyOrbit(*model, u, trace, ClassificationOptions{});
   }
   if (!c.physical) return false;
   ReplayOptions replay;
   replay.poincare.event.integrator.rtol = integrator_.rtol;
   replay.poincare.event.integrator.atol = integrator_.atol;
-  return ReplayOrbit(*model_, u, replay).physical();
+  return ReplayOrbit(*model, u, replay).physical();
 }
 
 void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* values) {
@@ -74,14 +95,14 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
 }
 
 std::unique_ptr<TestFunctions> FloquetTestFunctions::Clone() const {
-  return std::make_unique<FloquetTestFunctions>(*model_, integrator_, physical_only_);
+  return std::make_unique<FloquetTestFunctions>(*model_, integrator_, physical_only_, free_);
 }
 
 std::unique_ptr<TestFunctions> FloquetTestFunctions::Refined(double factor) const {
   IntegratorOptions refined = integrator_;
   refined.rtol *= factor;
   refined.atol *= factor;
-  return std::make_unique<FloquetTestFunctions>(*model_, refined, physical_only_);
+  return std::make_unique<FloquetTestFunctions>(*model_, refined, physical_only_, free_);
 }
 
 }  // namespace hybridcont

@@ -1,0 +1,141 @@
+// `hybridcont run MODEL --free P --fix H=c` (families in a model parameter at fixed H̄) and `--curves P`
+// (two-parameter curves of special points), against closed forms of the SLIP.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.h"
+#include "hybridcont/models.h"
+#include "known_orbits.h"
+
+namespace hybridcont::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The numeric columns of a CSV file by header name (empty cells: NaN).
+std::map<std::string, std::vector<double>> ReadColumns(const fs::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  std::stringstream hs(line);
+  for (std::string cell; std::getline(hs, cell, ',');) header.push_back(cell);
+  std::map<std::string, std::vector<double>> columns;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::size_t i = 0;
+    for (std::string cell; i < header.size(); ++i) {
+      if (!std::getline(ss, cell, ',')) cell.clear();
+      char* end = nullptr;
+      const double v = std::strtod(cell.c_str(), &end);
+      columns[header[i]].push_back(end != cell.c_str() ? v : std::nan(""));
+    }
+  }
+  return columns;
+}
+
+nlohmann::json ReadSummary(const fs::path& dir) {
+  std::ifstream f(dir / "summary.json");
+  return nlohmann::json::parse(f);
+}
+
+// Hopping in place at H̄ = 1.5 continued in k over [15, 100]: the branches whose orbits all have zero
+// forward speed are hopping in place, and every point equals the closed form at its k.
+TEST(CliParameters, SlipHoppingInPlaceInStiffnessMatchesTheClosedForm) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_cli_free_k";
+  const CliResult r = RunTool({"run", "slip", "--free", "k", "--fix", "H=1.5", "--bound", "k=15:100", "--out",
+                               dir.string(), "--quiet", "--no-plots", "--threads", "1", "--overwrite"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json summary = ReadSummary(dir);
+  EXPECT_EQ(summary["status"], "complete");
+  EXPECT_EQ(summary["options"]["free"], nlohmann::json::array({"k"}));
+  EXPECT_EQ(summary["options"]["fixed"]["H"], 1.5);
+  EXPECT_TRUE(summary.contains("version"));
+  const HybridModel slip = MakeBuiltinModel("slip");
+  const ShootingLayout layout(slip);
+  const std::vector<std::string> names = layout.unknown_names();
+  int hopping_points = 0;
+  double worst = 0, k_min = 1e300, k_max = -1e300;
+  for (const nlohmann::json& b : summary["branches"]) {
+    const auto columns = ReadColumns(dir / b["file"].get<std::string>());
+    ASSERT_TRUE(columns.count("k")) << b["file"];
+    const std::vector<double>& dx = columns.at("x2_dx");
+    const bool hopping = std::all_of(dx.begin(), dx.end(), [](double v) { return std::abs(v) < 1e-10; });
+    if (!hopping) continue;
+    for (std::size_t row = 0; row < dx.size(); ++row) {
+      const double k = columns.at("k")[row];
+      HybridModel at_k = MakeBuiltinModel("slip");
+      at_k.SetParameter("k", k);
+      const Vector exact = SlipHoppingInPlace(at_k, layout, 1.5);
+      for (int j = 0; j < layout.num_unknowns(); ++j) {
+        worst = std::max(worst, std::abs(columns.at(names[j])[row] - exact(j)));
+      }
+      EXPECT_EQ(columns.at("H")[row], 1.5);
+      k_min = std::min(k_min, k), k_max = std::max(k_max, k);
+      ++hopping_points;
+    }
+  }
+  EXPECT_GE(hopping_points, 20);
+  EXPECT_LT(worst, 1e-8);
+  EXPECT_NEAR(k_min, 15.0, 1e-9);
+  EXPECT_NEAR(k_max, 100.0, 1e-9);
+  RecordProperty("hopping_points", hopping_points);
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", worst);
+  RecordProperty("worst_deviation_from_closed_form", text);
+  // Running branches off hopping in place at an SB point, reported with its k.
+  bool sb = false;
+  for (const nlohmann::json& sp : summary["special_points"]) {
+    if (sp["type"] == "SB") sb = sp.contains("k") && sp["H"] == 1.5;
+  }
+  EXPECT_TRUE(sb);
+}
+
+// The SLIP's first SB point (H̄ = 1 + π²/40 at w2 = 5) continued in (w2, H̄) over [2, 10]: along the whole
+// curve H̄ = 1 + π²/(8 w2), the leg's swing half-period fitting the flight, whatever k.
+TEST(CliParameters, SlipFirstSbCurveInSwingFrequencyMatchesTheClosedForm) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_cli_curves_w2";
+  const CliResult r = RunTool({"run", "slip", "--curves", "w2", "--bound", "w2=2:10", "--out", dir.string(), "--quiet",
+                               "--threads", "1", "--overwrite"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json summary = ReadSummary(dir);
+  EXPECT_EQ(summary["options"]["curves"]["parameter"], "w2");
+  int first = -1;
+  for (const nlohmann::json& sp : summary["special_points"]) {
+    if (sp["type"] == "SB" && std::abs(sp["H"].get<double>() - (1 + M_PI * M_PI / 40)) < 1e-9 && first < 0) first = sp["id"];
+  }
+  ASSERT_GE(first, 0);
+  const nlohmann::json* curve = nullptr;
+  for (const nlohmann::json& c : summary["curves"]) {
+    if (c["special_point"] == first) curve = &c;
+  }
+  ASSERT_NE(curve, nullptr) << summary["curves"].dump();
+  EXPECT_EQ((*curve)["type"], "branch-point");
+  const auto columns = ReadColumns(dir / (*curve)["file"].get<std::string>());
+  const std::vector<double>&w2 = columns.at("w2"), &H = columns.at("H");
+  double worst = 0;
+  for (std::size_t i = 0; i < w2.size(); ++i) worst = std::max(worst, std::abs(H[i] - (1 + M_PI * M_PI / (8 * w2[i]))));
+  EXPECT_LT(worst, 1e-8);
+  EXPECT_NEAR(*std::min_element(w2.begin(), w2.end()), 2.0, 1e-9);
+  EXPECT_NEAR(*std::max_element(w2.begin(), w2.end()), 10.0, 1e-9);
+  EXPECT_GE(w2.size(), 10u);
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", worst);
+  RecordProperty("worst_deviation_from_closed_form", text);
+  RecordProperty("points", static_cast<int>(w2.size()));
+  EXPECT_TRUE(fs::exists(dir / "curves.png") || !r.err.empty());  // drawn where Python and matplotlib exist
+}
+
+}  // namespace
+}  // namespace hybridcont::app
