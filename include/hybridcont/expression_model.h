@@ -104,9 +104,9 @@ struct ExpressionPhaseData {
 template <class S>
 struct ExpressionJetData {
   const ExpressionPhaseData* base = nullptr;
-  std::vector<S> parameters;
+  const S* parameters = nullptr;  // per-thread storage of the seeding block, valid until its next seeding
   void Run(ProgramKind kind, const S* x, S* out) const {
-    base->programs[static_cast<int>(kind)]->EvaluateWithParameterJets(x, parameters.data(), out);
+    base->programs[static_cast<int>(kind)]->EvaluateWithParameterJets(x, parameters, out);
   }
 };
 

@@ -67,12 +67,15 @@ class ExpressionParameterBlock final : public ParameterBlock,
  private:
   template <class S, class Make>
   internal::ExpressionJetData<S> Seed(const internal::ExpressionPhaseData& values, int index, Make make) const {
+    // Seeded once per right-hand side with a free parameter: per-thread storage, no allocation once warm.
+    thread_local std::vector<S> storage;
+    storage.resize(data_->values.size());
+    for (int i = 0; i < static_cast<int>(data_->values.size()); ++i) {
+      storage[i] = make(data_->values[i], i == index ? 1.0 : 0.0);
+    }
     internal::ExpressionJetData<S> d;
     d.base = &values;
-    d.parameters.reserve(data_->values.size());
-    for (int i = 0; i < static_cast<int>(data_->values.size()); ++i) {
-      d.parameters.push_back(make(data_->values[i], i == index ? 1.0 : 0.0));
-    }
+    d.parameters = storage.data();
     return d;
   }
 
