@@ -85,6 +85,7 @@ class Checker {
     for (int p = 0; p < model_.num_phases(); ++p) CheckPhase(model_.phase(p));
     CheckAnchor();
     CheckShootingMap();
+    CheckParameterColumns();
     return report_;
   }
 
@@ -210,17 +211,61 @@ class Checker {
     }
   }
 
+  // A random u of the layout: durations, states near the typical ones, ξ and H̄; free parameters at the
+  // model's values.
+  Vector SampleUnknowns(const ShootingLayout& layout) {
+    Vector u(layout.num_unknowns());
+    for (int i = 0; i < layout.num_segments(); ++i) {
+      u(layout.time_index(i)) = Uniform(-o_.max_duration, o_.max_duration);
+      u.segment(layout.state_offset(i), layout.dim(i)) = SampleState(model_.phase(i));
+    }
+    for (int j = 0; j < layout.num_first_integrals(); ++j) u(layout.xi_index(j)) = Uniform(-o_.max_xi, o_.max_xi);
+    u(layout.H_index()) = Uniform(0.0, 2.0);
+    for (int i = 0; i < layout.num_free_parameters(); ++i) {
+      u(layout.parameter_index(i)) = model_.parameter_value(layout.parameter_model_index(i));
+    }
+    return u;
+  }
+
+  // The column of each model parameter in the time-based map with that parameter free (flow sensitivities
+  // and the parameter derivatives of resets, events, anchor and first integrals together) against central
+  // differences of r in the parameter.
+  void CheckParameterColumns() {
+    if (!model_.has_parameter_derivatives() || !model_.is_cloneable()) return;
+    for (const ParameterInfo& info : model_.parameters()) {
+      const std::string what = "shooting map: dr/d" + info.name;
+      TimeBasedShooting shooting(model_, o_.integrator, FreeParameters{{info.name}, {{info.name, info.default_value}}});
+      const int col = shooting.layout().parameter_index(0);
+      // Random points where the map cannot be integrated (a singular state reached) are drawn again: this
+      // checks derivatives, not the model's domain (dr/du reports such failures).
+      int checked = 0;
+      std::string failure;
+      for (int attempt = 0; attempt < 4 * o_.num_points && checked < o_.num_points; ++attempt) {
+        const Vector u = SampleUnknowns(shooting.layout());
+        Vector r, r_plus, r_minus;
+        Matrix dr;
+        const double h = o_.flow_step * std::max(1.0, std::abs(u(col)));
+        Vector up = u, um = u;
+        up(col) += h;
+        um(col) -= h;
+        const EvaluationStatus s = shooting.Evaluate(u, &r, &dr);
+        const bool ok = s.ok && shooting.Evaluate(up, &r_plus, nullptr).ok && shooting.Evaluate(um, &r_minus, nullptr).ok;
+        if (!ok) {
+          failure = s.ok ? "finite-difference evaluation failed" : s.message;
+          continue;
+        }
+        Record(what, o_.flow_tolerance, dr.col(col), (r_plus - r_minus) / (2 * h), true);
+        ++checked;
+      }
+      if (checked == 0) Record(what, o_.flow_tolerance, Matrix(), Matrix(), false, failure);
+    }
+  }
+
   void CheckShootingMap() {
     TimeBasedShooting shooting(model_, o_.integrator);
     const ShootingLayout& layout = shooting.layout();
     for (int point = 0; point < o_.num_points; ++point) {
-      Vector u(layout.num_unknowns());
-      for (int i = 0; i < layout.num_segments(); ++i) {
-        u(layout.time_index(i)) = Uniform(-o_.max_duration, o_.max_duration);
-        u.segment(layout.state_offset(i), layout.dim(i)) = SampleState(model_.phase(i));
-      }
-      for (int j = 0; j < layout.num_first_integrals(); ++j) u(layout.xi_index(j)) = Uniform(-o_.max_xi, o_.max_xi);
-      u(layout.H_index()) = Uniform(0.0, 2.0);
+      const Vector u = SampleUnknowns(layout);
       Vector r;
       Matrix dr;
       const EvaluationStatus s = shooting.Evaluate(u, &r, &dr);
