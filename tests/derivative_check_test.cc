@@ -14,9 +14,11 @@ TEST_P(BuiltinModelDerivatives, AgreeWithFiniteDifferences) {
   const HybridModel model = MakeBuiltinModel(GetParam());
   const DerivativeCheckReport report = CheckDerivatives(model, DerivativeCheckOptions{});
   // Every derivative kind is covered: per phase 7 (f, e, Delta, dH, d2H, Phi, Psi), anchor, shooting map,
-  // and the symmetry group of the shooting map (the SLIP: mirror, time reversal and their product).
+  // the symmetry group of the shooting map (the SLIP: mirror, time reversal and their product), and the map's
+  // column of every model parameter.
   const int symmetries = GetParam() == "slip" ? 3 : 1;
-  EXPECT_EQ(static_cast<int>(report.entries.size()), 7 * model.num_phases() + 2 + symmetries);
+  const int parameters = static_cast<int>(model.parameters().size());
+  EXPECT_EQ(static_cast<int>(report.entries.size()), 7 * model.num_phases() + 2 + symmetries + parameters);
   for (const auto& e : report.entries) {
     EXPECT_TRUE(e.passed()) << e.what << ": " << e.worst_error << " > " << e.tolerance << " " << e.note;
   }
