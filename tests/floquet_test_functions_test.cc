@@ -68,6 +68,15 @@ std::pair<std::complex<double>, std::complex<double>> PairAtMinusOne(TimeBasedSh
   return {mu[0], mu[1]};
 }
 
+// The PD points of a diagram within 1e-6 of H̄ (unknown iH).
+std::vector<const SpecialPoint*> PdPointsNear(const BifurcationDiagram& diagram, int iH, double H) {
+  std::vector<const SpecialPoint*> near;
+  for (const SpecialPoint* p : PdPoints(diagram)) {
+    if (std::abs(p->u(iH) - H) < 1e-6) near.push_back(p);
+  }
+  return near;
+}
+
 double PdTest(TimeBasedShooting& shooting, const Vector& u) {
   Matrix dr;
   EXPECT_TRUE(shooting.Evaluate(u, nullptr, &dr).ok);
@@ -89,10 +98,7 @@ TEST_P(RodMirrorPd, BothImagesLocatedWithAMultiplierAtMinusOne) {
   const ExplorationRun run = Explore("bouncing-rod", {{"r", r}});
   TimeBasedShooting shooting(run.model, IntegratorOptions{});
   const int iH = shooting.UnknownIndex("H");
-  std::vector<const SpecialPoint*> images;
-  for (const SpecialPoint* p : PdPoints(run.diagram)) {
-    if (std::abs(p->u(iH) - H) < 1e-6) images.push_back(p);
-  }
+  const std::vector<const SpecialPoint*> images = PdPointsNear(run.diagram, iH, H);
   ASSERT_EQ(images.size(), 2u) << run.diagram.FullReport();
   EXPECT_NE(images[0]->branch_id, images[1]->branch_id);
   for (const SpecialPoint* p : images) {
@@ -111,6 +117,51 @@ TEST_P(RodMirrorPd, BothImagesLocatedWithAMultiplierAtMinusOne) {
 INSTANTIATE_TEST_SUITE_P(Radii, RodMirrorPd,
                          ::testing::Values(std::pair{0.01, 0.515409213677}, std::pair{0.02, 0.530225755022},
                                            std::pair{0.05, 0.571185891986}));
+
+// The rod's symmetric family: between its second turning point and its SB point the reciprocal pair goes
+// round the unit circle, through −1 and back. A symmetric orbit is its half (the mirror-composed return
+// map Q, P = Q²) traversed twice, so μ + 1/μ + 2 = (tr Q)²: the pair passes through −1 on the unit circle
+// and PeriodDoublingTest has a double zero there, no sign change. It is located as a touching zero.
+// Reference H̄: the minimum of tr P + 2 (from the multipliers of floquet.h) over a dense scan of the
+// family in arclength steps of 1e-7 (one-parameter continuation, no test functions): 0.515403983675,
+// 0.53018269001, 0.57044011592, |tr P + 2| <= 5e-12 there.
+class RodSymmetricPd : public ::testing::TestWithParam<std::pair<double, double>> {};
+
+TEST_P(RodSymmetricPd, LocatedWhereThePairTouchesMinusOne) {
+  const auto [r, H] = GetParam();
+  const ExplorationRun run = Explore("bouncing-rod", {{"r", r}});
+  TimeBasedShooting shooting(run.model, IntegratorOptions{});
+  const int iH = shooting.UnknownIndex("H");
+  const std::vector<const SpecialPoint*> points = PdPointsNear(run.diagram, iH, H);
+  ASSERT_EQ(points.size(), 1u) << run.diagram.FullReport();
+  const SpecialPoint& pd = *points[0];
+  EXPECT_EQ(pd.status, LocationStatus::kLocated) << pd.BriefReport();
+  EXPECT_NEAR(pd.u(iH), H, 1e-9) << pd.BriefReport();
+  EXPECT_LT(pd.precision(), 1e-9) << pd.BriefReport();
+  EXPECT_NE(pd.message.find("touching zero"), std::string::npos) << pd.BriefReport();
+  // On the symmetric family, between the turning and the SB point that bracket it.
+  const Branch& branch = run.diagram.branches.at(pd.branch_id);
+  double turning = -1, sb = -1;
+  for (const SpecialPoint& p : branch.special_points) {
+    if (p.index != pd.index) continue;
+    if (p.type == SpecialPointType::kTurningPoint) turning = p.arclength;
+    if (p.type == SpecialPointType::kSimpleBifurcation) sb = p.arclength;
+  }
+  EXPECT_LT(std::min(turning, sb), pd.arclength);
+  EXPECT_GT(std::max(turning, sb), pd.arclength);
+  const Vector& before = branch.points.at(pd.index).u;
+  const Vector& after = branch.points.at(pd.index + 1).u;
+  EXPECT_GT(PdTest(shooting, before) * PdTest(shooting, after), 0);  // no sign change across the step
+  // The pair at −1: its mean −1 and its product 1 (a double root moves each root by the square root of
+  // the evaluation error, see RodMirrorPd).
+  const auto [mu1, mu2] = PairAtMinusOne(shooting, pd.u);
+  EXPECT_LT(std::abs(0.5 * (mu1 + mu2) + 1.0), 1e-6) << mu1 << " " << mu2;
+  EXPECT_LT(std::abs(mu1 * mu2 - 1.0), 1e-6) << mu1 << " " << mu2;
+}
+
+INSTANTIATE_TEST_SUITE_P(Radii, RodSymmetricPd,
+                         ::testing::Values(std::pair{0.01, 0.515403983675}, std::pair{0.02, 0.53018269001},
+                                           std::pair{0.05, 0.57044011592}));
 
 // Hopping in place: PeriodDoublingTest changes sign across both PD points (the branch points that bracket
 // each have opposite signs), each located to 1e-9 with a multiplier at −1 to 1e-6 (a simple one: the

@@ -13,6 +13,11 @@
 //   - two roots inside one step cancel in the signs: at every local minimum of |g| over the samples, g is
 //     minimized on the curve over the two neighbouring intervals, and a value of the other sign brackets
 //     both roots, each located;
+//   - a zero that g touches without changing sign (a double zero: on the bouncing rod's symmetric orbits a
+//     reciprocal pair of multipliers passes through −1 on the unit circle, and the PD test is a square
+//     there) is the minimum of |g| refined on the curve (Brent) to location_tolerance; where that minimum
+//     is at most 1e-10 of |g| at the samples around it, it is one located point whose message begins
+//     "touching zero", its interval the bracket or the distance by which the bowl may miss zero;
 //   - where g is undefined (NaN: e.g. a non-physical orbit) nothing is detected next to it; in the first
 //     interval of a branch from a singular point a test that vanishes at that point (below
 //     kStartNoise of its value at the next point) marks the parent's special point, not a new one.

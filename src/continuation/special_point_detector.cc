@@ -308,8 +308,10 @@ SpecialPoint SpecialPointDetector::LocateTestZero(int j, const CurveSample& l, c
 
 // Golden-section search for the minimum of sign·g_j on each of the intervals l–m and m–r (the one the
 // parabola through the three samples points to first), stopped at the first sample of the other sign.
-bool SpecialPointDetector::FindOtherSign(int j, double sign, const CurveSample& l, const CurveSample& m,
-                                         const CurveSample& r, CurveSample* found, bool* left) {
+// Where the smallest value found is a candidate touching zero, Brent's method (parabolic steps with a
+// golden-section fallback) refines that interval's bracket to location_tolerance in σ.
+SpecialPointDetector::CurveMinimum SpecialPointDetector::MinimizeOnCurve(int j, double sign, const CurveSample& l,
+                                                                         const CurveSample& m, const CurveSample& r) {
   const auto value = [&](const CurveSample& c) { return sign * c.point.test_values(j); };
   const double s0 = 0, s1 = (m.point.u - l.point.u).norm(), s2 = s1 + (r.point.u - m.point.u).norm();
   const double g0 = value(l), g1 = value(m), g2 = value(r);
@@ -317,27 +319,43 @@ bool SpecialPointDetector::FindOtherSign(int j, double sign, const CurveSample& 
   const double d1 = (g1 - g0) / (s1 - s0), d2 = (g2 - g1) / (s2 - s1);
   const double curvature = (d2 - d1) / (s2 - s0);
   const double vertex = curvature > 0 ? 0.5 * (s0 + s1) - d1 / (2 * curvature) : s1;
+  CurveMinimum best;
+  best.sample = m;
+  best.value = g1;
+  // Per interval (0: l–m, 1: m–r): the final golden bracket and every evaluation (σ, value) in it, for
+  // the refinement and the bowl's curvature.
+  struct Side {
+    bool searched = false;
+    double a = 0, b = 0;
+    std::vector<std::pair<double, double>> trace;
+  };
+  Side sides[2];
   int budget = kPairSearchEvaluations;
   for (const bool on_left : {vertex < s1, !(vertex < s1)}) {
     const CurveSample& lo = on_left ? l : m;
     const CurveSample& hi = on_left ? m : r;
     const double width = lo.point.tangent.dot(hi.point.u - lo.point.u);
     if (!(width > 0)) continue;
+    Side& side = sides[on_left ? 0 : 1];
+    side.trace = {{on_left ? width : 0.0, g1}};
+    const auto eval = [&](double x, CurveSample* c) {
+      if (budget-- <= 0 || !CurvePoint(lo, hi, x, c)) return std::numeric_limits<double>::quiet_NaN();
+      ++best.evaluations;
+      const double v = value(*c);
+      side.trace.emplace_back(x, v);
+      if (v < best.value) best.value = v, best.sample = *c, best.sigma = x, best.left = on_left;
+      return v;
+    };
     // Golden section on σ ∈ [0, width] of this interval, the minimum bracketed by the samples' values.
     constexpr double kGolden = 0.6180339887498949;
     double a = 0, b = width;
     double x1 = b - kGolden * (b - a), x2 = a + kGolden * (b - a);
     CurveSample c1, c2;
-    const auto eval = [&](double x, CurveSample* c) {
-      if (budget-- <= 0 || !CurvePoint(lo, hi, x, c)) return std::numeric_limits<double>::quiet_NaN();
-      return value(*c);
-    };
     double f1 = eval(x1, &c1), f2 = eval(x2, &c2);
     while (std::isfinite(f1) && std::isfinite(f2)) {
       if (f1 < 0 || f2 < 0) {
-        *found = f1 < f2 ? c1 : c2;
-        *left = on_left;
-        return true;
+        best.other_sign = true;
+        return best;
       }
       if (b - a < 1e-6 * width) break;
       if (f1 < f2) {
@@ -350,8 +368,129 @@ bool SpecialPointDetector::FindOtherSign(int j, double sign, const CurveSample& 
         f2 = eval(x2, &c2);
       }
     }
+    side.searched = true;
+    side.a = a, side.b = b;
   }
-  return false;
+  const double scale = std::max({std::abs(g0), std::abs(g1), std::abs(g2)});
+  if (!(best.value <= kTouchCandidate * scale)) return best;
+
+  // Brent's minimization on the final bracket of the interval that holds the smallest value, or of both
+  // when that is still the middle sample m (the minimum lies next to it, on either side).
+  const bool at_m = best.value == g1;
+  for (const int k : {0, 1}) {
+    Side& side = sides[k];
+    const bool on_left = k == 0;
+    if (!side.searched || !(at_m || best.left == on_left)) continue;
+    const CurveSample& lo = on_left ? l : m;
+    const CurveSample& hi = on_left ? m : r;
+    const auto f = [&](double x) {
+      CurveSample c;
+      if (!CurvePoint(lo, hi, x, &c)) return std::numeric_limits<double>::quiet_NaN();
+      ++best.evaluations;
+      const double v = value(c);
+      side.trace.emplace_back(x, v);
+      if (v < best.value) best.value = v, best.sample = std::move(c), best.sigma = x, best.left = on_left;
+      return v;
+    };
+    constexpr double kGoldenStep = 0.3819660112501051;
+    double a = side.a, b = side.b;
+    double x = at_m ? (on_left ? b : a) : best.sigma;
+    double w = x, v = x;
+    double fx = best.value, fw = fx, fv = fx;
+    double d = 0, e = 0;
+    for (int it = 0; it < kTouchEvaluations; ++it) {
+      const double mid = 0.5 * (a + b);
+      const double tol1 = 0.5 * location_tolerance_ + 1e-15 * std::abs(x), tol2 = 2 * tol1;
+      if (std::abs(x - mid) <= tol2 - 0.5 * (b - a)) break;
+      bool golden = true;
+      if (std::abs(e) > tol1) {
+        // The parabola through (x, fx), (w, fw), (v, fv): its vertex x + p/q.
+        const double rr = (x - w) * (fx - fv);
+        double q = (x - v) * (fx - fw);
+        double p = (x - v) * q - (x - w) * rr;
+        q = 2 * (q - rr);
+        if (q > 0) p = -p;
+        q = std::abs(q);
+        const double previous = e;
+        e = d;
+        if (std::abs(p) < std::abs(0.5 * q * previous) && p > q * (a - x) && p < q * (b - x)) {
+          d = p / q;
+          golden = false;
+          if ((x + d) - a < tol2 || b - (x + d) < tol2) d = mid > x ? tol1 : -tol1;
+        }
+      }
+      if (golden) {
+        e = x >= mid ? a - x : b - x;
+        d = kGoldenStep * e;
+      }
+      const double u = x + (std::abs(d) >= tol1 ? d : (d > 0 ? tol1 : -tol1));
+      const double fu = f(u);
+      if (!std::isfinite(fu)) break;
+      if (fu < 0) {
+        best.other_sign = true;
+        return best;
+      }
+      if (fu <= fx) {
+        (u >= x ? a : b) = x;
+        v = w, fv = fw, w = x, fw = fx, x = u, fx = fu;
+      } else {
+        (u < x ? a : b) = u;
+        if (fu <= fw || w == x) {
+          v = w, fv = fw, w = u, fw = fu;
+        } else if (fu <= fv || v == x || v == w) {
+          v = u, fv = fu;
+        }
+      }
+    }
+    side.a = a, side.b = b;
+  }
+  const Side& side = sides[best.left ? 0 : 1];
+  best.bracket = side.b - side.a;
+  // The bowl's curvature from the evaluation nearest σ* whose value is well above the minimum (the
+  // minimum's own neighbours are at its noise).
+  double kappa = 0, nearest = std::numeric_limits<double>::infinity();
+  for (const auto& [sigma, g] : side.trace) {
+    const double distance = std::abs(sigma - best.sigma);
+    if (g > 100 * std::max(best.value, 0.0) && distance > 0 && distance < nearest) {
+      nearest = distance;
+      kappa = (g - best.value) / (distance * distance);
+    }
+  }
+  best.miss = kappa > 0 ? std::sqrt(std::max(best.value, 0.0) / kappa) : 0.5 * best.bracket;
+  return best;
+}
+
+SpecialPoint SpecialPointDetector::TouchingZero(int j, const CurveSample& lo, const CurveSample& hi,
+                                                const CurveMinimum& minimum, double scale, Branch* branch) {
+  SpecialPoint point;
+  point.type = function_types_[j];
+  point.status = LocationStatus::kLocated;
+  point.branch_id = branch->id;
+  point.index = static_cast<int>(lo.step);
+  point.component_index = j;
+  point.u = minimum.sample.point.u;
+  point.tangent = minimum.sample.point.tangent;
+  point.tangent_before = lo.point.tangent;
+  point.tangent_after = hi.point.tangent;
+  point.arclength = minimum.sample.point.arclength;
+  point.test_value = minimum.sample.point.test_values(j);
+  // The minimum is known to its bracket; where g does not reach zero at the evaluations' resolution the
+  // zero may lie anywhere the bowl is below that resolution: half-width max(bracket, miss distance).
+  const double half = std::max(0.5 * minimum.bracket, minimum.miss);
+  point.interval_lo = point.arclength - half;
+  point.interval_hi = point.arclength + half;
+  point.interval_width = point.tangent.cwiseAbs() * (2 * half);
+  point.iterations = minimum.evaluations;
+  Vector residual;
+  if (TestCurve().problem->Evaluate(point.u, &residual, nullptr).ok) point.residual_norm = residual.norm();
+  char text[320];
+  std::snprintf(text, sizeof(text),
+                "touching zero: the test function reaches zero without changing sign (a double zero: |g| = %.2g, "
+                "%.2g of its value at the samples around it); located as the minimum of |g| on the curve",
+                std::abs(point.test_value), std::abs(point.test_value) / scale);
+  point.message = text;
+  branch->located_iterations += minimum.evaluations;
+  return point;
 }
 
 void SpecialPointDetector::DetectTestFunctions(size_t index, bool from_singular, Branch* branch) {
@@ -387,16 +526,17 @@ void SpecialPointDetector::DetectTestFunctions(size_t index, bool from_singular,
       if (!(defined(k - 1) && defined(k) && defined(k + 1))) continue;
       const bool one_sign = std::signbit(g(k - 1)) == std::signbit(g(k)) && std::signbit(g(k)) == std::signbit(g(k + 1));
       if (!one_sign || !(std::abs(g(k)) < std::abs(g(k - 1)) && std::abs(g(k)) <= std::abs(g(k + 1)))) continue;
-      CurveSample probe;
-      bool left = false;
-      if (!FindOtherSign(j, std::signbit(g(k)) ? -1.0 : 1.0, samples[k - 1], samples[k], samples[k + 1], &probe, &left)) {
+      CurveMinimum minimum = MinimizeOnCurve(j, std::signbit(g(k)) ? -1.0 : 1.0, samples[k - 1], samples[k], samples[k + 1]);
+      const CurveSample& lo = minimum.left ? samples[k - 1] : samples[k];
+      const CurveSample& hi = minimum.left ? samples[k] : samples[k + 1];
+      minimum.sample.step = lo.step;
+      if (minimum.other_sign) {
+        found.push_back(LocateTestZero(j, lo, minimum.sample, branch));
+        found.push_back(LocateTestZero(j, minimum.sample, hi, branch));
         continue;
       }
-      const CurveSample& lo = left ? samples[k - 1] : samples[k];
-      const CurveSample& hi = left ? samples[k] : samples[k + 1];
-      probe.step = lo.step;
-      found.push_back(LocateTestZero(j, lo, probe, branch));
-      found.push_back(LocateTestZero(j, probe, hi, branch));
+      const double scale = std::max({std::abs(g(k - 1)), std::abs(g(k)), std::abs(g(k + 1))});
+      if (minimum.value <= kTouchingZero * scale) found.push_back(TouchingZero(j, lo, hi, minimum, scale, branch));
     }
   }
   Insert(std::move(found), branch);

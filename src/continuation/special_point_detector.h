@@ -56,6 +56,16 @@ class SpecialPointDetector {
   static constexpr double kStartNoise = 1e-3;
   // Evaluations of the minimization that looks for a pair of zeros at a local minimum of |g|.
   static constexpr int kPairSearchEvaluations = 24;
+  // A minimum of |g| this small relative to the samples around it is refined (Brent, up to
+  // kTouchEvaluations more evaluations, to location_tolerance in σ) to decide whether g touches zero.
+  static constexpr double kTouchCandidate = 1e-4;
+  static constexpr int kTouchEvaluations = 60;
+  // A refined minimum of |g| of one sign at most this fraction of the samples' largest |g| is a zero that
+  // g touches without changing sign (a double zero, e.g. a reciprocal pair of multipliers passing
+  // through −1 on the unit circle): for a bowl g ≈ κ(s − s*)² + c it means a miss distance
+  // sqrt(c/κ) below 1e-5 of the samples' spread, where the test's own rounding and integration error
+  // (relative 1e-13 to 1e-9 on the maps of this library) can no longer tell c from zero.
+  static constexpr double kTouchingZero = 1e-10;
   // Relative agreement of a branch point's test values with the mapped ones at which a symmetry counts as
   // leaving the test functions invariant (integration noise of the mapped and the image's evaluation).
   static constexpr double kInvariantTolerance = 1e-6;
@@ -100,9 +110,23 @@ class SpecialPointDetector {
   void DetectTestFunctions(size_t index, bool from_singular, Branch* branch);
   // Zeros of function j between two samples of opposite sign.
   SpecialPoint LocateTestZero(int j, const CurveSample& l, const CurveSample& r, Branch* branch);
-  // Minimizes sign·g_j over [l, m] ∪ [m, r]; a sample of the other sign or nullopt.
-  bool FindOtherSign(int j, double sign, const CurveSample& l, const CurveSample& m, const CurveSample& r, CurveSample* found,
-                     bool* left);
+  // The result of minimizing sign·g_j over [l, m] ∪ [m, r] (m: a local minimum of |g_j| among the samples).
+  struct CurveMinimum {
+    bool other_sign = false;  // `sample` has the other sign: two zeros, one on each side of it
+    bool left = false;        // `sample` lies in [l, m], else in [m, r]
+    CurveSample sample;       // the sample of the other sign, or the smallest sign·g_j found
+    double value = 0;         // sign·g_j at `sample`
+    double sigma = 0;         // its σ in its interval
+    double bracket = 0;       // width in σ of the final bracket of the minimum
+    double miss = 0;          // sqrt(value/κ) for the bowl g ≈ κ(σ − σ*)² + value around it (σ units)
+    int evaluations = 0;
+  };
+  // Golden section on both intervals, then, for a candidate touching zero (kTouchCandidate), Brent's
+  // method on the interval that holds the smallest value; stops at the first sample of the other sign.
+  CurveMinimum MinimizeOnCurve(int j, double sign, const CurveSample& l, const CurveSample& m, const CurveSample& r);
+  // The zero that g_j touches at `minimum` (kTouchingZero), between samples lo and hi.
+  SpecialPoint TouchingZero(int j, const CurveSample& lo, const CurveSample& hi, const CurveMinimum& minimum,
+                            double scale, Branch* branch);
   double TestValue(int j, const Vector& u);
   static void Insert(std::vector<SpecialPoint> found, Branch* branch);
   // A turning point at an SB point of the same step keeps its root finder's bracket (bracket_only) and
