@@ -1,9 +1,13 @@
 // `hybridcont list` and `hybridcont check`.
 #include <fmt/format.h>
 
+#include <iomanip>
+#include <random>
+#include <sstream>
 #include <stdexcept>
 
 #include "commands.h"
+#include "hybridcont/conservation_check.h"
 #include "hybridcont/derivative_check.h"
 #include "hybridcont/models.h"
 #include "hybridcont/shooting_layout.h"
@@ -33,6 +37,47 @@ int ListCommand(const std::vector<std::string>& models, std::ostream& out, std::
   return 0;
 }
 
+namespace {
+
+// The typical state of each phase and `points` − 1 random states around it (seeded, reproducible).
+std::vector<std::vector<Vector>> SampleStates(const HybridModel& model, int points, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::vector<std::vector<Vector>> states(model.num_phases());
+  for (int i = 0; i < model.num_phases(); ++i) {
+    const Vector& typical = model.phase(i).typical_state();
+    states[i].push_back(typical);
+    for (int k = 1; k < points; ++k) {
+      Vector x = typical;
+      for (int j = 0; j < x.size(); ++j) x(j) += 0.1 * (1.0 + std::abs(x(j))) * uniform(rng);
+      states[i].push_back(x);
+    }
+  }
+  return states;
+}
+
+std::string ConservationTable(const ConservationReport& report) {
+  std::ostringstream os;
+  os << "\nconservation of the first integrals (relative, see conservation_check.h)\n";
+  std::size_t width = 44;
+  for (const auto& e : report.entries) width = std::max(width, e.what.size() + 2);
+  const int w = static_cast<int>(width);
+  os << std::left << std::setw(w) << "first integral" << std::right << std::setw(12) << "worst" << std::setw(12)
+     << "threshold" << "  verdict\n";
+  for (const auto& e : report.entries) {
+    os << std::left << std::setw(w) << e.what << std::right << std::scientific << std::setprecision(2)
+       << std::setw(12) << e.worst << std::setw(12) << ConservationReport::kTolerance << "  "
+       << (e.passed(ConservationReport::kTolerance) ? "ok" : "FAIL");
+    if (e.num_states == 0) os << " (no state on the guard reached)";
+    if (!e.passed(ConservationReport::kTolerance)) os << " at " << e.worst_state;
+    os << "\n";
+  }
+  os << (report.passed() ? "every flow and reset conserves the first integrals\n" : "THE ENERGY IS NOT CONSERVED\n");
+  return os.str();
+}
+
+}  // namespace
+
 int CheckCommand(const CheckArguments& args, std::ostream& out, std::ostream& err) {
   if (args.points < 1 || args.points > 1000) {
     throw std::invalid_argument("--points " + std::to_string(args.points) + ": must lie in [1, 1000]");
@@ -43,7 +88,9 @@ int CheckCommand(const CheckArguments& args, std::ostream& out, std::ostream& er
   options.seed = args.seed;
   const DerivativeCheckReport report = CheckDerivatives(model, options);
   out << report.Table();
-  return report.passed() ? 0 : 1;
+  const ConservationReport conservation = CheckConservation(model, SampleStates(model, args.points, args.seed));
+  out << ConservationTable(conservation);
+  return report.passed() && conservation.passed() ? 0 : 1;
 }
 
 }  // namespace hybridcont::app

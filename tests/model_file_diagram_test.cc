@@ -63,9 +63,10 @@ HybridModel LoadFile(const std::string& name) {
   return LoadModelFile(std::filesystem::path(HYBRIDCONT_SOURCE_DIR) / "models" / (name + ".toml"), options);
 }
 
-void ExpectSameDiagram(const std::string& name) {
+// The built-in model `name` against models/<file>.toml (by default the file of the same name).
+void ExpectSameDiagram(const std::string& name, const std::string& file_name = "") {
   const HybridModel builtin = MakeBuiltinModel(name);
-  const HybridModel file = LoadFile(name);
+  const HybridModel file = LoadFile(file_name.empty() ? name : file_name);
   const Run a = Explore(builtin);
   const Run b = Explore(file);
   const BifurcationDiagram& da = a.diagram;
@@ -254,6 +255,9 @@ TEST(ModelFileDiagram, RockingBlock) { ExpectSameDiagram("rocking-block"); }
 TEST(ModelFileDiagram, BouncingRod) { ExpectSameDiagram("bouncing-rod"); }
 TEST(ModelFileDiagram, Slip) { ExpectSameDiagram("slip"); }
 TEST(ModelFileDiagram, BallChain) { ExpectSameDiagram("ball-chain"); }
+// Written from their mechanics (mechanics.h): the same turning, SB, BP and PD points to 1e-9.
+TEST(ModelFileDiagram, LagrangianRod) { ExpectSameDiagram("bouncing-rod", "bouncing-rod-lagrangian"); }
+TEST(ModelFileDiagram, LagrangianSlip) { ExpectSameDiagram("slip", "slip-lagrangian"); }
 
 }  // namespace
 }  // namespace hybridcont

@@ -30,12 +30,13 @@ Vector RandomPoint(const HybridModel& model, std::mt19937* rng, double spread) {
   return u;
 }
 
-void ExpectSameMap(const std::string& name, bool compile) {
+// The built-in model `name` against models/<file>.toml (by default the file of the same name).
+void ExpectSameMap(const std::string& name, bool compile, const std::string& file_name = "") {
   const HybridModel builtin = MakeBuiltinModel(name);
   ModelFileOptions options;
   options.compile = compile;
   options.cache_dir = std::filesystem::temp_directory_path() / "hybridcont-test-cache";
-  const HybridModel file = LoadModelFile(ModelPath(name), options);
+  const HybridModel file = LoadModelFile(ModelPath(file_name.empty() ? name : file_name), options);
   ASSERT_EQ(ShootingLayout(file).unknown_names(), ShootingLayout(builtin).unknown_names());
   TimeBasedShooting a(builtin, IntegratorOptions{}), b(file, IntegratorOptions{});
   std::mt19937 rng(7);
@@ -53,8 +54,9 @@ void ExpectSameMap(const std::string& name, bool compile) {
     max_r = std::max(max_r, (ra - rb).lpNorm<Eigen::Infinity>() / scale);
     max_dr = std::max(max_dr, (da - db).lpNorm<Eigen::Infinity>() / dr_scale);
   }
-  std::printf("%s (%s): max |r_file - r_builtin| / (1 + |r|) = %.2g, max |dr_file - dr_builtin| / (1 + |dr|) = %.2g\n",
-              name.c_str(), compile ? "compiled" : "interpreted", max_r, max_dr);
+  std::printf("%s%s (%s): max |r_file - r_builtin| / (1 + |r|) = %.2g, max |dr_file - dr_builtin| / (1 + |dr|) = %.2g\n",
+              name.c_str(), file_name.empty() ? "" : (" from " + file_name).c_str(), compile ? "compiled" : "interpreted",
+              max_r, max_dr);
 }
 
 // The same declarations: phase and state names in order, typical states, parameters (defaults and
@@ -104,6 +106,14 @@ TEST(ModelFileEquivalence, BouncingRodInterpreted) { ExpectSameMap("bouncing-rod
 TEST(ModelFileEquivalence, BouncingRodCompiled) { ExpectSameMap("bouncing-rod", true); }
 TEST(ModelFileEquivalence, BallChainInterpreted) { ExpectSameMap("ball-chain", false); }
 TEST(ModelFileEquivalence, BallChainCompiled) { ExpectSameMap("ball-chain", true); }
+
+// Models written from their mechanics (mechanics.h): the rod from T, V and the elastic impact law at its
+// two corners, the SLIP's stance from T and V in (alpha, l), its flight a Lagrangian point mass beside the
+// explicit swing-leg equation.
+TEST(ModelFileEquivalence, LagrangianRodInterpreted) { ExpectSameMap("bouncing-rod", false, "bouncing-rod-lagrangian"); }
+TEST(ModelFileEquivalence, LagrangianRodCompiled) { ExpectSameMap("bouncing-rod", true, "bouncing-rod-lagrangian"); }
+TEST(ModelFileEquivalence, LagrangianSlipInterpreted) { ExpectSameMap("slip", false, "slip-lagrangian"); }
+TEST(ModelFileEquivalence, LagrangianSlipCompiled) { ExpectSameMap("slip", true, "slip-lagrangian"); }
 
 }  // namespace
 }  // namespace hybridcont

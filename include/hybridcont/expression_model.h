@@ -34,6 +34,11 @@ struct ExpressionPhaseSpec {
   ExpressionProgram integrals;     // k outputs (the first integrals H_1..H_k)
   ExpressionProgram event;         // 1 output
   ExpressionProgram reset;         // outputs: the next phase's states
+  // A phase given by its mechanics (mechanics.h): its mass matrix M(q) (n × n outputs, row-major) and the
+  // states holding q, so that a non-finite vector field where M is not positive definite is explained.
+  // Empty otherwise.
+  ExpressionProgram mass_matrix;
+  std::vector<int> coordinates;
 };
 
 struct ExpressionModelSpec {
@@ -83,6 +88,7 @@ namespace internal {
 // What one phase's functions read: its programs, the parameter values, the compiled entry points.
 struct ExpressionPhaseData {
   const ExpressionProgram* programs[5] = {};
+  const ExpressionPhaseSpec* phase = nullptr;  // null for the anchor
   const double* parameters = nullptr;
   const std::array<CompiledProgramFn, kNumScalarKinds>* compiled[5] = {};
 
@@ -133,6 +139,8 @@ struct ExpressionFunctions {
   static T Anchor(const StateVector<T>& x, const D& d) {
     return Outputs(ProgramKind::kAnchor, x, d)(0);
   }
+  // A mechanical phase's vector field is NaN where its mass matrix is not positive definite: says so.
+  static std::string ExplainNonFinite(const Vector& x, const ExpressionPhaseData& d);
 
  private:
   static const ExpressionPhaseData& Base(const ExpressionPhaseData& d) { return d; }

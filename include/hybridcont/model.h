@@ -91,6 +91,13 @@ class Phase {
                                                 const Eigen::Ref<const Vector>& xi, int parameter,
                                                 Vector* dfdp, bool include_mixed_term = true) const;
 
+  // Why the vector field is not finite at x, in words ("the mass matrix is not positive definite at ..."),
+  // for the integrator's message; "" when the phase cannot tell (the default).
+  virtual std::string ExplainNonFinite(const Eigen::Ref<const Vector>& x) const {
+    (void)x;
+    return "";
+  }
+
   // The same phase reading its parameters from `parameters`, a copy of the block it was made with
   // (HybridModel::Clone). nullptr, the default: the phase cannot be rebound (a hand-written phase that
   // keeps its own parameters), and its model cannot be cloned.

@@ -32,6 +32,7 @@ struct AugmentedRhsWorkspace {
   long rhs_evaluations = 0;
   bool nonfinite = false;
   double nonfinite_time = 0.0;
+  std::string nonfinite_reason;  // the phase's explanation at the first non-finite evaluation, if any
   Vector f;
   Matrix A, B, Bp;
   Vector dfdp;
@@ -48,6 +49,7 @@ struct AugmentedRhsWorkspace {
     rhs_evaluations = 0;
     nonfinite = false;
     nonfinite_time = 0.0;
+    nonfinite_reason.clear();
     return sensitivities ? n + n * n + n * (k + q) : n;
   }
   // z at t = 0: [x0; I; 0].
@@ -87,7 +89,10 @@ struct AugmentedRhsWorkspace {
       finite = std::isfinite(dz.sum());
     }
     if (!finite) {
-      if (!nonfinite) nonfinite_time = t;
+      if (!nonfinite) {
+        nonfinite_time = t;
+        nonfinite_reason = phase->ExplainNonFinite(z.head(n));
+      }
       nonfinite = true;
       dz.setZero();
     }

@@ -197,7 +197,8 @@ EventFlowStatus EventFlow::Integrate(const Eigen::Ref<const Vector>& x0, const E
     double t_new = span.second;
     if (rhs.nonfinite || !z_new.allFinite()) {
       const double t_bad = rhs.nonfinite ? rhs.nonfinite_time : t_new;
-      return finish(EventFlowStatus::kNonFinite, at(t_bad) + "the model returned a non-finite value", t_bad,
+      return finish(EventFlowStatus::kNonFinite, at(t_bad) + "the model returned a non-finite value" +
+                                                        (rhs.nonfinite_reason.empty() ? "" : ": " + rhs.nonfinite_reason), t_bad,
                     dense.previous_state(), g_prev, g_dot_prev);
     }
     double g_new = 0.0;

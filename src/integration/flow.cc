@@ -163,6 +163,7 @@ FlowStatus PhaseFlow::Integrate(const Eigen::Ref<const Vector>& x0, const Eigen:
       std::ostringstream os;
       os << "phase '" << phase_->name() << "': model returned a non-finite value at t = "
          << (w.nonfinite ? w.nonfinite_time : time) << " (duration " << t << ")";
+      if (w.nonfinite && !w.nonfinite_reason.empty()) os << ": " << w.nonfinite_reason;
       return finish(FlowStatus::kNonFinite, os.str());
     }
     if (step_result == odeint::success) {

@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "hybridcont/mechanics.h"
+
 namespace hybridcont {
 namespace {
 
@@ -31,6 +33,7 @@ void BindPhaseData(ExpressionModelData* data) {
     d.programs[1] = &p.integrals;
     d.programs[2] = &p.event;
     d.programs[3] = &p.reset;
+    d.phase = &p;
     d.parameters = data->values.data();
     for (int k = 0; k < 4; ++k) d.compiled[k] = entry(i, static_cast<ProgramKind>(k));
   }
@@ -83,6 +86,20 @@ class ExpressionParameterBlock final : public ParameterBlock,
 };
 
 }  // namespace
+
+std::string internal::ExpressionFunctions::ExplainNonFinite(const Vector& x, const ExpressionPhaseData& d) {
+  if (d.phase == nullptr || d.phase->coordinates.empty() || !x.allFinite()) return "";
+  const ExpressionProgram& program = d.phase->mass_matrix;
+  std::vector<double> entries(program.num_outputs());
+  for (int k = 0; k < program.num_outputs(); ++k) entries[k] = program.EvaluateScalar(x.data(), d.parameters, k);
+  std::vector<std::string> names;
+  std::vector<double> q;
+  for (int c : d.phase->coordinates) {  // ignorable coordinates (-1) do not enter M
+    names.push_back(c >= 0 ? d.phase->state_names[c] : "(ignorable)");
+    q.push_back(c >= 0 ? x(c) : 0.0);
+  }
+  return ExplainMassMatrix(entries, names, q);
+}
 
 HybridModel BuildExpressionModel(ExpressionModelSpec spec, std::shared_ptr<const CompiledPrograms> compiled) {
   const int m = static_cast<int>(spec.phases.size());

@@ -97,12 +97,33 @@ class Reader {
   void ReadPhaseFunctions(int i);
   // The let quantities of phase i, each parsed now: errors in unused quantities are errors too.
   void ReadLets(int i);
-  // ode: one expression per state, keyed by the state's name.
-  void ReadVectorField(int i);
-  // First integrals: `energy` (one) or `integrals` (several), as many in every phase as in the first.
-  void ReadIntegrals(int i);
-  // reset: the next phase's states by name (the next phase may have another dimension).
-  void ReadReset(int i);
+  // ode: one expression per state, keyed by the state's name; `derived` (non-empty for a phase given by its
+  // mechanics) holds the rates of its coordinates and velocities, and ode gives the others.
+  void ReadVectorField(int i, const std::vector<ExprPtr>& derived);
+  // First integrals: `energy` (one) or `integrals` (several), as many in every phase as in the first; a
+  // phase given by its mechanics may leave both out (derived_energy, H = T + V).
+  void ReadIntegrals(int i, const ExprPtr& derived_energy);
+  // reset: the next phase's states by name (the next phase may have another dimension); `defaults` (after
+  // an impact: the post-impact state, non-empty) fills the states the reset table does not give.
+  void ReadReset(int i, const std::vector<ExprPtr>& defaults);
+
+  // ---- phases given by their mechanics (read_mechanics.cc)
+  struct MechanicalNames {
+    std::vector<std::string> coordinates, velocities;  // empty: the phase is given by its ode
+    std::set<std::string> ignorable;                   // coordinates that are not states (cyclic)
+  };
+  // coordinates and velocities (default: "d" + coordinate), checked as names.
+  MechanicalNames ReadMechanicalNames(const toml::table& t, const std::string& pf) const;
+  struct Mechanics {
+    std::vector<ExprPtr> vector_field;  // empty for an ode phase; else the rates of q and q̇, null elsewhere
+    ExprPtr energy;                     // H derived from the mechanics
+    ExprPtr constraint;                 // the impact's contact constraint g(q), if any
+    SourceLocation constraint_where;
+    std::vector<ExprPtr> reset;         // after an impact: the next phase's states (null where not known)
+  };
+  // kinetic/potential or mass_matrix/forces/potential, and impact: derives the equations of motion
+  // (mechanics.h), checks them and stores M for explanations.
+  Mechanics ReadMechanics(int i);
   void ReadSymmetries();
 
   // ---- sections (read_presentation.cc)
@@ -129,6 +150,7 @@ class Reader {
   std::vector<const toml::table*> phase_tables_;
   std::vector<const toml::table*> phase_lets_;
   int num_integrals_ = 1;
+  std::vector<MechanicalNames> mechanical_names_;
 };
 
 }  // namespace hybridcont::internal

@@ -15,7 +15,8 @@ void Reader::ReadPhaseHeaders() {
     const std::string field = "phases[" + std::to_string(i) + "]";
     if (!a.get(i)->is_table()) Fail(a.get(i), field, "expected a [[phases]] table, got " + TypeName(*a.get(i)));
     const toml::table& t = *a.get(i)->as_table();
-    CheckKeys(t, field, {"name", "states", "typical", "let", "ode", "energy", "integrals", "event", "reset", "anchor"});
+    CheckKeys(t, field, {"name", "states", "typical", "let", "ode", "energy", "integrals", "event", "reset", "anchor",
+                         "coordinates", "velocities", "ignorable", "kinetic", "potential", "mass_matrix", "forces", "impact"});
     ExpressionPhaseSpec p;
     p.name = RequiredString(t, "name", field);
     if (p.name.empty() || !names.insert(p.name).second) {
@@ -23,8 +24,31 @@ void Reader::ReadPhaseHeaders() {
     }
     const std::string pf = "phases." + p.name;
     const toml::node* states = t.get("states");
-    if (states == nullptr) Fail(&t, pf + ".states", "missing field 'states'");
-    p.state_names = StringArray(*states, pf + ".states");
+    MechanicalNames mech = ReadMechanicalNames(t, pf);
+    if (states == nullptr && mech.coordinates.empty()) {
+      Fail(&t, pf + ".states", "missing field 'states' (or 'coordinates', for a phase given by its mechanics)");
+    }
+    if (states) {
+      p.state_names = StringArray(*states, pf + ".states");
+    } else {
+      states = t.get("coordinates");
+      for (const std::string& q : mech.coordinates) {
+        if (!mech.ignorable.count(q)) p.state_names.push_back(q);
+      }
+      p.state_names.insert(p.state_names.end(), mech.velocities.begin(), mech.velocities.end());
+    }
+    for (const std::vector<std::string>* names : {&mech.coordinates, &mech.velocities}) {
+      for (const std::string& s : *names) {
+        const bool is_state = std::find(p.state_names.begin(), p.state_names.end(), s) != p.state_names.end();
+        if (mech.ignorable.count(s)) {
+          if (is_state) Fail(states, pf + ".states", "'" + s + "' is ignorable: it is not a state");
+        } else if (!is_state) {
+          Fail(states, pf + ".states", "'" + s + "' is a coordinate or velocity but not a state (the state holds " +
+                                           "every coordinate and its velocity)");
+        }
+      }
+    }
+    mechanical_names_.push_back(std::move(mech));
     if (p.state_names.empty() || static_cast<int>(p.state_names.size()) > kMaxPhaseDim) {
       Fail(states, pf + ".states", std::to_string(p.state_names.size()) + " states, expected 1 to " +
                                        std::to_string(kMaxPhaseDim));
@@ -58,16 +82,22 @@ void Reader::ReadPhaseHeaders() {
 
 void Reader::ReadPhaseFunctions(int i) {
   ReadLets(i);
-  ReadVectorField(i);
-  ReadIntegrals(i);
+  const Mechanics mechanics = ReadMechanics(i);
+  ReadVectorField(i, mechanics.vector_field);
+  ReadIntegrals(i, mechanics.energy);
   const toml::table& t = *phase_tables_[i];
   ExpressionPhaseSpec& p = spec_.phases[i];
   const std::string pf = "phases." + p.name;
   const int dim = static_cast<int>(p.state_names.size());
   const toml::node* event = t.get("event");
-  if (event == nullptr) Fail(&t, pf + ".event", "missing field 'event' (the phase ends at its downward zero crossing)");
-  p.event = ExpressionProgram({ParsePhaseExpression(i, *event, pf + ".event")}, dim, true, {At(event, pf + ".event")});
-  ReadReset(i);
+  if (event != nullptr) {
+    p.event = ExpressionProgram({ParsePhaseExpression(i, *event, pf + ".event")}, dim, true, {At(event, pf + ".event")});
+  } else if (mechanics.constraint) {  // the phase ends at its contact
+    p.event = ExpressionProgram({mechanics.constraint}, dim, true, {mechanics.constraint_where});
+  } else {
+    Fail(&t, pf + ".event", "missing field 'event' (the phase ends at its downward zero crossing)");
+  }
+  ReadReset(i, mechanics.reset);
   if (i == 0) {
     const toml::node* anchor = t.get("anchor");
     if (anchor == nullptr) {
@@ -94,14 +124,16 @@ void Reader::ReadLets(int i) {
   }
 }
 
-void Reader::ReadVectorField(int i) {
+void Reader::ReadVectorField(int i, const std::vector<ExprPtr>& derived) {
   const toml::table& t = *phase_tables_[i];
   ExpressionPhaseSpec& p = spec_.phases[i];
   const std::string pf = "phases." + p.name;
   const int dim = static_cast<int>(p.state_names.size());
-  const toml::table& ode = RequiredTable(t, "ode", pf);
-  std::vector<ExprPtr> f(dim);
-  std::vector<SourceLocation> f_where(dim);
+  const bool mechanical = !derived.empty();
+  static const toml::table kNoEquations;
+  const toml::table& ode = mechanical && !t.get("ode") ? kNoEquations : RequiredTable(t, "ode", pf);
+  std::vector<ExprPtr> f = mechanical ? derived : std::vector<ExprPtr>(dim);
+  std::vector<SourceLocation> f_where(dim, At(t.get("kinetic") ? t.get("kinetic") : t.get("mass_matrix"), pf));
   for (auto&& [key, node] : ode) {
     const std::string name(key.str());
     const auto it = std::find(p.state_names.begin(), p.state_names.end(), name);
@@ -109,6 +141,10 @@ void Reader::ReadVectorField(int i) {
       Fail(&node, pf + ".ode." + name, "'" + name + "' is not a state of phase '" + p.name + "'");
     }
     const int k = static_cast<int>(it - p.state_names.begin());
+    if (f[k]) {
+      Fail(&node, pf + ".ode." + name, "'" + name + "' is a coordinate or velocity: its rate comes from the " +
+                                           "mechanics (give 'ode' for the other states only)");
+    }
     f[k] = ParsePhaseExpression(i, node, pf + ".ode." + name);
     f_where[k] = At(&node, pf + ".ode." + name);
   }
@@ -118,19 +154,25 @@ void Reader::ReadVectorField(int i) {
   p.vector_field = ExpressionProgram(f, dim, true, f_where);
 }
 
-void Reader::ReadIntegrals(int i) {
+void Reader::ReadIntegrals(int i, const ExprPtr& derived_energy) {
   const toml::table& t = *phase_tables_[i];
   ExpressionPhaseSpec& p = spec_.phases[i];
   const std::string pf = "phases." + p.name;
   const toml::node* energy = t.get("energy");
   const toml::node* integrals = t.get("integrals");
-  if ((energy == nullptr) == (integrals == nullptr)) {
-    Fail(integrals ? integrals : &t, pf + ".energy",
-         "give exactly one of 'energy' (the first integral) or 'integrals' (several)");
+  if (energy && integrals) {
+    Fail(integrals, pf + ".energy", "give exactly one of 'energy' (the first integral) or 'integrals' (several)");
+  }
+  if (!energy && !integrals && !derived_energy) {
+    Fail(&t, pf + ".energy", "give exactly one of 'energy' (the first integral) or 'integrals' (several)");
   }
   std::vector<ExprPtr> h;
   std::vector<SourceLocation> h_where;
-  if (energy) {
+  if (!energy && !integrals) {  // H = T + V of a phase given by its mechanics
+    h.push_back(derived_energy);
+    h_where.push_back(At(t.get("kinetic") ? t.get("kinetic") : t.get("mass_matrix"), pf + ".energy"));
+    energy = t.get("kinetic") ? t.get("kinetic") : t.get("mass_matrix");
+  } else if (energy) {
     h.push_back(ParsePhaseExpression(i, *energy, pf + ".energy"));
     h_where.push_back(At(energy, pf + ".energy"));
   } else {
@@ -151,15 +193,17 @@ void Reader::ReadIntegrals(int i) {
   p.integrals = ExpressionProgram(h, static_cast<int>(p.state_names.size()), true, h_where);
 }
 
-void Reader::ReadReset(int i) {
+void Reader::ReadReset(int i, const std::vector<ExprPtr>& defaults) {
   const toml::table& t = *phase_tables_[i];
   ExpressionPhaseSpec& p = spec_.phases[i];
   const std::string pf = "phases." + p.name;
   const int m = static_cast<int>(spec_.phases.size());
   const ExpressionPhaseSpec& next = spec_.phases[(i + 1) % m];
-  const toml::table& reset = RequiredTable(t, "reset", pf);
+  static const toml::table kNoReset;
+  const toml::table& reset = !defaults.empty() && !t.get("reset") ? kNoReset : RequiredTable(t, "reset", pf);
   std::vector<ExprPtr> r(next.state_names.size());
-  std::vector<SourceLocation> r_where(next.state_names.size());
+  std::vector<SourceLocation> r_where(next.state_names.size(), At(t.get("impact"), pf + ".impact"));
+  if (!defaults.empty()) r = defaults;
   for (auto&& [key, node] : reset) {
     const std::string name(key.str());
     const auto it = std::find(next.state_names.begin(), next.state_names.end(), name);
@@ -173,7 +217,7 @@ void Reader::ReadReset(int i) {
   }
   for (std::size_t k = 0; k < r.size(); ++k) {
     if (!r[k]) {
-      Fail(&reset, pf + ".reset", "missing the value of state '" + next.state_names[k] + "' of the next phase '" +
+      Fail(t.get("reset") ? static_cast<const toml::node*>(&reset) : &t, pf + ".reset", "missing the value of state '" + next.state_names[k] + "' of the next phase '" +
                                       next.name + "' (the reset gives all " + std::to_string(r.size()) + " of them)");
     }
   }

@@ -286,6 +286,15 @@ class AutoDiffPhase final : public Phase {
 
   bool has_parameter_derivatives() const override { return differentiable_; }
 
+  // F may explain a non-finite vector field: static std::string ExplainNonFinite(const Vector&, const P&).
+  std::string ExplainNonFinite(const Eigen::Ref<const Vector>& x) const override {
+    if constexpr (requires(const Vector& v) { F::ExplainNonFinite(v, *p_); }) {
+      return F::ExplainNonFinite(Vector(x), *p_);
+    } else {
+      return Phase::ExplainNonFinite(x);
+    }
+  }
+
   void ParameterDerivatives(const Eigen::Ref<const Vector>& x, int parameter, Vector* field, Vector* integrals,
                             double* event, Vector* reset) const override {
     HYBRIDCONT_DEMAND(differentiable_);

@@ -1,0 +1,80 @@
+// A phase given by its mechanics: the equations of motion, the energy and impact laws derived from a
+// Lagrangian or a mass-matrix form, as expressions (expression.h) over the phase's states.
+//
+// Two forms, over generalized coordinates q (n of them) and their velocities q̇ (both are states):
+//   - Lagrangian: kinetic energy T(q, q̇) = ½ q̇ᵀ M(q) q̇ (a quadratic form in q̇), potential V(q) and
+//     optional generalized forces Q(q, q̇). Euler–Lagrange, d/dt ∂T/∂q̇ − ∂T/∂q + ∂V/∂q = Q, gives
+//         M(q) q̈ = h(q, q̇),  M = ∂²T/∂q̇²,  h = ∂T/∂q − (∂²T/∂q̇∂q) q̇ − ∂V/∂q + Q,
+//     and the energy H = T + V, which Q conserves when it does no work (Q·q̇ = 0).
+//   - Mass-matrix: M(q) and h(q, q̇) given; with a potential V declared, −∂V/∂q is added to h and
+//     H = ½ q̇ᵀ M q̇ + V.
+// q̈ = M⁻¹ h is solved by the tool (CholeskySolve, expression_derivative.h): exact derivatives through it,
+// NaN (reported by the integrator, explained by ExplainMassMatrix) where M is not positive definite.
+//
+// Impact at a contact constraint g(q) = 0 with Newton's law of restitution e (the paper's resets of the
+// rod, eq. jumpLeft and jumpRight, are the case e = 1): with G = ∂g/∂q (a row) and the impulse along
+// M⁻¹Gᵀ,
+//         q⁺ = q,   q̇⁺ = q̇ − (1 + e) M⁻¹Gᵀ (G q̇) / (G M⁻¹ Gᵀ),
+// so that G q̇⁺ = −e G q̇ and, for e = 1, T(q, q̇⁺) = T(q, q̇).
+#ifndef HYBRIDCONT_MECHANICS_H_
+#define HYBRIDCONT_MECHANICS_H_
+
+#include <string>
+#include <vector>
+
+#include "hybridcont/expression.h"
+#include "hybridcont/types.h"
+
+namespace hybridcont {
+
+// The mechanics of a phase. Indices are inputs of the phase's expressions (its states).
+struct MechanicalSystem {
+  // q: n input indices; -1 for an ignorable (cyclic) coordinate that is not a state: nothing depends on
+  // it, only its velocity is a state.
+  std::vector<int> coordinates;
+  std::vector<int> velocities;   // q̇: n input indices, velocities[i] the rate of coordinates[i]
+  // Lagrangian form: kinetic (non-null) and potential (null: V = 0).
+  ExprPtr kinetic;
+  ExprPtr potential;
+  // Mass-matrix form (when kinetic is null): n × n, symmetric.
+  std::vector<std::vector<ExprPtr>> mass_matrix;
+  // Q (Lagrangian) or h (mass-matrix form); n entries, null entries zero.
+  std::vector<ExprPtr> forces;
+  // Where each field came from, for messages: kinetic, potential, mass_matrix, forces.
+  SourceLocation kinetic_where, potential_where, mass_matrix_where, forces_where;
+};
+
+// The derived equations: M (n × n, symmetric), h (n), q̈ = M⁻¹h (n) and the energy.
+struct EquationsOfMotion {
+  std::vector<std::vector<ExprPtr>> mass_matrix;
+  std::vector<ExprPtr> forces;
+  std::vector<ExprPtr> accelerations;
+  ExprPtr energy;
+};
+
+// Derives the equations. Throws ModelInputError (at the field concerned) for bad mechanics that shows in
+// the structure: T or M depending on a velocity, V depending on a velocity, a non-smooth operation, a mass
+// matrix of the wrong size. CheckMechanics finds what only shows in values.
+EquationsOfMotion DeriveEquationsOfMotion(const MechanicalSystem& system);
+
+// Checks at `states` (each a full state of the phase) with parameter values p: T equals ½ q̇ᵀ M q̇ (no
+// terms of order 0, 1 or above 2 in q̇), M is symmetric (mass-matrix form). Throws ModelInputError naming
+// the field, the state and the values.
+void CheckMechanics(const MechanicalSystem& system, const EquationsOfMotion& equations, int num_states,
+                    const std::vector<Vector>& states, const std::vector<double>& p,
+                    const std::vector<std::string>& state_names);
+
+// The post-impact velocities q̇⁺ (n) at the constraint g (an expression of q; throws ModelInputError at
+// `where` if g does not depend on q or depends on a velocity).
+std::vector<ExprPtr> ImpactVelocities(const MechanicalSystem& system, const EquationsOfMotion& equations,
+                                      const ExprPtr& constraint, double restitution, const SourceLocation& where);
+
+// Why M is not positive definite at a state, from its entries there (n × n, row-major): "" if it is.
+// Names the coordinates (names[i] for q_i) and the values: "the mass matrix is not positive definite at
+// (y = 0.3, alpha = 0.1): pivot 2 of its Cholesky factorization is -0.25".
+std::string ExplainMassMatrix(const std::vector<double>& entries, const std::vector<std::string>& names,
+                              const std::vector<double>& coordinates);
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_MECHANICS_H_

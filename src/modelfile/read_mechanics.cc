@@ -1,0 +1,178 @@
+// Reading a phase given by its mechanics: coordinates and velocities, a Lagrangian (kinetic, potential,
+// forces) or a mass-matrix form (mass_matrix, forces, potential), and an impact law at a contact.
+#include <algorithm>
+
+#include "hybridcont/expression_derivative.h"
+#include "hybridcont/mechanics.h"
+#include "model_reader.h"
+
+namespace hybridcont::internal {
+
+Reader::MechanicalNames Reader::ReadMechanicalNames(const toml::table& t, const std::string& pf) const {
+  MechanicalNames names;
+  const toml::node* coordinates = t.get("coordinates");
+  if (coordinates == nullptr) {
+    for (const char* key : {"velocities", "ignorable", "kinetic", "potential", "mass_matrix", "forces", "impact"}) {
+      if (const toml::node* n = t.get(key)) {
+        Fail(n, pf + "." + key, std::string("'") + key + "' needs 'coordinates' (a phase given by its mechanics)");
+      }
+    }
+    return names;
+  }
+  names.coordinates = StringArray(*coordinates, pf + ".coordinates");
+  if (names.coordinates.empty()) Fail(coordinates, pf + ".coordinates", "at least one coordinate");
+  if (const toml::node* v = t.get("velocities")) {
+    names.velocities = StringArray(*v, pf + ".velocities");
+    if (names.velocities.size() != names.coordinates.size()) {
+      Fail(v, pf + ".velocities", std::to_string(names.velocities.size()) + " velocities for " +
+                                      std::to_string(names.coordinates.size()) + " coordinates");
+    }
+  } else {
+    for (const std::string& q : names.coordinates) names.velocities.push_back("d" + q);
+  }
+  if (const toml::node* ig = t.get("ignorable")) {
+    for (const std::string& q : StringArray(*ig, pf + ".ignorable")) {
+      if (std::find(names.coordinates.begin(), names.coordinates.end(), q) == names.coordinates.end()) {
+        Fail(ig, pf + ".ignorable", "'" + q + "' is not a coordinate (ignorable coordinates are coordinates that " +
+                                        "T, V and the forces do not depend on, left out of the state)");
+      }
+      names.ignorable.insert(q);
+    }
+  }
+  if (!t.get("kinetic") && !t.get("mass_matrix")) {
+    Fail(&t, pf + ".kinetic", "a phase with coordinates needs 'kinetic' (T, a Lagrangian) or 'mass_matrix' (M)");
+  }
+  if (t.get("kinetic") && t.get("mass_matrix")) {
+    Fail(t.get("mass_matrix"), pf + ".mass_matrix", "give 'kinetic' (T, M derived from it) or 'mass_matrix', not both");
+  }
+  std::set<std::string> seen;
+  for (const std::vector<std::string>* list : {&names.coordinates, &names.velocities}) {
+    for (const std::string& s : *list) {
+      const std::string field = pf + (list == &names.coordinates ? ".coordinates" : ".velocities");
+      const toml::node* at = list == &names.coordinates || !t.get("velocities") ? coordinates : t.get("velocities");
+      CheckName(at, field, s);
+      if (!seen.insert(s).second) Fail(at, field, "'" + s + "' is both a coordinate and a velocity, or listed twice");
+    }
+  }
+  return names;
+}
+
+Reader::Mechanics Reader::ReadMechanics(int i) {
+  Mechanics out;
+  const MechanicalNames& names = mechanical_names_[i];
+  if (names.coordinates.empty()) return out;
+  const toml::table& t = *phase_tables_[i];
+  ExpressionPhaseSpec& p = spec_.phases[i];
+  const std::string pf = "phases." + p.name;
+  const int dim = static_cast<int>(p.state_names.size());
+  const int n = static_cast<int>(names.coordinates.size());
+  // The state holding a name; -1 for an ignorable coordinate (derivatives in it vanish: no input is -1).
+  const auto index = [&](const std::string& s) {
+    if (names.ignorable.count(s)) return -1;
+    return static_cast<int>(std::find(p.state_names.begin(), p.state_names.end(), s) - p.state_names.begin());
+  };
+  MechanicalSystem system;
+  for (int k = 0; k < n; ++k) {
+    system.coordinates.push_back(index(names.coordinates[k]));
+    system.velocities.push_back(index(names.velocities[k]));
+  }
+  if (const toml::node* kinetic = t.get("kinetic")) {
+    system.kinetic = ParsePhaseExpression(i, *kinetic, pf + ".kinetic");
+    system.kinetic_where = At(kinetic, pf + ".kinetic");
+  }
+  if (const toml::node* potential = t.get("potential")) {
+    system.potential = ParsePhaseExpression(i, *potential, pf + ".potential");
+    system.potential_where = At(potential, pf + ".potential");
+  }
+  if (const toml::node* mass = t.get("mass_matrix")) {
+    const std::string field = pf + ".mass_matrix";
+    system.mass_matrix_where = At(mass, field);
+    const toml::array& rows = AsArray(*mass, field);
+    if (static_cast<int>(rows.size()) != n) {
+      Fail(mass, field, std::to_string(rows.size()) + " rows for " + std::to_string(n) + " coordinates (M is n × n)");
+    }
+    for (int r = 0; r < n; ++r) {
+      const std::string rf = field + "[" + std::to_string(r) + "]";
+      const toml::array& row = AsArray(*rows.get(r), rf);
+      if (static_cast<int>(row.size()) != n) {
+        Fail(rows.get(r), rf, std::to_string(row.size()) + " entries for " + std::to_string(n) + " coordinates");
+      }
+      system.mass_matrix.emplace_back();
+      for (int c = 0; c < n; ++c) {
+        system.mass_matrix.back().push_back(
+            ParsePhaseExpression(i, *row.get(c), rf + "[" + std::to_string(c) + "]"));
+      }
+    }
+  }
+  system.forces.assign(n, nullptr);
+  if (const toml::table* forces = OptionalTable(t, "forces", pf)) {
+    system.forces_where = At(forces, pf + ".forces");
+    for (auto&& [key, node] : *forces) {
+      const std::string name(key.str());
+      const auto it = std::find(names.coordinates.begin(), names.coordinates.end(), name);
+      if (it == names.coordinates.end()) {
+        Fail(&node, pf + ".forces." + name, "'" + name + "' is not a coordinate of phase '" + p.name +
+                                                "' (forces are keyed by coordinate: " + JoinNames(names.coordinates) +
+                                                ")");
+      }
+      system.forces[it - names.coordinates.begin()] = ParsePhaseExpression(i, node, pf + ".forces." + name);
+    }
+  }
+  const EquationsOfMotion eq = DeriveEquationsOfMotion(system);
+
+  // Values only: T quadratic in q̇, M symmetric; at the typical state and two others around it.
+  std::vector<double> values;
+  for (const ParameterInfo& info : spec_.parameters) values.push_back(info.default_value);
+  std::vector<Vector> states;
+  for (int k = 0; k < 3; ++k) {
+    Vector x = p.typical_state;
+    for (int j = 0; j < dim; ++j) x(j) += k == 0 ? 0.0 : 0.1 * (k == 1 ? 1.0 + 0.3 * j : -1.0 + 0.2 * j);
+    for (int v : system.velocities) x(v) *= k == 2 ? -1.7 : 1.0;
+    states.push_back(x);
+  }
+  CheckMechanics(system, eq, dim, states, values, p.state_names);
+
+  out.vector_field.assign(dim, nullptr);
+  for (int k = 0; k < n; ++k) {
+    if (system.coordinates[k] >= 0) out.vector_field[system.coordinates[k]] = MakeInput(system.velocities[k]);
+    out.vector_field[system.velocities[k]] = eq.accelerations[k];
+  }
+  out.energy = eq.energy;
+  std::vector<ExprPtr> entries;
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) entries.push_back(eq.mass_matrix[r][c]);
+  }
+  p.mass_matrix = ExpressionProgram(entries, dim, false, {});
+  p.coordinates = system.coordinates;
+
+  if (const toml::table* impact = OptionalTable(t, "impact", pf)) {
+    const std::string field = pf + ".impact";
+    CheckKeys(*impact, field, {"constraint", "restitution"});
+    const toml::node* g = impact->get("constraint");
+    if (g == nullptr) Fail(impact, field + ".constraint", "missing field 'constraint' (the contact's g(q); impact at g = 0)");
+    out.constraint = ParsePhaseExpression(i, *g, field + ".constraint");
+    out.constraint_where = At(g, field + ".constraint");
+    const double e = OptionalNumber(*impact, "restitution", field, 1.0);
+    if (e != 1.0) {
+      Fail(impact->get("restitution"), field + ".restitution",
+           "restitution " + std::to_string(e) + ": only the elastic law (1), which conserves the energy, is "
+           "supported in a conservative model");
+    }
+    const std::vector<ExprPtr> after = ImpactVelocities(system, eq, out.constraint, e, out.constraint_where);
+    // Into the next phase: a state named like one of this phase's takes its value after the impact.
+    const ExpressionPhaseSpec& next = spec_.phases[(i + 1) % spec_.phases.size()];
+    for (const std::string& s : next.state_names) {
+      const auto v = std::find(names.velocities.begin(), names.velocities.end(), s);
+      if (v != names.velocities.end()) {
+        out.reset.push_back(after[v - names.velocities.begin()]);
+      } else if (index(s) >= 0 && index(s) < dim) {
+        out.reset.push_back(MakeInput(index(s)));
+      } else {
+        out.reset.push_back(nullptr);
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace hybridcont::internal
