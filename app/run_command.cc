@@ -350,7 +350,8 @@ std::unique_ptr<ModelExploration> MakeExploration(const RunArguments& args, cons
 
 // The model must keep its first integrals (conservation_check.h): checked at the typical states and at the
 // start orbit's states before anything runs; a violation is a modelling error (bad input).
-void CheckConservationAtStart(const HybridModel& model, const ShootingLayout& layout, const Vector& start) {
+void CheckConservationAtStart(const HybridModel& model, const std::string& argument, const ShootingLayout& layout,
+                              const Vector& start) {
   std::vector<std::vector<Vector>> states(model.num_phases());
   for (int i = 0; i < model.num_phases(); ++i) states[i].push_back(model.phase(i).typical_state());
   if (start.size() == layout.num_unknowns()) {
@@ -361,7 +362,7 @@ void CheckConservationAtStart(const HybridModel& model, const ShootingLayout& la
   const ConservationReport report = CheckConservation(model, states);
   if (!report.passed()) {
     throw std::invalid_argument("model '" + model.name() + "' does not conserve its energy: " +
-                                report.FirstFailure() + " (`hybridcont check " + model.name() +
+                                report.FirstFailure() + " (`hybridcont check " + argument +
                                 "` shows every phase and reset)");
   }
 }
@@ -382,7 +383,7 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   const RunSetup setup = MakeRunSetup(args, model);
   const nlohmann::json options_json = OptionsJson(args, setup);
   const std::unique_ptr<ModelExploration> exploration = MakeExploration(args, model, setup, formulation);
-  CheckConservationAtStart(model, exploration->shooting().layout(), setup.scenario.start);
+  CheckConservationAtStart(model, args.model, exploration->shooting().layout(), setup.scenario.start);
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / model.name() : fs::path(args.out_dir);
   ResultsWriter::PrepareDirectory(dir, model.name(), args.overwrite);
 

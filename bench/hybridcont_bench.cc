@@ -172,6 +172,24 @@ void BM_ModelFileFullRun(benchmark::State& state) {
 }
 BENCHMARK(BM_ModelFileFullRun)->ArgsProduct({{0, 1, 2, 3}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
 
+// Models written from their mechanics (models/<name>-lagrangian.toml: T, V, impact laws; mechanics.h)
+// against the same models in explicit form, in the same run: BM_LagrangianFullRun/<model>/<variant>, model
+// 0 the bouncing rod, 1 the SLIP; variant 0 the built-in C++ model, 1 the explicit model file, 2 the
+// Lagrangian model file (both compiled, cache warm). One thread.
+void BM_LagrangianFullRun(benchmark::State& state) {
+  const std::string name = state.range(0) == 0 ? "bouncing-rod" : "slip";
+  const int variant = static_cast<int>(state.range(1));
+  ModelFileOptions options;
+  options.cache_dir = std::filesystem::temp_directory_path() / "hybridcont-bench-cache";
+  const std::string file = name + (variant == 2 ? "-lagrangian" : "");
+  const HybridModel model =
+      variant == 0 ? MakeBuiltinModel(name)
+                   : LoadModelFile(std::filesystem::path(HYBRIDCONT_SOURCE_DIR) / "models" / (file + ".toml"), options);
+  FullRun(state, model, 1);
+  state.SetLabel(name + (variant == 0 ? " built-in" : variant == 1 ? " explicit file" : " Lagrangian file"));
+}
+BENCHMARK(BM_LagrangianFullRun)->ArgsProduct({{0, 1}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
+
 // What the first use of a model file costs: parse, generate, compile with the system compiler and load,
 // into an empty cache (later uses load the cached library: BM_ModelFileLoad).
 void ModelFileLoad(benchmark::State& state, bool cold) {

@@ -133,12 +133,41 @@ std::string Repeat(const std::string& s, int n) {
   return out;
 }
 
+// A model given by its mechanics, for the rows of bad mechanics.
+constexpr const char* kPendulum = R"toml(# The pendulum on a bouncing slider (models/bouncing-pendulum.toml), trimmed: the base of the bad-mechanics rows.
+hybridcont = 1
+name = "bouncing-pendulum"
+
+[parameters]
+m1 = { value = 1.0, range = "(0, inf)" }
+m2 = { value = 1.0, range = "(0, inf)" }
+l  = { value = 1.0, range = "(0, inf)" }
+g  = { value = 1.0, range = "(0, inf)" }
+
+[[phases]]
+name = "flight"
+coordinates = ["y", "theta"]
+typical = [0.3, 0.4, -0.2, 0.5]
+kinetic = "0.5*m1*dy^2 + 0.5*m2*((l*cos(theta)*dtheta)^2 + (dy + l*sin(theta)*dtheta)^2)"
+potential = "(m1 + m2)*g*y + m2*g*l*(1 - cos(theta))"
+impact = { constraint = "y", restitution = 1 }
+anchor = "dy"
+
+[start]
+kind = "singular"
+values = { t1 = "sqrt(0.5)", t2 = "sqrt(0.5)", x1_y = "0.25", x2_dy = "sqrt(0.5)", H = "0.5" }
+
+[run]
+bounds = { xi = [-1, 1], H = [0.05, 3], period = [-20, 20] }
+)toml";
+
 struct BadFile {
   std::string name;     // the test's name
-  std::string find;     // text of kSlip to replace (it occurs exactly once); empty: append `replace`
+  std::string find;     // text of `model` to replace (it occurs exactly once); empty: append `replace`
   std::string replace;
   int line;             // the line the error must name (where().line)
   std::string message;  // a substring of the message: the field and the problem
+  const char* model = kSlip;
 };
 
 // Every row breaks one thing; the line is the line of the broken value (or of the table that lacks it).
@@ -275,12 +304,51 @@ const BadFile kBadFiles[] = {
      "drawing.flight.points.foot[0]: in expression 'X + l0*s' at column 8: unknown symbol 's'"},
     {"DrawingUnknownSymbol", "x_velocity = \"dx\"", "x_velocity = \"dz\"", 97,
      "drawing.flight.x_velocity: in expression 'dz' at column 1: unknown symbol 'dz'"},
+    // ---- bad mechanics (a phase given by its mechanics, mechanics.h)
+    {"KineticNotQuadratic", "kinetic = \"0.5*m1*dy^2", "kinetic = \"0.1*dy^4 + 0.5*m1*dy^2", 15,
+     "phases.flight.kinetic: the kinetic energy is not quadratic in the velocities", kPendulum},
+    {"KineticWithLinearTerm", "kinetic = \"0.5*m1*dy^2", "kinetic = \"m1*g*dy + 0.5*m1*dy^2", 15,
+     "phases.flight.kinetic: the kinetic energy is not a quadratic form in the velocities: T = ", kPendulum},
+    {"PotentialOfAVelocity", "potential = \"(m1 + m2)*g*y", "potential = \"(m1 + m2)*g*y + dtheta", 16,
+     "phases.flight.potential: the potential energy V(q) depends on a velocity", kPendulum},
+    {"MassMatrixNotSymmetric", "kinetic = \"0.5*m1*dy^2 + 0.5*m2*((l*cos(theta)*dtheta)^2 + (dy + l*sin(theta)*dtheta)^2)\"", "mass_matrix = [[\"m1 + m2\", \"m2*l*sin(theta)\"], [\"0\", \"m2*l^2\"]]", 15,
+     "phases.flight.mass_matrix: the mass matrix is not symmetric: entry (2, 1) = 0 but (1, 2) = ", kPendulum},
+    {"MassMatrixWrongSize", "kinetic = \"0.5*m1*dy^2 + 0.5*m2*((l*cos(theta)*dtheta)^2 + (dy + l*sin(theta)*dtheta)^2)\"", "mass_matrix = [[\"m1 + m2\"]]", 15,
+     "phases.flight.mass_matrix: 1 rows for 2 coordinates (M is n × n)", kPendulum},
+    {"MassMatrixOfAVelocity", "kinetic = \"0.5*m1*dy^2 + 0.5*m2*((l*cos(theta)*dtheta)^2 + (dy + l*sin(theta)*dtheta)^2)\"", "mass_matrix = [[\"m1 + m2\", \"0\"], [\"0\", \"m2*l^2*dy\"]]", 15,
+     "phases.flight.mass_matrix: mass-matrix entry (2, 2) depends on a velocity", kPendulum},
+    {"KineticAndMassMatrix", "potential = \"", "mass_matrix = [[\"1\", \"0\"], [\"0\", \"1\"]]\npotential = \"", 16,
+     "phases.flight.mass_matrix: give 'kinetic' (T, M derived from it) or 'mass_matrix', not both", kPendulum},
+    {"NeitherKineticNorMassMatrix", "kinetic = \"0.5*m1*dy^2 + 0.5*m2*((l*cos(theta)*dtheta)^2 + (dy + l*sin(theta)*dtheta)^2)\"\n", "", 11,
+     "phases.flight.kinetic: a phase with coordinates needs 'kinetic' (T, a Lagrangian) or 'mass_matrix' (M)", kPendulum},
+    {"ConstraintWithoutCoordinates", "constraint = \"y\"", "constraint = \"l - 1\"", 17,
+     "phases.flight.impact.constraint: the contact constraint g(q) does not depend on the coordinates", kPendulum},
+    {"ConstraintOfAVelocity", "constraint = \"y\"", "constraint = \"y + dy\"", 17,
+     "phases.flight.impact.constraint: the contact constraint g(q) depends on a velocity", kPendulum},
+    {"ImpactWithoutConstraint", "constraint = \"y\", ", "", 17,
+     "phases.flight.impact.constraint: missing field 'constraint'", kPendulum},
+    {"RestitutionBelowOne", "restitution = 1", "restitution = 0.8", 17,
+     "phases.flight.impact.restitution: restitution 0.8: only the elastic law (1)", kPendulum},
+    {"UndeclaredCoordinateUsed", "dy^2 + 0.5*m2", "dy^2 + 0.5*dphi^2 + 0.5*m2", 15,
+     "unknown symbol 'dphi'", kPendulum},
+    {"ForceOnUndeclaredCoordinate", "anchor = \"dy\"", "anchor = \"dy\"\nforces = { phi = \"0\" }", 19,
+     "phases.flight.forces.phi: 'phi' is not a coordinate of phase 'flight' (forces are keyed by coordinate: y, theta)", kPendulum},
+    {"OdeForACoordinate", "anchor = \"dy\"", "anchor = \"dy\"\node = { theta = \"dtheta\" }", 19,
+     "phases.flight.ode.theta: 'theta' is a coordinate or velocity: its rate comes from the mechanics", kPendulum},
+    {"VelocitiesCountWrong", "coordinates = [\"y\", \"theta\"]", "coordinates = [\"y\", \"theta\"]\nvelocities = [\"dy\"]", 14,
+     "phases.flight.velocities: 1 velocities for 2 coordinates", kPendulum},
+    {"IgnorableNotACoordinate", "coordinates = [\"y\", \"theta\"]", "coordinates = [\"y\", \"theta\"]\nignorable = [\"x\"]", 14,
+     "phases.flight.ignorable: 'x' is not a coordinate", kPendulum},
+    {"MechanicsWithoutCoordinates", "coordinates = [\"y\", \"theta\"]\n", "states = [\"y\", \"theta\", \"dy\", \"dtheta\"]\n", 15,
+     "phases.flight.kinetic: 'kinetic' needs 'coordinates'", kPendulum},
+    {"StatesWithoutAVelocity", "coordinates = [\"y\", \"theta\"]", "coordinates = [\"y\", \"theta\"]\nstates = [\"y\", \"theta\", \"dy\"]", 14,
+     "phases.flight.states: 'dtheta' is a coordinate or velocity but not a state", kPendulum},
 };
 
 void PrintTo(const BadFile& row, std::ostream* os) { *os << row.name; }
 
 std::string Mutate(const BadFile& row) {
-  std::string text = kSlip;
+  std::string text = row.model;
   if (row.find.empty()) return text + row.replace;
   const std::size_t at = text.find(row.find);
   if (at == std::string::npos || text.find(row.find, at + 1) != std::string::npos) {
@@ -293,6 +361,7 @@ std::string Mutate(const BadFile& row) {
 TEST(ModelFileErrors, TheUnbrokenModelParses) {
   const ExpressionModelSpec spec = ParseModelText(kSlip, "slip.toml");
   EXPECT_EQ(spec.phases.size(), 2u);
+  EXPECT_EQ(ParseModelText(kPendulum, "pendulum.toml").phases.size(), 1u);
   EXPECT_GE(std::size(kBadFiles), 40u);
 }
 
@@ -351,8 +420,10 @@ TEST(ModelFileErrorsCli, ExitCode2MessageNamesFileAndLineNothingWritten) {
   const fs::path dir = fs::temp_directory_path() / ("hybridcont_model_file_errors_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const std::vector<std::string> rows = {"Version2", "TomlDuplicateKey", "UnknownSymbol", "ResetMissingNextPhaseState",
-                                         "ComparisonInOde", "ParameterOutsideRange", "FigureFileWithSlash"};
+  const std::vector<std::string> rows = {"Version2",          "TomlDuplicateKey",      "UnknownSymbol",
+                                         "ResetMissingNextPhaseState", "ComparisonInOde", "ParameterOutsideRange",
+                                         "FigureFileWithSlash", "KineticWithLinearTerm", "MassMatrixNotSymmetric",
+                                         "ConstraintWithoutCoordinates"};
   for (const std::string& name : rows) {
     const auto row = std::find_if(std::begin(kBadFiles), std::end(kBadFiles),
                                   [&](const BadFile& b) { return name == b.name; });
@@ -372,6 +443,34 @@ TEST(ModelFileErrorsCli, ExitCode2MessageNamesFileAndLineNothingWritten) {
       EXPECT_FALSE(fs::exists(out)) << command << " " << name << ": " << out << " was created";
     }
   }
+  fs::remove_all(dir);
+}
+
+// A model that parses but does not conserve its energy (a damping torque on the pendulum): `run` refuses it
+// before anything runs (exit code 2, the phase named, nothing written), `check` says so (exit code 1).
+TEST(ModelFileErrorsCli, EnergyNotConservedIsRefused) {
+  const fs::path dir = fs::temp_directory_path() / ("hybridcont_energy_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::string text = kPendulum;
+  const std::string anchor = "anchor = \"dy\"";
+  text.replace(text.find(anchor), anchor.size(), anchor + "\nforces = { theta = \"-0.1*dtheta\" }");
+  const fs::path model = dir / "damped.toml";
+  std::ofstream(model) << text;
+  const fs::path out = dir / "out";
+  const ToolResult run = RunTool("run '" + model.string() + "' --quiet --no-plots --out '" + out.string() + "'", dir);
+  EXPECT_EQ(run.code, 2) << run.err;
+  EXPECT_NE(run.err.find("model 'bouncing-pendulum' does not conserve its energy: phase 'flight': H kept by the flow"),
+            std::string::npos)
+      << run.err;
+  EXPECT_FALSE(fs::exists(out));
+  const ToolResult check = RunTool("check '" + model.string() + "'", dir);
+  EXPECT_EQ(check.code, 1) << check.err;
+  std::ifstream in(dir / "stdout.txt");
+  std::ostringstream table;
+  table << in.rdbuf();
+  EXPECT_NE(table.str().find("THE ENERGY IS NOT CONSERVED"), std::string::npos) << table.str();
+  EXPECT_NE(table.str().find("phase 'flight': H kept by the flow"), std::string::npos) << table.str();
   fs::remove_all(dir);
 }
 

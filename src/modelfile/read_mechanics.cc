@@ -1,6 +1,7 @@
 // Reading a phase given by its mechanics: coordinates and velocities, a Lagrangian (kinetic, potential,
 // forces) or a mass-matrix form (mass_matrix, forces, potential), and an impact law at a contact.
 #include <algorithm>
+#include <sstream>
 
 #include "hybridcont/expression_derivative.h"
 #include "hybridcont/mechanics.h"
@@ -56,6 +57,14 @@ Reader::MechanicalNames Reader::ReadMechanicalNames(const toml::table& t, const 
   }
   return names;
 }
+
+namespace {
+std::string FormatNumber(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+}  // namespace
 
 Reader::Mechanics Reader::ReadMechanics(int i) {
   Mechanics out;
@@ -155,7 +164,7 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
     const double e = OptionalNumber(*impact, "restitution", field, 1.0);
     if (e != 1.0) {
       Fail(impact->get("restitution"), field + ".restitution",
-           "restitution " + std::to_string(e) + ": only the elastic law (1), which conserves the energy, is "
+           "restitution " + FormatNumber(e) + ": only the elastic law (1), which conserves the energy, is "
            "supported in a conservative model");
     }
     const std::vector<ExprPtr> after = ImpactVelocities(system, eq, out.constraint, e, out.constraint_where);
