@@ -19,10 +19,14 @@
 #ifndef HYBRIDCONT_MECHANICS_H_
 #define HYBRIDCONT_MECHANICS_H_
 
+#include <cmath>
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "hybridcont/expression.h"
+#include "hybridcont/model.h"
 #include "hybridcont/types.h"
 
 namespace hybridcont {
@@ -74,6 +78,79 @@ std::vector<ExprPtr> ImpactVelocities(const MechanicalSystem& system, const Equa
 // (y = 0.3, alpha = 0.1): pivot 2 of its Cholesky factorization is -0.25".
 std::string ExplainMassMatrix(const std::vector<double>& entries, const std::vector<std::string>& names,
                               const std::vector<double>& coordinates);
+
+// ---- The same mechanics in a C++ model (model_builder.h): phase functions are templates over the scalar
+// type T (double and the jets of automatic differentiation), so these are too. A phase in the mass-matrix
+// form writes
+//     MassMatrix<T> M(2, 2);  M << ...;   StateVector<T> h(2);  h << ...;
+//     const StateVector<T> acc = SolveMassMatrix(M, h);              // q̈ = M⁻¹ h
+// and an impact reset
+//     const StateVector<T> after = ImpactVelocities(M, G, qdot, 1.0);  // G = ∂g/∂q at the contact
+// Derivatives flow through both exactly (they are loops of +, −, ×, ÷ and √ over T).
+
+template <class T>
+using MassMatrix = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxPhaseDim, kMaxPhaseDim>;
+
+namespace internal {
+
+// x = A⁻¹ b by the Cholesky factorization A = L Lᵀ of a symmetric positive definite A (only its lower
+// triangle is read: a(i, j) for j <= i), over any scalar type with −, ×, ÷ and sqrt: numbers and jets
+// (SolveMassMatrix) and expression trees (CholeskySolve, expression_derivative.h). Where A is not positive
+// definite a pivot is negative and its square root NaN, never a wrong finite value.
+template <class T, class A, class B, class X>
+void CholeskySolveInto(int n, const A& a, const B& b, X&& x) {
+  using std::sqrt;
+  thread_local std::vector<T> L, y;  // per thread: no allocation once warm
+  L.assign(static_cast<std::size_t>(n) * n, T(a(0, 0)));
+  y.assign(n, T(b(0)));
+  const auto l = [&](int i, int j) -> T& { return L[static_cast<std::size_t>(i) * n + j]; };
+  for (int j = 0; j < n; ++j) {
+    for (int i = j; i < n; ++i) {
+      T s = a(i, j);
+      for (int k = 0; k < j; ++k) s = s - l(i, k) * l(j, k);
+      l(i, j) = i == j ? T(sqrt(s)) : T(s / l(j, j));
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    T s = b(i);
+    for (int k = 0; k < i; ++k) s = s - l(i, k) * y[k];
+    y[i] = s / l(i, i);
+  }
+  for (int i = n - 1; i >= 0; --i) {
+    T s = y[i];
+    for (int k = i + 1; k < n; ++k) s = s - l(k, i) * x(k);
+    x(i) = s / l(i, i);
+  }
+}
+
+}  // namespace internal
+
+// x = M⁻¹ b (M symmetric positive definite): internal::CholeskySolveInto over the phase's scalar type.
+template <class T>
+StateVector<T> SolveMassMatrix(const MassMatrix<T>& M, const StateVector<T>& b) {
+  StateVector<T> x(b.size());
+  internal::CholeskySolveInto<T>(
+      static_cast<int>(b.size()), [&](int i, int j) -> const T& { return M(i, j); },
+      [&](int i) -> const T& { return b(i); }, [&](int i) -> T& { return x(i); });
+  return x;
+}
+
+// Newton's law of restitution e at a contact with Jacobian G = ∂g/∂q (as a column): the post-impact
+// velocities q̇ − (1 + e) M⁻¹Gᵀ (G q̇) / (G M⁻¹ Gᵀ).
+template <class T>
+StateVector<T> ImpactVelocities(const MassMatrix<T>& M, const StateVector<T>& G, const StateVector<T>& qdot,
+                                double restitution) {
+  const StateVector<T> w = SolveMassMatrix(M, G);
+  T gq = G(0) * qdot(0), gw = G(0) * w(0);
+  for (int i = 1; i < G.size(); ++i) {
+    gq = gq + G(i) * qdot(i);
+    gw = gw + G(i) * w(i);
+  }
+  const T factor = (1.0 + restitution) * gq / gw;
+  StateVector<T> after(qdot.size());
+  for (int i = 0; i < qdot.size(); ++i) after(i) = qdot(i) - w(i) * factor;
+  return after;
+}
 
 }  // namespace hybridcont
 

@@ -1,5 +1,7 @@
 #include "hybridcont/expression_derivative.h"
 
+#include "hybridcont/mechanics.h"
+
 #include <unordered_map>
 
 namespace hybridcont {
@@ -164,28 +166,25 @@ ExprPtr Differentiate(const ExprPtr& e, int input, const SourceLocation& where) 
   return Differentiator(input, where).D(e);
 }
 
+namespace {
+// An expression as a scalar of internal::CholeskySolveInto: its operations build simplified trees.
+struct Symbol {
+  ExprPtr e;
+};
+Symbol operator-(const Symbol& a, const Symbol& b) { return {Sub(a.e, b.e)}; }
+Symbol operator*(const Symbol& a, const Symbol& b) { return {Mul(a.e, b.e)}; }
+Symbol operator/(const Symbol& a, const Symbol& b) { return {Div(a.e, b.e)}; }
+Symbol sqrt(const Symbol& a) { return {Sqrt(a.e)}; }
+}  // namespace
+
 std::vector<ExprPtr> CholeskySolve(const std::vector<std::vector<ExprPtr>>& A, const std::vector<ExprPtr>& b) {
-  const int n = static_cast<int>(b.size());
-  std::vector<std::vector<ExprPtr>> L(n, std::vector<ExprPtr>(n, MakeConstant(0.0)));
-  for (int j = 0; j < n; ++j) {
-    for (int i = j; i < n; ++i) {
-      ExprPtr s = A[i][j];
-      for (int k = 0; k < j; ++k) s = Sub(s, Mul(L[i][k], L[j][k]));
-      L[i][j] = i == j ? Sqrt(s) : Div(s, L[j][j]);
-    }
-  }
-  std::vector<ExprPtr> y(n), x(n);
-  for (int i = 0; i < n; ++i) {
-    ExprPtr s = b[i];
-    for (int k = 0; k < i; ++k) s = Sub(s, Mul(L[i][k], y[k]));
-    y[i] = Div(s, L[i][i]);
-  }
-  for (int i = n - 1; i >= 0; --i) {
-    ExprPtr s = y[i];
-    for (int k = i + 1; k < n; ++k) s = Sub(s, Mul(L[k][i], x[k]));
-    x[i] = Div(s, L[i][i]);
-  }
-  return x;
+  std::vector<Symbol> x(b.size());
+  internal::CholeskySolveInto<Symbol>(
+      static_cast<int>(b.size()), [&](int i, int j) { return Symbol{A[i][j]}; }, [&](int i) { return Symbol{b[i]}; },
+      [&](int i) -> Symbol& { return x[i]; });
+  std::vector<ExprPtr> out;
+  for (const Symbol& s : x) out.push_back(s.e);
+  return out;
 }
 
 }  // namespace hybridcont
