@@ -631,6 +631,13 @@ TEST(BadInputTable, DISABLED_WriteMarkdown) {
   md << "\n";
   for (const char* section : {"command line", "output folders", "model files", "hybridcont plot", "figure script"}) {
     md << "\n## " << section << "\n\n";
+    if (std::string(section) == "model files") {
+      md << "The model file's own content (fields, expressions, bad mechanics) is refused by the reader with file, "
+            "line and field: those rows are in `docs/model-files.md`, \"Bad files and their messages\" "
+            "(`tests/model_file_errors_test.cc`). A model that parses but does not conserve its energy is refused by "
+            "`run` (exit 2, the phase or reset named) and flagged by `check` (exit 1, \"THE ENERGY IS NOT "
+            "CONSERVED\"): `ModelFileErrorsCli.EnergyNotConservedIsRefused`.\n\n";
+    }
     for (const BadInputCase& c : Cases()) {
       if (section_of(c) != section) continue;
       std::string args;
