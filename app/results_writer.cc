@@ -172,7 +172,9 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
   }
   std::ofstream& f = it->second;
   const Vector& u = p.u;
-  f << fmt::format("{},{:.17g},{:.17g}", p.index, u(layout.H_index()), layout.Period(u));
+  // A model without first integral has no H̄: the column stays (every branch file has it) and holds nan.
+  f << fmt::format("{},{:.17g},{:.17g}", p.index, layout.has_level() ? u(layout.H_index()) : std::nan(""),
+                   layout.Period(u));
   for (int j = 0; j < layout.num_free_parameters(); ++j) f << fmt::format(",{:.17g}", u(layout.parameter_index(j)));
   for (int j = 0; j < layout.num_first_integrals(); ++j) f << fmt::format(",{:.17g}", u(layout.xi_index(j)));
   for (int i = 0; i < layout.num_segments(); ++i) f << fmt::format(",{:.17g}", u(layout.time_index(i)));

@@ -29,6 +29,7 @@
 #include "model_options.h"
 #include "orbit_analysis.h"
 #include "parameter_curves.h"
+#include "orbit_start.h"
 #include "parameter_starts.h"
 #include "period_doubled_families.h"
 #include "results_writer.h"
@@ -186,7 +187,7 @@ int KeyframePoint(const Branch& b, const std::vector<bool>& physical, const Scen
   for (int i = 0; i < static_cast<int>(b.points.size()) && i < static_cast<int>(physical.size()); ++i) {
     if (!physical[i]) continue;
     const Vector& u = b.points[i].u;
-    const double value = sc.keyframes.component == "T" ? layout.Period(u) : u(layout.H_index());
+    const double value = sc.keyframes.component == "T" ? layout.Period(u) : u(layout.level_index());
     const double distance = std::abs(value - sc.keyframes.value);
     if (distance < best_distance) best = i, best_distance = distance;
   }
@@ -209,7 +210,8 @@ void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log,
     HybridModel at_point = model.Clone();
     SetFreeParameters(layout, u, &at_point);
     const OrbitTrace trace(at_point, OrbitPart(layout, u), setup.integrator);
-    writer.AddOrbit(trace, b.id, best, u(layout.H_index()), layout.Period(u), sc.describe(u));
+    writer.AddOrbit(trace, b.id, best, layout.has_level() ? u(layout.H_index()) : std::nan(""), layout.Period(u),
+                    sc.describe(u));
     ++orbits;
   }
 }
@@ -224,9 +226,10 @@ std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayou
     for (const SpecialPoint& sp : diagram.special_points) {
       if (sp.type != type || sp.u.size() == 0) continue;
       const double precision = sp.interval_width.size() ? sp.interval_width.norm() : sp.precision();
-      report += fmt::format("  {} on branch {} after point {}: H = {:.12f}, T = {:.12f} ({}, precision {:.1e}){}\n", code,
-                            sp.branch_id, sp.index, sp.u(layout.H_index()), layout.Period(sp.u), ToString(sp.status),
-                            precision, sp.message.empty() ? "" : " " + sp.message);
+      report += fmt::format("  {} on branch {} after point {}: {} = {:.12f}, T = {:.12f} ({}, precision {:.1e}){}\n", code,
+                            sp.branch_id, sp.index, layout.level_name(), sp.u(layout.level_index()),
+                            layout.Period(sp.u), ToString(sp.status), precision,
+                            sp.message.empty() ? "" : " " + sp.message);
       ++count;
     }
   }
@@ -292,6 +295,13 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   BifurcationDiagram diagram;
   if (setup.free.empty()) {
     diagram = exploration.Run(on_point);
+  } else if (model.num_first_integrals() == 0) {  // the family in the parameter from the model's start
+    const OrbitStart start = FindOrbitStart(model, setup, layout);
+    starts_report = start.report;
+    if (!args.quiet) out << starts_report;
+    int skipped = 0;
+    diagram = exploration.RunFromStarts(start.ok ? std::vector<Vector>{start.u} : std::vector<Vector>{}, on_point,
+                                        &skipped);
   } else {
     const ParameterStarts starts = FindParameterStarts(model, setup, exploration.shooting());
     int skipped = 0;

@@ -128,6 +128,35 @@ void RequireParameter(const std::string& option, const HybridModel& model, const
 // options with an H bound widened to the fixed value.
 void ApplyFreeParameter(const RunArguments& args, const HybridModel& model, RunSetup* setup) {
   setup->seed_exploration = setup->exploration;
+  if (model.num_first_integrals() == 0) {
+    // No first integral: the families are continued in a parameter (the model's run.parameter, or --free).
+    const std::string parameter = args.free.empty() ? model.setup().run.parameter : args.free;
+    if (!args.fix.empty()) {
+      throw std::invalid_argument("--fix '" + args.fix + "': model '" + model.name() +
+                                  "' has no first integral; its families are continued in one parameter alone");
+    }
+    if (parameter.empty()) {
+      throw std::invalid_argument("model '" + model.name() + "' has no first integral: name the parameter its "
+                                  "families are continued in (--free NAME)");
+    }
+    RequireParameter("--free", model, parameter);
+    if (!model.has_parameter_derivatives()) {
+      throw std::invalid_argument(fmt::format("--free '{}': model '{}' has no parameter derivatives", parameter,
+                                              model.name()));
+    }
+    setup->free = FreeParameters{{parameter}, {}};
+    const double v = model.parameter(parameter);
+    setup->scenario.unknown_scales.push_back({parameter, v != 0 ? std::abs(v) : 1.0});
+    const bool bounded = std::any_of(setup->exploration.continuation.bounds.begin(),
+                                     setup->exploration.continuation.bounds.end(),
+                                     [&](const ComponentBound& b) { return b.component == parameter; });
+    if (!bounded) {
+      setup->scenario.bounds.push_back(DefaultParameterBound(model, parameter));
+      setup->exploration.continuation.bounds.push_back(setup->scenario.bounds.back());
+    }
+    setup->exploration.start_conditions.clear();
+    return;
+  }
   if (args.free.empty() && args.fix.empty()) return;
   if (args.free.empty()) throw std::invalid_argument("--fix '" + args.fix + "': needs --free PARAMETER");
   if (args.fix.empty()) {

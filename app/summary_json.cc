@@ -70,8 +70,9 @@ nlohmann::json OptionsJson(const RunArguments& args, const RunSetup& setup) {
 nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayout& layout) {
   nlohmann::json list = nlohmann::json::array();
   for (const SpecialPoint& sp : d.special_points) {
-    const double H = sp.u.size() ? sp.u(layout.H_index()) : std::nan("");
-    const double precision_H = sp.interval_width.size() ? sp.interval_width(layout.H_index()) : std::nan("");
+    const bool level = layout.has_level();  // no H̄ without a first integral
+    const double H = sp.u.size() && level ? sp.u(layout.H_index()) : std::nan("");
+    const double precision_H = sp.interval_width.size() && level ? sp.interval_width(layout.H_index()) : std::nan("");
     // "precision": the width of the interval that holds the point, as a distance in u (model units); state-based runs know the widths of their own unknowns
     // only (x̄_1, ξ, H̄; NaN for the rest). "precision_arclength": the same interval along the branch in
     // the engine's scaled arclength (SpecialPoint::precision()).

@@ -18,6 +18,10 @@
 // carries exactly the n1 - 2 nontrivial multipliers (its eigenvalues are those of the Poincaré map
 // restricted to the energy level). The BP/PD test functions and the stability verdict use M.
 //
+// A model without first integral (a dissipative or forced system) has one trivial multiplier, +1 with the
+// flow direction f; B is then an orthonormal basis of f^⊥ (n1 − 1 columns), M = B^T Phi_T B carries the
+// n1 − 1 multipliers of the Poincaré map, and an orbit can be asymptotically stable (all |mu| < 1).
+//
 // Tolerances (FloquetOptions) and why:
 //   unit_tolerance   = 1e-6:  a nontrivial multiplier within this of +1 counts as a further unit multiplier
 //                             (normal := none does). Simple multipliers are accurate to ~1e-9 at rtol 1e-10;
@@ -83,9 +87,13 @@ struct FloquetResult {
   int num_unit = 0;        // 2 (the trivial pair) + nontrivial multipliers within unit_tolerance of +1
   bool normal = false;     // num_unit == 2: exactly two multipliers equal 1 (paper: normal conservative orbit)
   bool stable = false;     // all nontrivial multipliers on (or inside) the unit circle within tolerance
+  // All nontrivial multipliers inside the unit circle by more than the tolerance: perturbations decay
+  // (possible only without first integral; a conservative orbit is at best neutrally stable).
+  bool asymptotically_stable = false;
+  int num_trivial = 2;     // trivial multipliers deflated: 2 (with a first integral) or 1 (without)
   double max_modulus = 0;  // largest |mu| of the nontrivial multipliers (1 if there are none)
   double bp_test = 0;      // prod (mu - 1) over the nontrivial multipliers
-  double pd_test = 0;      // 4 * prod (mu + 1) over the nontrivial multipliers
+  double pd_test = 0;      // 2^num_trivial * prod (mu + 1) over the nontrivial multipliers
   // Residuals of the theory on this orbit (|Phi_T f - f| / |f|, |dH Phi_T - dH| / |dH|): ~integration
   // error on a periodic orbit; large values mean u is not a periodic orbit at xi = 0.
   double flow_residual = 0;

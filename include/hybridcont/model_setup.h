@@ -41,7 +41,10 @@ struct StartSpec {
   // kSingular: an exact point of the family where r = 0 holds by construction (an equilibrium with zero
   // durations, a zero-flight-time oscillation; the paper's starts); the exploration analyses its kernel.
   // kGuess: an approximate orbit; Newton corrects it at fixed H before the exploration starts from it.
-  enum class Kind { kSingular, kGuess };
+  // kSimulation: the state x1 given (values x1_<state>) starts an event-driven simulation of the phase cycle
+  // that runs until it converges to an attracting orbit (models without first integral), which Newton then
+  // refines at fixed parameters.
+  enum class Kind { kSingular, kGuess, kSimulation };
   Kind kind = Kind::kSingular;
   // Unknowns of the time-based layout by name (t1.., x<i>_<state>, xi, H); unlisted unknowns are 0.
   std::vector<std::pair<std::string, SetupValue>> values;
@@ -71,8 +74,11 @@ struct RunSpec {
   int max_points = 600;
   double initial_step = 0.02;
   double max_step = 0.1;
-  // Key frames: on each physical branch, the point closest to `value` of `component` ("H" or "T").
+  // Key frames: on each physical branch, the point closest to `value` of `component` ("H" or "T"; the
+  // continuation parameter for a model without first integral).
   std::string keyframe_component = "H";
+  // A model without first integral: the model parameter its families are continued in (e.g. "gamma").
+  std::string parameter;
   SetupValue keyframe_value = "0.5";
   int keyframe_orbits = 4;
 };

@@ -20,6 +20,12 @@
 // others. A parameter is named as in the model ("k"); any unknown may be fixed ("H", "t2", "x1_l", "xi").
 // Without free parameters the layout is the paper's.
 //
+// Models without a first integral (k = 0: dissipative or forced systems, a passive walker) have no
+// unfolding and no level: u = [ segments | p_1..p_q ], r = [ blocks | fixing rows ], and the first free
+// parameter carries the family (q = number of fixed unknowns + 1). H_index() is then -1; level_index() is
+// the coordinate a family is followed in, H̄ or that parameter. With no parameter free, such a layout is
+// square (an isolated orbit at fixed parameters) and has no level_index().
+//
 // Names (used as CSV column headers and to address components): "t1".."t<m+1>", "x<i>_<state>" (e.g.
 // "x2_dx"), "xi" (or "xi1".."xik"), "H", then the free parameters' names.
 //
@@ -57,18 +63,25 @@ class ShootingLayout {
   int dim(int i) const { return dims_[CheckedSegment(i)]; }
   int num_first_integrals() const { return k_; }
   int num_unknowns() const { return num_unknowns_; }
-  int num_equations() const { return num_unknowns_ - 1; }
+  // num_unknowns() − 1, except for the base layout of a model without first integral (no free parameter):
+  // num_unknowns(), the square system of an orbit at fixed parameters.
+  int num_equations() const;
 
   // Index of t_{i+1} in u (0-based segment i).
   int time_index(int i) const { return time_index_[CheckedSegment(i)]; }
   // Index of the first entry of x̄_{i+1} in u.
   int state_offset(int i) const { return time_index(i) + 1; }
   int xi_index(int j = 0) const { return xi_index_ + j; }
+  // Index of H̄ in u; -1 for a model without first integral.
   int H_index() const { return H_index_; }
+  bool has_level() const { return H_index_ >= 0; }
+  // The coordinate a family is followed in: H̄, or (no first integral) the first free parameter.
+  int level_index() const { return H_index_ >= 0 ? H_index_ : parameter_index(0); }
+  const std::string& level_name() const { return names_[level_index()]; }
 
   // Free parameters: their number q, the index in u of the i-th and its index among the model's parameters.
   int num_free_parameters() const { return static_cast<int>(parameter_model_index_.size()); }
-  int parameter_index(int i = 0) const { return H_index_ + 1 + i; }
+  int parameter_index(int i = 0) const { return parameter_start_ + i; }
   int parameter_model_index(int i) const { return parameter_model_index_.at(i); }
   // Fixing rows: the i-th holds unknown fixed_index(i) at fixed_value(i), in row fixed_row(i).
   int num_fixed() const { return static_cast<int>(fixed_index_.size()); }
@@ -96,8 +109,10 @@ class ShootingLayout {
   int k_;
   std::vector<int> time_index_;
   std::vector<int> block_row_;
+  int segment_rows_;
   int xi_index_;
   int H_index_;
+  int parameter_start_;
   int num_unknowns_;
   std::vector<int> parameter_model_index_;
   std::vector<int> fixed_index_;

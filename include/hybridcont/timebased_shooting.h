@@ -33,6 +33,10 @@
 //   TimeBasedShooting shooting(model, IntegratorOptions{});
 //   Vector r; Matrix dr;
 //   EvaluationStatus s = shooting.Evaluate(u, &r, &dr);
+//
+// A model without first integral has no ξ and H̄ columns nor first-integral rows; it is continued with one
+// free parameter (shooting_layout.h). Without one its map is square (dr is N × N): an orbit at fixed
+// parameters, for Newton's method (a start), not a ZeroProblem to continue.
 #ifndef HYBRIDCONT_TIMEBASED_SHOOTING_H_
 #define HYBRIDCONT_TIMEBASED_SHOOTING_H_
 
@@ -124,6 +128,9 @@ class TimeBasedShooting : public ShootingProblem {
   // r and the blocks of dr (eq. multishootJacobian) into a sink: dense matrix or triplets.
   template <class Sink>
   EvaluationStatus Assemble(const Vector& u, Vector* r, Sink* dr);
+  // The first-integral rows (models with k > 0).
+  template <class Sink>
+  void AssembleFirstIntegrals(const Vector& u, Vector* r, Sink* dr);
 
   // Sets the free parameters of own_model_ from u; a failure when a value lies outside its range.
   EvaluationStatus SetParameters(const Vector& u);

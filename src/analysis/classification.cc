@@ -81,7 +81,8 @@ bool ClassifyByUnknowns(const HybridModel& model, const Vector& u, const Classif
   const ShootingLayout layout(model);
   const int m = model.num_phases();
   std::ostringstream os;
-  const double xi = u.segment(layout.xi_index(), layout.num_first_integrals()).cwiseAbs().maxCoeff();
+  const int k = layout.num_first_integrals();  // no ξ without a first integral
+  const double xi = k > 0 ? u.segment(layout.xi_index(), k).cwiseAbs().maxCoeff() : 0.0;
   const double T = layout.Period(u);
   const double zero_time = options.duration_tolerance * std::max(1.0, std::abs(T));
   bool all_zero = true, any_negative = false, any_zero = false;

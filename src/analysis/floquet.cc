@@ -41,7 +41,8 @@ std::string FloquetResult::BriefReport() const {
   std::ostringstream os;
   os << ToString(status);
   if (!ok()) return os.str() + " (" + message + ")";
-  os << ": " << (normal ? "normal" : "not normal") << ", " << (stable ? "stable" : "unstable") << ", |mu|max "
+  os << ": " << (normal ? "normal" : "not normal") << ", "
+     << (asymptotically_stable ? "asymptotically stable" : stable ? "stable" : "unstable") << ", |mu|max "
      << max_modulus << ", nontrivial multipliers";
   for (const auto& mu : nontrivial) os << " " << mu.real() << (mu.imag() >= 0 ? "+" : "") << mu.imag() << "i";
   return os.str();
@@ -57,13 +58,15 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
     res.message = "monodromy matrix has non-finite entries";
     return res;
   }
-  if (!(f0.norm() > 0.0) || !(dH0.norm() > 0.0)) {
+  const bool conservative = dH0.size() > 0;  // no first integral: one trivial multiplier
+  res.num_trivial = conservative ? 2 : 1;
+  if (!(f0.norm() > 0.0) || (conservative && !(dH0.norm() > 0.0))) {
     res.status = FloquetStatus::kDegenerateOrbit;
-    res.message = "f(x0) = 0 or dH(x0) = 0 (an equilibrium): no trivial multiplier pair to deflate";
+    res.message = "f(x0) = 0 or dH(x0) = 0 (an equilibrium): no trivial multiplier to deflate";
     return res;
   }
   res.flow_residual = (monodromy * f0 - f0).norm() / f0.norm();
-  res.first_integral_residual = (dH0 * monodromy - dH0).norm() / dH0.norm();
+  if (conservative) res.first_integral_residual = (dH0 * monodromy - dH0).norm() / dH0.norm();
 
   Eigen::EigenSolver<Matrix> full(monodromy, /*computeEigenvectors=*/false);
   if (full.info() != Eigen::Success) {
@@ -77,13 +80,14 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
     return da != db ? da < db : a.imag() > b.imag();
   });
 
-  // Deflate the trivial pair: B orthonormal, spanning ker dH ∩ f^⊥ (see the header).
-  if (n > 2) {
-    const Matrix Q = Eigen::HouseholderQR<Matrix>(dH0.transpose()).householderQ();
-    const Matrix Q1 = Q.rightCols(n - 1);  // ker dH
+  // Deflate the trivial multipliers: B orthonormal, spanning ker dH ∩ f^⊥, or f^⊥ (see the header).
+  const int reduced_dim = n - res.num_trivial;
+  if (reduced_dim > 0) {
+    Matrix Q1 = Matrix::Identity(n, n);  // ker dH (everything without a first integral)
+    if (conservative) Q1 = Matrix(Eigen::HouseholderQR<Matrix>(dH0.transpose()).householderQ()).rightCols(n - 1);
     const Vector c = Q1.transpose() * f0;
     const Matrix Qc = Eigen::HouseholderQR<Matrix>(c).householderQ();
-    const Matrix B = Q1 * Qc.rightCols(n - 2);
+    const Matrix B = Q1 * Qc.rightCols(reduced_dim);
     const Matrix M = B.transpose() * monodromy * B;
     Eigen::EigenSolver<Matrix> reduced(M, false);
     if (reduced.info() != Eigen::Success) {
@@ -91,27 +95,29 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
       res.message = "EigenSolver failed on the deflated monodromy";
       return res;
     }
-    for (int i = 0; i < n - 2; ++i) res.nontrivial.push_back(reduced.eigenvalues()(i));
+    for (int i = 0; i < reduced_dim; ++i) res.nontrivial.push_back(reduced.eigenvalues()(i));
   }
   std::sort(res.nontrivial.begin(), res.nontrivial.end(), [](const auto& a, const auto& b) {
     const double ma = std::abs(a), mb = std::abs(b);
     return ma != mb ? ma > mb : a.imag() > b.imag();
   });
 
-  std::complex<double> bp = 1.0, pd = 4.0;
-  res.num_unit = 2;
+  std::complex<double> bp = 1.0, pd = conservative ? 4.0 : 2.0;
+  res.num_unit = res.num_trivial;
   res.max_modulus = 1.0;
   res.stable = true;
+  res.asymptotically_stable = !conservative;
   for (const auto& mu : res.nontrivial) {
     bp *= mu - 1.0;
     pd *= mu + 1.0;
     if (std::abs(mu - 1.0) <= options.unit_tolerance) ++res.num_unit;
     if (std::abs(mu) > 1.0 + options.circle_tolerance) res.stable = false;
+    if (!(std::abs(mu) < 1.0 - options.circle_tolerance)) res.asymptotically_stable = false;
   }
   if (!res.nontrivial.empty()) res.max_modulus = std::abs(res.nontrivial.front());
   res.bp_test = bp.real();  // conjugate pairs make the products real up to round-off
   res.pd_test = pd.real();
-  res.normal = res.num_unit == 2;
+  res.normal = res.num_unit == res.num_trivial;
   return res;
 }
 
@@ -160,7 +166,7 @@ FloquetResult ComputeFloquet(TimeBasedShooting& shooting, const Vector& u, const
   model.phase(0).UnfoldedVectorField(x1, xi, &f0, nullptr, nullptr);
   model.phase(0).FirstIntegrals(x1, &H, &dH, nullptr);
   std::vector<Matrix> saltations = std::move(res.saltations);
-  res = AnalyzeMonodromy(Phi_T, f0, dH.row(0), options);
+  res = AnalyzeMonodromy(Phi_T, f0, k > 0 ? RowVector(dH.row(0)) : RowVector(), options);
   res.saltations = std::move(saltations);
   return res;
 }

@@ -158,7 +158,7 @@ class Checker {
         phase.FirstIntegrals(y, out, nullptr, nullptr);
         return out->allFinite();
       }, x, o_.model_step, &ok);
-      Record(tag + "dH/dx", o_.model_tolerance, dH, fd, ok);
+      if (k > 0) Record(tag + "dH/dx", o_.model_tolerance, dH, fd, ok);  // none without a first integral
       for (int j = 0; j < k; ++j) {
         fd = FiniteDifferenceJacobian([&](const Vector& y, Vector* out) {
           Vector h;
@@ -192,7 +192,7 @@ class Checker {
       Record(tag + "Phi = dphi/dx0", o_.flow_tolerance, res.Phi, fd, ok);
       fd = FiniteDifferenceJacobian([&](const Vector& z, Vector* out) { return integrate(x, z, out); }, xi,
                                     o_.flow_step, &ok);
-      Record(tag + "Psi = dphi/dxi", o_.flow_tolerance, res.Psi, fd, ok);
+      if (k > 0) Record(tag + "Psi = dphi/dxi", o_.flow_tolerance, res.Psi, fd, ok);
     }
   }
 
@@ -220,7 +220,7 @@ class Checker {
       u.segment(layout.state_offset(i), layout.dim(i)) = SampleState(model_.phase(i));
     }
     for (int j = 0; j < layout.num_first_integrals(); ++j) u(layout.xi_index(j)) = Uniform(-o_.max_xi, o_.max_xi);
-    u(layout.H_index()) = Uniform(0.0, 2.0);
+    if (layout.has_level()) u(layout.H_index()) = Uniform(0.0, 2.0);
     for (int i = 0; i < layout.num_free_parameters(); ++i) {
       u(layout.parameter_index(i)) = model_.parameter_value(layout.parameter_model_index(i));
     }
@@ -234,7 +234,11 @@ class Checker {
     if (!model_.has_parameter_derivatives() || !model_.is_cloneable()) return;
     for (const ParameterInfo& info : model_.parameters()) {
       const std::string what = "shooting map: dr/d" + info.name;
-      TimeBasedShooting shooting(model_, o_.integrator, FreeParameters{{info.name}, {{info.name, info.default_value}}});
+      // The parameter free (and, with a first integral, held by a fixing row; without, it carries the family).
+      const FreeParameters free = model_.num_first_integrals() > 0
+                                      ? FreeParameters{{info.name}, {{info.name, info.default_value}}}
+                                      : FreeParameters{{info.name}, {}};
+      TimeBasedShooting shooting(model_, o_.integrator, free);
       const int col = shooting.layout().parameter_index(0);
       // Random points where the map cannot be integrated (a singular state reached) are drawn again: this
       // checks derivatives, not the model's domain (dr/du reports such failures).

@@ -207,7 +207,6 @@ void ValidatePhaseSizes(const std::string& model_name, const std::vector<std::un
                                   std::to_string(phases.front()->num_first_integrals()) +
                                   " (a hybrid first integral exists in every phase)");
     }
-    if (p.num_first_integrals() < 1) throw std::invalid_argument(where + ": needs at least one first integral");
   }
 }
 

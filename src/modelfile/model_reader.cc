@@ -10,8 +10,11 @@ namespace hybridcont::internal {
 
 ExpressionModelSpec Reader::Read() {
   CheckKeys(root_, "", {"hybridcont", "name", "description", "title", "parameters", "definitions", "phases",
-                        "symmetries", "start", "run", "families", "quantities", "figures", "drawing"});
+                        "symmetries", "start", "run", "families", "quantities", "figures", "drawing",
+                        "conservative"});
   ReadVersion();
+  conservative_ = OptionalBool(root_, "conservative", "", true);
+  if (!conservative_) num_integrals_ = 0;
   spec_.name = RequiredString(root_, "name", "");
   if (spec_.name.empty() || spec_.name.find_first_of("/\\ \t\n") != std::string::npos) {
     Fail(root_["name"].node(), "name", "a model name must be non-empty without spaces or slashes, got '" +
@@ -227,7 +230,11 @@ std::vector<std::string> Reader::UnknownNames() const {
   for (int i = 0; i <= m; ++i) {
     for (const std::string& s : spec_.phases[i % m].state_names) names.push_back("x" + std::to_string(i + 1) + "_" + s);
   }
-  if (num_integrals_ <= 1) {
+  if (num_integrals_ == 0) {  // no unfolding, no level: the run's parameter carries the family
+    if (!spec_.setup.run.parameter.empty()) names.push_back(spec_.setup.run.parameter);
+    return names;
+  }
+  if (num_integrals_ == 1) {
     names.push_back("xi");
   } else {
     for (int j = 1; j <= num_integrals_; ++j) names.push_back("xi" + std::to_string(j));

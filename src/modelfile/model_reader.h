@@ -151,6 +151,8 @@ class Reader {
   std::vector<const toml::table*> phase_lets_;
   int num_integrals_ = 1;
   std::vector<MechanicalNames> mechanical_names_;
+  // `conservative = false`: no phase has a first integral; families are continued in run.parameter.
+  bool conservative_ = true;
 };
 
 }  // namespace hybridcont::internal

@@ -146,7 +146,7 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
     if (system.coordinates[k] >= 0) out.vector_field[system.coordinates[k]] = MakeInput(system.velocities[k]);
     out.vector_field[system.velocities[k]] = eq.accelerations[k];
   }
-  out.energy = eq.energy;
+  if (conservative_) out.energy = eq.energy;
   std::vector<ExprPtr> entries;
   for (int r = 0; r < n; ++r) {
     for (int c = 0; c < n; ++c) entries.push_back(eq.mass_matrix[r][c]);
@@ -162,10 +162,13 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
     out.constraint = ParsePhaseExpression(i, *g, field + ".constraint");
     out.constraint_where = At(g, field + ".constraint");
     const double e = OptionalNumber(*impact, "restitution", field, 1.0);
-    if (e != 1.0) {
+    if (!(e >= 0.0 && e <= 1.0)) {
+      Fail(impact->get("restitution"), field + ".restitution", "restitution " + FormatNumber(e) + " is outside [0, 1]");
+    }
+    if (conservative_ && e != 1.0) {
       Fail(impact->get("restitution"), field + ".restitution",
            "restitution " + FormatNumber(e) + ": only the elastic law (1), which conserves the energy, is "
-           "supported in a conservative model");
+           "possible in a conservative model (declare conservative = false for a dissipative one)");
     }
     const std::vector<ExprPtr> after = ImpactVelocities(system, eq, out.constraint, e, out.constraint_where);
     // Into the next phase: a state named like one of this phase's takes its value after the impact.

@@ -160,6 +160,15 @@ void Reader::ReadIntegrals(int i, const ExprPtr& derived_energy) {
   const std::string pf = "phases." + p.name;
   const toml::node* energy = t.get("energy");
   const toml::node* integrals = t.get("integrals");
+  if (!conservative_) {
+    if (energy || integrals) {
+      Fail(energy ? energy : integrals, pf + (energy ? ".energy" : ".integrals"),
+           "a model with conservative = false has no first integral (write what you measure as a [quantities] "
+           "entry)");
+    }
+    p.integrals = ExpressionProgram({}, static_cast<int>(p.state_names.size()), true, {});
+    return;
+  }
   if (energy && integrals) {
     Fail(integrals, pf + ".energy", "give exactly one of 'energy' (the first integral) or 'integrals' (several)");
   }

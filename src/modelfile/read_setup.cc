@@ -104,7 +104,8 @@ void Reader::ReadStart() {
   const std::string kind = OptionalString(*t, "kind", "start", "singular");
   if (kind == "singular") spec_.setup.start.kind = StartSpec::Kind::kSingular;
   else if (kind == "guess") spec_.setup.start.kind = StartSpec::Kind::kGuess;
-  else Fail(t->get("kind"), "start.kind", "'" + kind + "': expected 'singular' or 'guess'");
+  else if (kind == "simulation") spec_.setup.start.kind = StartSpec::Kind::kSimulation;
+  else Fail(t->get("kind"), "start.kind", "'" + kind + "': expected 'singular', 'guess' or 'simulation'");
   if (const toml::table* values = OptionalTable(*t, "values", "start")) {
     for (auto&& [key, node] : *values) {
       const std::string name(key.str());
@@ -138,11 +139,29 @@ void Reader::ReadStart() {
 void Reader::ReadRun() {
   RunSpec& run = spec_.setup.run;
   // Without a [run] table: |xi| <= 1 and the defaults of RunSpec; a model file should bound H.
-  run.bounds.push_back({"xi", "-1", "1"});
+  if (conservative_) run.bounds.push_back({"xi", "-1", "1"});
   const toml::table* t = OptionalTable(root_, "run", "");
+  if (t == nullptr && !conservative_) {
+    Fail(&root_, "run.parameter", "a model with conservative = false needs [run] parameter = \"NAME\" (the model "
+                                  "parameter its families are continued in)");
+  }
   if (t == nullptr) return;
   CheckKeys(*t, "run", {"bounds", "scales", "max_branches", "max_depth", "max_points", "initial_step", "max_step",
-                        "keyframes"});
+                        "keyframes", "parameter"});
+  if (const toml::node* p = t->get("parameter")) {
+    run.parameter = AsString(*p, "run.parameter");
+    if (conservative_) {
+      Fail(p, "run.parameter", "a conservative model is continued in H (run.parameter is for conservative = false; "
+                               "continue in a parameter with --free NAME --fix H=VALUE)");
+    }
+    if (!parameter_index_.count(run.parameter)) {
+      Fail(p, "run.parameter", "'" + run.parameter + "' is not a parameter of the model");
+    }
+  } else if (!conservative_) {
+    Fail(t, "run.parameter", "a model with conservative = false needs parameter = \"NAME\" (the model parameter its "
+                             "families are continued in)");
+  }
+  if (!conservative_) run.keyframe_component = run.parameter;
   if (const toml::table* b = OptionalTable(*t, "bounds", "run")) {
     for (auto&& [key, node] : *b) {
       const std::string name(key.str());
@@ -175,9 +194,10 @@ void Reader::ReadRun() {
   if (!(run.max_step >= run.initial_step)) Fail(t->get("max_step"), "run.max_step", "must be at least initial_step");
   if (const toml::table* k = OptionalTable(*t, "keyframes", "run")) {
     CheckKeys(*k, "run.keyframes", {"component", "value", "orbits"});
-    run.keyframe_component = OptionalString(*k, "component", "run.keyframes", "H");
-    if (run.keyframe_component != "H" && run.keyframe_component != "T") {
-      Fail(k->get("component"), "run.keyframes.component", "expected \"H\" or \"T\"");
+    run.keyframe_component = OptionalString(*k, "component", "run.keyframes", run.keyframe_component);
+    const std::string level = conservative_ ? "H" : run.parameter;
+    if (run.keyframe_component != level && run.keyframe_component != "T") {
+      Fail(k->get("component"), "run.keyframes.component", "expected \"" + level + "\" or \"T\"");
     }
     if (const toml::node* v = k->get("value")) run.keyframe_value = AsSetupValue(*v, "run.keyframes.value");
     CheckSetupValue(run.keyframe_value, {});

@@ -28,11 +28,18 @@ ShootingLayout::ShootingLayout(const HybridModel& model, const FreeParameters& f
     block_row_[i] = row;
     row += dims_[(i + 1) % (m + 1)] + 1;
   }
+  segment_rows_ = row;
   xi_index_ = col;
-  for (int j = 0; j < k_; ++j) names_.push_back(k_ == 1 ? "xi" : "xi" + std::to_string(j + 1));
-  names_.push_back("H");
-  H_index_ = col + k_;
-  num_unknowns_ = col + k_ + 1;
+  if (k_ > 0) {
+    for (int j = 0; j < k_; ++j) names_.push_back(k_ == 1 ? "xi" : "xi" + std::to_string(j + 1));
+    names_.push_back("H");
+    H_index_ = col + k_;
+    num_unknowns_ = col + k_ + 1;
+  } else {  // no first integral: no unfolding, no level; a free parameter carries the family
+    H_index_ = -1;
+    num_unknowns_ = col;
+  }
+  parameter_start_ = num_unknowns_;
   for (const std::string& name : free.parameters) {
     const int index = model.FindParameter(name);
     if (index < 0) {
@@ -55,7 +62,8 @@ ShootingLayout::ShootingLayout(const HybridModel& model, const FreeParameters& f
   for (const auto& [name, value] : free.fixed) {
     const auto it = std::find(names_.begin(), names_.end(), name);
     if (it == names_.end()) {
-      throw std::invalid_argument("fixed unknown '" + name + "' is not an unknown of the problem (unknowns: H, xi, "
+      throw std::invalid_argument("fixed unknown '" + name + "' is not an unknown of the problem (unknowns: " +
+                                  std::string(k_ > 0 ? "H, xi, " : "") +
                                   "t1..t" + std::to_string(m + 1) + ", x<i>_<state>, the free parameters)");
     }
     const int index = static_cast<int>(it - names_.begin());
@@ -66,12 +74,22 @@ ShootingLayout::ShootingLayout(const HybridModel& model, const FreeParameters& f
     fixed_index_.push_back(index);
     fixed_value_.push_back(value);
   }
-  if (fixed_index_.size() != parameter_model_index_.size()) {
-    throw std::invalid_argument(std::to_string(parameter_model_index_.size()) + " free parameter(s) and " +
-                                std::to_string(fixed_index_.size()) +
-                                " fixed unknown(s): each free parameter needs one fixed unknown (e.g. --free k "
-                                "--fix H=1.5) so that the solutions form a curve");
+  // Without H̄, one free parameter carries the family; with none free, the layout is the square system of an
+  // orbit at fixed parameters (the base layout of such a model: Newton at fixed parameters, replay, files).
+  const std::size_t carried = k_ > 0 || parameter_model_index_.empty() ? 0 : 1;
+  if (fixed_index_.size() + carried != parameter_model_index_.size()) {
+    throw std::invalid_argument(
+        std::to_string(parameter_model_index_.size()) + " free parameter(s) and " + std::to_string(fixed_index_.size()) +
+        " fixed unknown(s): " +
+        (k_ > 0 ? "each free parameter needs one fixed unknown (e.g. --free k --fix H=1.5)"
+                : "a model without first integral is continued in one free parameter (e.g. --free gamma), each "
+                  "further one needs a fixed unknown") +
+        " so that the solutions form a curve");
   }
+}
+
+int ShootingLayout::num_equations() const {
+  return segment_rows_ + k_ + num_fixed();  // the blocks, the first integrals, the fixing rows
 }
 
 double ShootingLayout::Period(const Vector& u) const {

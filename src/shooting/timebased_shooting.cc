@@ -33,7 +33,7 @@ TimeBasedShooting::TimeBasedShooting(const HybridModel& model, IntegratorOptions
       free_(std::move(free)),
       threads_(std::max(1, static_cast<int>(std::thread::hardware_concurrency()))),
       layout_(model, free_),
-      fixed_levels_(Vector::Zero(model.num_first_integrals() - 1)) {
+      fixed_levels_(Vector::Zero(std::max(0, model.num_first_integrals() - 1))) {
   if (const std::string why = options.Validate(); !why.empty()) throw std::invalid_argument(why);
   const int m = model_->num_phases();
   std::vector<int> parameters;
@@ -215,7 +215,7 @@ struct TripletSink {
 EvaluationStatus TimeBasedShooting::Evaluate(const Vector& u, Vector* r, Matrix* dr) {
   if (dr == nullptr) return Assemble<DenseSink>(u, r, nullptr);
   const int N = layout_.num_equations();
-  dr->setZero(N, N + 1);
+  dr->setZero(N, layout_.num_unknowns());  // N + 1, or N for the square system of a model without first integral
   DenseSink sink{dr};
   const EvaluationStatus status = Assemble(u, r, &sink);
   if (status.ok && !dr->allFinite()) return EvaluationStatus::Failure("Jacobian has non-finite entries");
@@ -229,7 +229,7 @@ EvaluationStatus TimeBasedShooting::EvaluateSparse(const Vector& u, Vector* r, S
   const EvaluationStatus status = Assemble(u, r, &sink);
   if (!status.ok) return status;
   const int N = layout_.num_equations();
-  dr->resize(N, N + 1);
+  dr->resize(N, layout_.num_unknowns());
   dr->setFromTriplets(triplets_.begin(), triplets_.end());
   if (!Eigen::Map<const Vector>(dr->valuePtr(), dr->nonZeros()).allFinite()) {
     return EvaluationStatus::Failure("Jacobian has non-finite entries");
@@ -292,10 +292,12 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
       const int ct = layout_.time_index(i);
       dr->Add(row, ct, D_ * f_tilde);
       dr->Add(row, ct + 1, D_ * flow.Phi);
-      dr->Add(row, layout_.xi_index(), D_ * flow.Psi.leftCols(k));
       dr->Add(row + n_out, ct, de_.dot(f_tilde));
       dr->Add(row + n_out, ct + 1, de_ * flow.Phi);
-      dr->Add(row + n_out, layout_.xi_index(), de_ * flow.Psi.leftCols(k));
+      if (k > 0) {
+        dr->Add(row, layout_.xi_index(), D_ * flow.Psi.leftCols(k));
+        dr->Add(row + n_out, layout_.xi_index(), de_ * flow.Psi.leftCols(k));
+      }
       // Free parameters: through the flow (D Psi_p, de Psi_p) and the reset/event (anchor) themselves.
       for (int p = 0; p < q; ++p) {
         const int col = layout_.parameter_index(p);
@@ -314,7 +316,21 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
       dr->AddDiagonal(row, layout_.state_offset(next), n_out, -1.0);
     }
   }
-  // First integrals at x̄_1: H_1 - H̄ (unknown level), H_j - H̄_j fixed for j >= 2.
+  // First integrals at x̄_1: H_1 - H̄ (unknown level), H_j - H̄_j fixed for j >= 2 (none without).
+  if (k > 0) AssembleFirstIntegrals(u, r, dr);
+  // Fixing rows: u_j − c_j.
+  for (int i = 0; i < layout_.num_fixed(); ++i) {
+    if (r) (*r)(layout_.fixed_row(i)) = u(layout_.fixed_index(i)) - layout_.fixed_value(i);
+    if (dr) dr->Add(layout_.fixed_row(i), layout_.fixed_index(i), 1.0);
+  }
+  return r == nullptr || r->allFinite() ? EvaluationStatus{}
+                                        : EvaluationStatus::Failure("first integral returned a non-finite value");
+}
+
+template <class Sink>
+void TimeBasedShooting::AssembleFirstIntegrals(const Vector& u, Vector* r, Sink* dr) {
+  const int k = layout_.num_first_integrals();
+  const int q = layout_.num_free_parameters();
   const int n1 = layout_.dim(0);
   const auto x1 = u.segment(layout_.state_offset(0), n1);
   model_->phase(0).FirstIntegrals(x1, &H_, dr ? &dH_ : nullptr, nullptr);
@@ -322,7 +338,6 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
   if (r) {
     (*r)(row) = H_(0) - u(layout_.H_index());
     for (int j = 1; j < k; ++j) (*r)(row + j) = H_(j) - fixed_levels_(j - 1);
-    if (!r->allFinite()) return EvaluationStatus::Failure("first integral returned a non-finite value");
   }
   if (dr) {
     dr->Add(row, layout_.state_offset(0), dH_);
@@ -332,12 +347,6 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
       dr->Add(row, layout_.parameter_index(p), dp_H_);
     }
   }
-  // Fixing rows: u_j − c_j.
-  for (int i = 0; i < layout_.num_fixed(); ++i) {
-    if (r) (*r)(layout_.fixed_row(i)) = u(layout_.fixed_index(i)) - layout_.fixed_value(i);
-    if (dr) dr->Add(layout_.fixed_row(i), layout_.fixed_index(i), 1.0);
-  }
-  return {};
 }
 
 }  // namespace hybridcont
