@@ -4,6 +4,7 @@
 
 #include <Eigen/LU>
 
+#include "hybridcont/setup_evaluation.h"
 #include "hybridcont/simulation_start.h"
 #include "hybridcont/timebased_shooting.h"
 
@@ -25,43 +26,63 @@ bool RefineAtFixedParameters(TimeBasedShooting& shooting, Vector* u, double* res
   return shooting.Evaluate(*u, &r, nullptr).ok && (*residual = r.lpNorm<Eigen::Infinity>()) <= 1e-11;
 }
 
-}  // namespace
 
-OrbitStart FindOrbitStart(const HybridModel& model, const RunSetup& setup, const ShootingLayout& free_layout) {
-  OrbitStart start;
+// One start: simulated or declared, then refined; false (and why in *report) if it fails.
+bool OneStart(const HybridModel& model, const RunSetup& setup, const StartSpec& spec, Vector* u,
+              std::string* report) {
   const ShootingLayout base(model);  // the square layout: segments only
-  Vector u = setup.scenario.start;
-  if (model.setup().start.kind == StartSpec::Kind::kSimulation) {
+  *u = StartPoint(model, spec);
+  if (spec.kind == StartSpec::Kind::kSimulation) {
     SimulationStartOptions options;
     options.integrator.integrator = setup.integrator;
-    const Vector x1 = u.segment(base.state_offset(0), base.dim(0));
+    if (spec.cycles > 0) {
+      options.max_cycles = spec.cycles;
+      options.require_convergence = false;
+    }
+    const Vector x1 = u->segment(base.state_offset(0), base.dim(0));
     const SimulationStartResult s = SimulateToOrbit(model, x1, options);
     if (!s.converged) {
-      start.report = "  start: the event-driven simulation did not settle on an orbit: " + s.message + "\n";
-      return start;
+      *report += "event-driven simulation did not settle on an orbit: " + s.message;
+      return false;
     }
-    u = s.u;
-    start.report = "  start: event-driven simulation from the declared state, " + s.message + "\n";
+    *u = s.u;
+    *report += "event-driven simulation from the declared state, " + s.message + "; ";
   } else {
-    start.report = "  start: the declared orbit\n";
+    *report += "the declared orbit; ";
   }
   TimeBasedShooting shooting(model, setup.integrator);
   double residual = 0;
   int iterations = 0;
-  if (!RefineAtFixedParameters(shooting, &u, &residual, &iterations)) {
-    start.report += fmt::format("  Newton at fixed parameters did not converge (|r| = {:.2e} after {} iterations)\n",
-                                residual, iterations);
-    return start;
+  if (!RefineAtFixedParameters(shooting, u, &residual, &iterations)) {
+    *report += fmt::format("Newton at fixed parameters did not converge (|r| = {:.2e} after {} iterations)", residual,
+                           iterations);
+    return false;
   }
-  start.report += fmt::format("  refined by Newton at fixed parameters: |r| = {:.1e} after {} iterations\n", residual,
-                              iterations);
-  start.u = Vector::Zero(free_layout.num_unknowns());
-  start.u.head(base.num_unknowns()) = u;
-  for (int i = 0; i < free_layout.num_free_parameters(); ++i) {
-    start.u(free_layout.parameter_index(i)) = model.parameter_value(free_layout.parameter_model_index(i));
+  *report += fmt::format("refined by Newton at fixed parameters, |r| = {:.1e} after {} iterations", residual,
+                         iterations);
+  return true;
+}
+
+}  // namespace
+
+OrbitStarts FindOrbitStarts(const HybridModel& model, const RunSetup& setup, const ShootingLayout& free_layout) {
+  OrbitStarts starts;
+  std::vector<StartSpec> specs = {model.setup().start};
+  specs.insert(specs.end(), model.setup().more_starts.begin(), model.setup().more_starts.end());
+  for (std::size_t i = 0; i < specs.size(); ++i) {
+    Vector u;
+    std::string report;
+    const bool ok = OneStart(model, setup, specs[i], &u, &report);
+    starts.report += fmt::format("  start {}: {}\n", i + 1, report);
+    if (!ok) continue;
+    Vector point = Vector::Zero(free_layout.num_unknowns());
+    point.head(u.size()) = u;
+    for (int p = 0; p < free_layout.num_free_parameters(); ++p) {
+      point(free_layout.parameter_index(p)) = model.parameter_value(free_layout.parameter_model_index(p));
+    }
+    starts.points.push_back(point);
   }
-  start.ok = true;
-  return start;
+  return starts;
 }
 
 }  // namespace hybridcont::app

@@ -6,25 +6,27 @@
 //     attracting orbit (simulation_start.h);
 //   - kind = "guess" (or "singular"): the declared values are the guess.
 //
-//   OrbitStart s = FindOrbitStart(model, setup, exploration.shooting().layout());
-//   if (s.ok) exploration.RunFromStarts({s.u}, ...);
+//   OrbitStarts s = FindOrbitStarts(model, setup, exploration.shooting().layout());
+//   exploration.RunFromStarts(s.points, ...);
+// Every start the model declares ([start], or each [[start]]) gives one point; a start that fails is
+// reported and left out.
 #ifndef HYBRIDCONT_APP_ORBIT_START_H_
 #define HYBRIDCONT_APP_ORBIT_START_H_
 
 #include <string>
+#include <vector>
 
 #include "hybridcont/shooting_layout.h"
 #include "run_setup.h"
 
 namespace hybridcont::app {
 
-struct OrbitStart {
-  bool ok = false;
-  Vector u;            // in `free_layout`
-  std::string report;  // how it was found, or why not
+struct OrbitStarts {
+  std::vector<Vector> points;  // in `free_layout`
+  std::string report;          // per start: how it was found, or why not
 };
 
-OrbitStart FindOrbitStart(const HybridModel& model, const RunSetup& setup, const ShootingLayout& free_layout);
+OrbitStarts FindOrbitStarts(const HybridModel& model, const RunSetup& setup, const ShootingLayout& free_layout);
 
 }  // namespace hybridcont::app
 

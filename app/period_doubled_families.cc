@@ -74,10 +74,12 @@ std::string Multipliers(const FloquetResult& f) {
 std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridModel& doubled, const RunSetup& setup,
                                          const BifurcationDiagram& diagram, nlohmann::json* special_points,
                                          ResultsWriter& writer, std::ostream& out, bool quiet) {
-  const ShootingLayout parent(model), layout(doubled);
+  // A model without first integral is followed in its parameter: both maps have it free (setup.free).
+  const ShootingLayout parent(model, setup.free), layout(doubled, setup.free);
   const ExplorationOptions options = DoubledOptions(setup.exploration, parent);
   const Scenario scenario = DefaultScenario(doubled);
-  TimeBasedShooting parent_map(model, setup.integrator), floquet_map(doubled, setup.integrator);
+  TimeBasedShooting parent_map(model, setup.integrator, setup.free), floquet_map(doubled, setup.integrator, setup.free);
+  HybridModel at_point = doubled.Clone();  // the doubled model at a point's free-parameter values
   const ReplayOptions replay = ReplayOptionsFor(setup.integrator);
   std::string report = "Period-doubled families (the phase sequence traversed twice, model " + doubled.name() + "):\n";
   int next_branch = static_cast<int>(diagram.branches.size());
@@ -89,24 +91,27 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
     const int pd_id = pd.id;
     const int offset = next_branch;
     FamilyLog log;
-    ModelExploration exploration(doubled, scenario, setup.integrator, options);
+    ModelExploration exploration(doubled, scenario, setup.integrator, options, Formulation::kTimeBased, setup.free);
     BifurcationDiagram d = exploration.RunPeriodDoubled(parent, u_pd, [&](const ProgressInfo& info, const Vector& u) {
       const int id = info.branch_id + offset;
       if (log.H.find(id) == log.H.end()) writer.SetBranchModel(id, doubled);
       PointRecord record = RecordOf(info, u);
-      AnalyzePoint(doubled, setup.integrator, floquet_map, replay, &record);
+      SetFreeParameters(layout, u, &at_point);
+      AnalyzePoint(at_point, setup.integrator, floquet_map, replay, &record);
       log.stable[id].push_back(record.extra[1].second);
-      log.H[id].push_back(u(layout.H_index()));
+      log.H[id].push_back(u(layout.level_index()));
       writer.AddPoint(id, record);
       if (!quiet) {
-        out << fmt::format("  b{:<3} #{:<4} H = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {} (period-doubled)\n", id,
-                           info.point_index, u(layout.H_index()), layout.Period(u), info.step, info.newton_iterations,
+        out << fmt::format("  b{:<3} #{:<4} {} = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {} (period-doubled)\n",
+                           id, info.point_index, layout.level_name(), u(layout.level_index()), layout.Period(u),
+                           info.step, info.newton_iterations,
                            ToString(record.classification.reason));
       }
     });
     const FloquetResult at_pd = ComputeFloquet(parent_map, u_pd);
-    report += fmt::format("  from PD #{} at H = {:.12f} (parent period {:.12f}, multipliers {}):\n", pd_id,
-                          u_pd(parent.H_index()), parent.Period(u_pd), at_pd.ok() ? Multipliers(at_pd) : "-");
+    report += fmt::format("  from PD #{} at {} = {:.12f} (parent period {:.12f}, multipliers {}):\n", pd_id,
+                          parent.level_name(), u_pd(parent.level_index()), parent.Period(u_pd),
+                          at_pd.ok() ? Multipliers(at_pd) : "-");
     if (d.status == ExplorationStatus::kStartFailed) {
       report += "    not started: " + d.message + "\n";
       continue;
@@ -126,7 +131,7 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
       for (size_t i = 0; i < stable.size(); ++i) {
         if (!std::isfinite(stable[i])) continue;
         if (std::isfinite(previous) && stable[i] != previous) {
-          changes.push_back({{"after_point", i - 1}, {"H", log.H[b.id][i]}, {"stable", stable[i] == 1}});
+          changes.push_back({{"after_point", i - 1}, {layout.level_name(), log.H[b.id][i]}, {"stable", stable[i] == 1}});
         }
         previous = stable[i];
       }
@@ -138,8 +143,8 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
       const FloquetResult f = b.points.empty() ? FloquetResult{} : ComputeFloquet(floquet_map, start);
       std::string flips;
       for (const nlohmann::json& c : changes) {
-        flips += fmt::format("{}H = {:.10f} ({})", flips.empty() ? "" : ", ", c["H"].get<double>(),
-                             c["stable"].get<bool>() ? "stable" : "unstable");
+        flips += fmt::format("{}{} = {:.10f} ({})", flips.empty() ? "" : ", ", layout.level_name(),
+                             c[layout.level_name()].get<double>(), c["stable"].get<bool>() ? "stable" : "unstable");
       }
       report += fmt::format("    branch {}: {} points, {}; start T = {:.12f} (2x parent {:.12f}), multipliers {}; "
                             "stability changes: {}\n",

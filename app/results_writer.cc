@@ -81,7 +81,7 @@ nlohmann::json PresentationJson(const HybridModel& model, const OrbitPresentatio
 
 ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::json options,
                              const FreeParameters& free)
-    : dir_(std::move(dir)), model_(model), layout_(model, free), presentation_(model) {
+    : dir_(std::move(dir)), model_(model), free_(free), layout_(model, free), presentation_(model) {
   summary_["model"] = model.name();
   summary_["version"] = HYBRIDCONT_VERSION;
   summary_["description"] = model.description();
@@ -138,7 +138,8 @@ bool ResultsWriter::WriteFailed(const fs::path& file) {
 }
 
 void ResultsWriter::SetBranchModel(int branch_id, const HybridModel& model) {
-  branch_models_.insert_or_assign(branch_id, BranchModel{ShootingLayout(model), OrbitPresentation(model)});
+  // The run's free parameters are the other model's too (a doubled model's columns: its unknowns and p).
+  branch_models_.insert_or_assign(branch_id, BranchModel{ShootingLayout(model, free_), OrbitPresentation(model)});
 }
 
 void ResultsWriter::AnnotateBranch(int branch_id, const nlohmann::json& fields) {

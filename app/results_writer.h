@@ -113,6 +113,7 @@ class ResultsWriter {
  private:
   std::filesystem::path dir_;
   const HybridModel& model_;
+  FreeParameters free_;
   ShootingLayout layout_;
   OrbitPresentation presentation_;
   nlohmann::json summary_;

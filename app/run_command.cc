@@ -296,12 +296,11 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   if (setup.free.empty()) {
     diagram = exploration.Run(on_point);
   } else if (model.num_first_integrals() == 0) {  // the family in the parameter from the model's start
-    const OrbitStart start = FindOrbitStart(model, setup, layout);
-    starts_report = start.report;
-    if (!args.quiet) out << starts_report;
+    const OrbitStarts starts = FindOrbitStarts(model, setup, layout);
     int skipped = 0;
-    diagram = exploration.RunFromStarts(start.ok ? std::vector<Vector>{start.u} : std::vector<Vector>{}, on_point,
-                                        &skipped);
+    if (!args.quiet) out << starts.report;
+    diagram = exploration.RunFromStarts(starts.points, on_point, &skipped);
+    starts_report = starts.report + fmt::format("  {} of them on branches traced from earlier starts\n", skipped);
   } else {
     const ParameterStarts starts = FindParameterStarts(model, setup, exploration.shooting());
     int skipped = 0;

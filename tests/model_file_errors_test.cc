@@ -280,7 +280,7 @@ const BadFile kBadFiles[] = {
     {"StartValueForUnknownUnknown", "x2_y = \"l0\"", "x2_q = \"l0\"", 60,
      "start.values.x2_q: 'x2_q' is not an unknown of the model"},
     {"StartKindWrong", "kind = \"singular\"", "kind = \"exact\"", 59,
-     "start.kind: 'exact': expected 'singular' or 'guess'"},
+     "start.kind: 'exact': expected 'singular', 'guess' or 'simulation'"},
     {"StartValueUnknownSymbol", "H = \"m*g*l0\"", "H = \"m*g*L0\"", 60,
      "start.values.H: in expression 'm*g*L0' at column 5: unknown symbol 'L0'"},
     {"BoundWithOneElement", "H = [0, 2]", "H = [0]", 63, "run.bounds.H: expected [lower, upper]"},

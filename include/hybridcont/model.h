@@ -91,6 +91,11 @@ class Phase {
                                                 const Eigen::Ref<const Vector>& xi, int parameter,
                                                 Vector* dfdp, bool include_mixed_term = true) const;
 
+  // Whether the event function bounds the state during the phase (a gap, like a height above the ground,
+  // that a physical orbit never makes negative), as events do; false for an event that only marks a time
+  // (the cut at the Poincaré section of a repeated model), which only its downward crossing matters for.
+  virtual bool event_bounds_state() const { return true; }
+
   // Why the vector field is not finite at x, in words ("the mass matrix is not positive definite at ..."),
   // for the integrator's message; "" when the phase cannot tell (the default).
   virtual std::string ExplainNonFinite(const Eigen::Ref<const Vector>& x) const {

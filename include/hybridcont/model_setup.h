@@ -46,6 +46,9 @@ struct StartSpec {
   // refines at fixed parameters.
   enum class Kind { kSingular, kGuess, kSimulation };
   Kind kind = Kind::kSingular;
+  // kSimulation: cycles simulated; 0 runs until the cycle settles (an attracting orbit), n > 0 exactly n
+  // cycles whose last is Newton's guess (an unstable orbit the simulation passes close to).
+  int cycles = 0;
   // Unknowns of the time-based layout by name (t1.., x<i>_<state>, xi, H); unlisted unknowns are 0.
   std::vector<std::pair<std::string, SetupValue>> values;
   // Linear conditions sum coefficient * direction[component] = 0 that select the start direction when the
@@ -135,6 +138,9 @@ struct DrawingSpec {
 
 struct ModelSetup {
   StartSpec start;
+  // Further starts ([[start]] in a model file), each traced as a family of its own: for models without
+  // first integral, whose families need not meet (the walker's long- and short-period gaits).
+  std::vector<StartSpec> more_starts;
   RunSpec run;
   std::vector<FamilyRule> families;
   std::vector<QuantitySpec> quantities;

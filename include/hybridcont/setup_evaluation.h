@@ -42,6 +42,8 @@ double EvaluateSetupValue(const HybridModel& model, const SetupValue& v, const s
 // The start of the exploration in the time-based layout: setup().start.values evaluated, every other
 // unknown 0. Throws ModelInputError for a name that is not an unknown or a bad value.
 Vector StartPoint(const HybridModel& model);
+// The same for one of the model's starts (ModelSetup::start or an entry of more_starts).
+Vector StartPoint(const HybridModel& model, const StartSpec& start);
 
 // How the orbits of one model are presented: per-point quantities, family names and the key-frame
 // drawing, every expression parsed once at construction. Keeps a reference to the model (which must

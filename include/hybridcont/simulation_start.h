@@ -28,6 +28,9 @@ namespace hybridcont {
 struct SimulationStartOptions {
   // Cycles simulated at most; a stable gait with multipliers of modulus 0.5 settles to 1e-9 in ~30.
   int max_cycles = 1000;
+  // false: exactly max_cycles cycles, the last one returned as a guess whether or not it has settled (an
+  // unstable orbit that the simulation passes close to, for Newton to converge to).
+  bool require_convergence = true;
   // Convergence: max-norm change of the state at the section from one cycle to the next, relative to
   // 1 + |x|. Newton refines the result, so this only needs to reach its basin of attraction.
   double tolerance = 1e-9;

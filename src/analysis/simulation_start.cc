@@ -79,7 +79,7 @@ SimulationStartResult SimulateToOrbit(const HybridModel& model, const Vector& x1
       res.message = "cycle " + std::to_string(cycle) + ": non-finite state at the section";
       return res;
     }
-    if (res.change <= o.tolerance) {
+    if (res.change <= o.tolerance || (!o.require_convergence && cycle == o.max_cycles)) {
       if (layout.num_first_integrals() > 0) {  // a conservative model: its level at the section
         Vector H;
         model.phase(0).FirstIntegrals(section, &H, nullptr, nullptr);
@@ -89,7 +89,8 @@ SimulationStartResult SimulateToOrbit(const HybridModel& model, const Vector& x1
       res.u = u;
       std::ostringstream os;
       os.precision(2);
-      os << "converged after " << cycle << " cycles (change " << res.change << ")";
+      os << (res.change <= o.tolerance ? "converged after " : "stopped after ") << cycle << " cycles (change "
+         << res.change << ")";
       res.message = os.str();
       return res;
     }

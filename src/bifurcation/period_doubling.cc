@@ -23,7 +23,8 @@ BifurcationDiagram ExplorePeriodDoubled(ZeroProblem* doubled, const ShootingLayo
     throw std::invalid_argument("ExplorePeriodDoubled: the problem has " + std::to_string(doubled->num_unknowns()) +
                                 " unknowns, the doubled layout " + std::to_string(u2.size()));
   }
-  options.start_conditions = {LinearCondition{{{"H", 1.0}}}};
+  // The antiperiodic direction keeps the level (H̄, or the parameter of a model without first integral).
+  options.start_conditions = {LinearCondition{{{layout.level_name(), 1.0}}}};
   const double point_tolerance = options.same_point_tolerance;
   options.known_ray = [&layout, point_tolerance](const Vector& u, const Vector& v) {
     return IsRepeatedOrbit(layout, u, 2, point_tolerance) &&

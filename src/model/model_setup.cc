@@ -242,11 +242,13 @@ double EvaluateSetupValue(const HybridModel& model, const SetupValue& value, con
   return Finite(program.EvaluateScalar(nullptr, p.data()), v);
 }
 
-Vector StartPoint(const HybridModel& model) {
+Vector StartPoint(const HybridModel& model) { return StartPoint(model, model.setup().start); }
+
+Vector StartPoint(const HybridModel& model, const StartSpec& start) {
   const ShootingLayout layout(model);
   const std::vector<std::string>& names = layout.unknown_names();
   Vector u = Vector::Zero(layout.num_unknowns());
-  for (const auto& [name, value] : model.setup().start.values) {
+  for (const auto& [name, value] : start.values) {
     const SetupValue v = Located(value, "start.values." + name);
     const auto it = std::find(names.begin(), names.end(), name);
     if (it == names.end()) throw ModelInputError(v.where, "'" + name + "' is not an unknown of the time-based layout");

@@ -13,10 +13,20 @@
 
 namespace hybridcont::internal {
 
+// A parameter block that reads through to a parent model (the repeated model's). A copy of such a block
+// holds a copy of the parent, and the views below clone themselves onto that copy's phases: so a model of
+// views can be copied (HybridModel::Clone) and its parameters made free like any other's.
+class ParentModelAccess {
+ public:
+  virtual ~ParentModelAccess() = default;
+  virtual const HybridModel& parent() const = 0;
+};
+
 // `target` again, under its own name and states (it must outlive the view).
 class PhaseView : public Phase {
  public:
-  explicit PhaseView(const Phase& target) : PhaseView(target, target.next_dim()) {}
+  // `target` is phase `index` of its model (CloneWith finds it there in the copy).
+  PhaseView(const Phase& target, int index) : PhaseView(target, index, target.next_dim()) {}
 
   void VectorField(const Eigen::Ref<const Vector>& x, Vector* f, Matrix* df) const override {
     target_.VectorField(x, f, df);
@@ -38,11 +48,19 @@ class PhaseView : public Phase {
                                         int parameter, Vector* dfdp, bool include_mixed_term) const override {
     target_.UnfoldedFieldParameterDerivative(x, xi, parameter, dfdp, include_mixed_term);
   }
+  std::string ExplainNonFinite(const Eigen::Ref<const Vector>& x) const override { return target_.ExplainNonFinite(x); }
+  bool event_bounds_state() const override { return target_.event_bounds_state(); }
+  std::unique_ptr<Phase> CloneWith(const ParameterBlock& parameters) const override {
+    const auto* access = dynamic_cast<const ParentModelAccess*>(&parameters);
+    if (access == nullptr) return nullptr;
+    return std::make_unique<PhaseView>(access->parent().phase(index_), index_);
+  }
 
  protected:
-  PhaseView(const Phase& target, int next_dim)
+  PhaseView(const Phase& target, int index, int next_dim)
       : Phase(target.name(), target.state_names(), next_dim, target.num_first_integrals(), target.typical_state()),
-        target_(target) {}
+        target_(target),
+        index_(index) {}
 
   void ComputeUnfoldedVectorField(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
                                   Vector* f_tilde, Matrix* A, Matrix* B, bool include_hessian_term) const override {
@@ -51,6 +69,7 @@ class PhaseView : public Phase {
 
  private:
   const Phase& target_;
+  int index_;
 };
 
 // Phase 1 ended at the Poincaré section: phase 1's flow and first integrals, the anchor a as its event
@@ -59,7 +78,7 @@ class PhaseView : public Phase {
 // parent's monodromy.
 class SectionPhaseView : public PhaseView {
  public:
-  SectionPhaseView(const Phase& phase1, const Anchor& anchor) : PhaseView(phase1, phase1.dim()), anchor_(anchor) {}
+  SectionPhaseView(const Phase& phase1, const Anchor& anchor) : PhaseView(phase1, 0, phase1.dim()), anchor_(anchor) {}
 
   double Event(const Eigen::Ref<const Vector>& x, RowVector* de) const override { return anchor_.Evaluate(x, de); }
   void Reset(const Eigen::Ref<const Vector>& x, Vector* x_next, Matrix* D) const override {
@@ -75,6 +94,12 @@ class SectionPhaseView : public PhaseView {
     if (event != nullptr) *event = anchor_.ParameterDerivative(x, parameter);
     if (reset != nullptr) reset->setZero(x.size());
   }
+  std::unique_ptr<Phase> CloneWith(const ParameterBlock& parameters) const override {
+    const auto* access = dynamic_cast<const ParentModelAccess*>(&parameters);
+    if (access == nullptr) return nullptr;
+    return std::make_unique<SectionPhaseView>(access->parent().phase(0), access->parent().anchor());
+  }
+  bool event_bounds_state() const override { return false; }  // the section marks a time, as the anchor does
 
  private:
   const Anchor& anchor_;
@@ -88,6 +113,11 @@ class AnchorView : public Anchor {
   bool has_parameter_derivatives() const override { return target_.has_parameter_derivatives(); }
   double ParameterDerivative(const Eigen::Ref<const Vector>& x, int parameter) const override {
     return target_.ParameterDerivative(x, parameter);
+  }
+  std::unique_ptr<Anchor> CloneWith(const ParameterBlock& parameters) const override {
+    const auto* access = dynamic_cast<const ParentModelAccess*>(&parameters);
+    if (access == nullptr) return nullptr;
+    return std::make_unique<AnchorView>(access->parent().anchor());
   }
 
  private:

@@ -13,19 +13,31 @@
 namespace hybridcont {
 namespace {
 
-// The parent's parameters, read through; the parent's phases read them from the parent's block.
-class ParameterView : public ParameterBlock {
+// The parent's parameters, read through; the parent's phases read them from the parent's block. A copy
+// (Clone) owns a copy of the parent, whose parameters it then sets: a copied repeated model is a model of
+// its own, with its parameters free to change (a free parameter of the doubled map).
+class ParameterView : public ParameterBlock, public internal::ParentModelAccess {
  public:
-  ParameterView(const HybridModel& parent) : parent_(parent) {}  // NOLINT(google-explicit-constructor)
-  const std::vector<ParameterInfo>& infos() const override { return parent_.parameters(); }
-  double Get(int index) const override { return parent_.parameter(parent_.parameters()[index].name); }
-  void Set(int index, double) override {
-    throw std::invalid_argument("parameter '" + parent_.parameters()[index].name + "' of a repeated model is its parent '" +
-                                parent_.name() + "''s: set it on the parent model");
+  ParameterView(const HybridModel& parent) : parent_(&parent) {}  // NOLINT(google-explicit-constructor)
+  explicit ParameterView(std::shared_ptr<HybridModel> owned) : parent_(owned.get()), owned_(std::move(owned)) {}
+  const std::vector<ParameterInfo>& infos() const override { return parent_->parameters(); }
+  double Get(int index) const override { return parent_->parameter_value(index); }
+  void Set(int index, double value) override {
+    if (!owned_) {
+      throw std::invalid_argument("parameter '" + parent_->parameters()[index].name + "' of a repeated model is its "
+                                  "parent '" + parent_->name() + "''s: set it on the parent model");
+    }
+    owned_->SetParameterValue(index, value);
   }
+  std::unique_ptr<ParameterBlock> Clone() const override {
+    if (!parent_->is_cloneable()) return nullptr;
+    return std::make_unique<ParameterView>(std::make_shared<HybridModel>(parent_->Clone()));
+  }
+  const HybridModel& parent() const override { return *parent_; }
 
  private:
-  const HybridModel& parent_;
+  const HybridModel* parent_;
+  std::shared_ptr<HybridModel> owned_;  // a copy's own parent
 };
 
 void RequireFold(int k) {
@@ -90,7 +102,7 @@ HybridModel RepeatedModel(const HybridModel& model, int k) {
   std::vector<int> parent_phase;  // per phase of the k-fold model: the parent phase it repeats
   for (int c = 0; c < k; ++c) {
     for (int i = 0; i < m; ++i) {
-      phases.push_back(std::make_unique<internal::PhaseView>(model.phase(i)));
+      phases.push_back(std::make_unique<internal::PhaseView>(model.phase(i), i));
       parent_phase.push_back(i);
     }
     if (c + 1 < k) {

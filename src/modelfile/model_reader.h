@@ -87,6 +87,8 @@ class Reader {
   void ReadParameters();
   void ReadDefinitions();
   void ReadStart();
+  // One start table ([start] or an element of [[start]]).
+  StartSpec ReadStartTable(const toml::table& t, const std::string& field);
   void ReadRun();
   void ReadFamilies();
   void ReadQuantities();

@@ -98,42 +98,68 @@ void Reader::ReadDefinitions() {
 }
 
 void Reader::ReadStart() {
-  const toml::table* t = OptionalTable(root_, "start", "");
-  if (t == nullptr) Fail(&root_, "start", "missing table [start] (where the exploration begins)");
-  CheckKeys(*t, "start", {"kind", "values", "conditions"});
-  const std::string kind = OptionalString(*t, "kind", "start", "singular");
-  if (kind == "singular") spec_.setup.start.kind = StartSpec::Kind::kSingular;
-  else if (kind == "guess") spec_.setup.start.kind = StartSpec::Kind::kGuess;
-  else if (kind == "simulation") spec_.setup.start.kind = StartSpec::Kind::kSimulation;
-  else Fail(t->get("kind"), "start.kind", "'" + kind + "': expected 'singular', 'guess' or 'simulation'");
-  if (const toml::table* values = OptionalTable(*t, "values", "start")) {
+  const toml::node* n = root_.get("start");
+  if (n == nullptr) Fail(&root_, "start", "missing table [start] (where the exploration begins)");
+  if (const toml::array* a = n->as_array()) {  // [[start]]: several starts, one family each
+    if (conservative_) {
+      Fail(n, "start", "several starts ([[start]]) are for models without first integral (conservative = false); "
+                       "a conservative model's exploration branches from its one start");
+    }
+    if (a->empty()) Fail(n, "start", "at least one start");
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const std::string field = "start[" + std::to_string(i) + "]";
+      if (!a->get(i)->is_table()) Fail(a->get(i), field, "expected a [[start]] table");
+      StartSpec s = ReadStartTable(*a->get(i)->as_table(), field);
+      if (i == 0) spec_.setup.start = std::move(s);
+      else spec_.setup.more_starts.push_back(std::move(s));
+    }
+    return;
+  }
+  spec_.setup.start = ReadStartTable(RequiredTable(root_, "start", ""), "start");
+}
+
+StartSpec Reader::ReadStartTable(const toml::table& st, const std::string& field) {
+  const toml::table* t = &st;
+  StartSpec start;
+  CheckKeys(*t, field, {"kind", "values", "conditions", "cycles"});
+  const std::string kind = OptionalString(*t, "kind", field, "singular");
+  if (kind == "singular") start.kind = StartSpec::Kind::kSingular;
+  else if (kind == "guess") start.kind = StartSpec::Kind::kGuess;
+  else if (kind == "simulation") start.kind = StartSpec::Kind::kSimulation;
+  else Fail(t->get("kind"), field + ".kind", "'" + kind + "': expected 'singular', 'guess' or 'simulation'");
+  start.cycles = OptionalInteger(*t, "cycles", field, 0, 0, 1000000);
+  if (start.cycles > 0 && start.kind != StartSpec::Kind::kSimulation) {
+    Fail(t->get("cycles"), field + ".cycles", "only a simulation start has cycles");
+  }
+  if (const toml::table* values = OptionalTable(*t, "values", field)) {
     for (auto&& [key, node] : *values) {
       const std::string name(key.str());
-      CheckUnknown(&node, "start.values." + name, name, false);
-      SetupValue v = AsSetupValue(node, "start.values." + name);
+      CheckUnknown(&node, field + ".values." + name, name, false);
+      SetupValue v = AsSetupValue(node, field + ".values." + name);
       CheckSetupValue(v, {});
-      spec_.setup.start.values.push_back({name, v});
+      start.values.push_back({name, v});
     }
   }
   if (const toml::node* c = t->get("conditions")) {
-    const toml::array& a = AsArray(*c, "start.conditions");
+    const toml::array& a = AsArray(*c, field + ".conditions");
     for (std::size_t i = 0; i < a.size(); ++i) {
-      const std::string field = "start.conditions[" + std::to_string(i) + "]";
-      if (!a.get(i)->is_table()) Fail(a.get(i), field, "expected a table { terms = {...}, description = \"...\" }");
+      const std::string cf = field + ".conditions[" + std::to_string(i) + "]";
+      if (!a.get(i)->is_table()) Fail(a.get(i), cf, "expected a table { terms = {...}, description = \"...\" }");
       const toml::table& ct = *a.get(i)->as_table();
-      CheckKeys(ct, field, {"terms", "description"});
+      CheckKeys(ct, cf, {"terms", "description"});
       StartSpec::Condition cond;
-      const toml::table& terms = RequiredTable(ct, "terms", field);
+      const toml::table& terms = RequiredTable(ct, "terms", cf);
       for (auto&& [key, node] : terms) {
         const std::string name(key.str());
-        CheckUnknown(&node, field + ".terms." + name, name, false);
-        cond.terms.push_back({name, AsNumber(node, field + ".terms." + name)});
+        CheckUnknown(&node, cf + ".terms." + name, name, false);
+        cond.terms.push_back({name, AsNumber(node, cf + ".terms." + name)});
       }
-      if (cond.terms.empty()) Fail(&terms, field + ".terms", "a condition needs at least one term");
-      cond.description = OptionalString(ct, "description", field, "");
-      spec_.setup.start.conditions.push_back(cond);
+      if (cond.terms.empty()) Fail(&terms, cf + ".terms", "a condition needs at least one term");
+      cond.description = OptionalString(ct, "description", cf, "");
+      start.conditions.push_back(cond);
     }
   }
+  return start;
 }
 
 void Reader::ReadRun() {
