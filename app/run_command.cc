@@ -219,10 +219,11 @@ void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log,
 // The Floquet crossings among the diagram's special points (located by the exploration as test functions,
 // floquet_test_functions.h), one line each, BP before PD.
 std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayout& layout) {
-  std::string report = "Floquet special points (multiplier crossings on physical orbits):\n";
+  std::string report = "Floquet special points (multiplier crossings on physical orbits; grazing events):\n";
   int count = 0;
   for (const auto& [type, code] : {std::pair{SpecialPointType::kFloquetBranchPoint, "BP"},
-                                   std::pair{SpecialPointType::kPeriodDoubling, "PD"}}) {
+                                   std::pair{SpecialPointType::kPeriodDoubling, "PD"},
+                                   std::pair{SpecialPointType::kGrazing, "GR"}}) {
     for (const SpecialPoint& sp : diagram.special_points) {
       if (sp.type != type || sp.u.size() == 0) continue;
       const double precision = sp.interval_width.size() ? sp.interval_width.norm() : sp.precision();

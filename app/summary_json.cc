@@ -16,6 +16,7 @@ std::string SpecialPointTypeCode(SpecialPointType type) {
     case SpecialPointType::kFloquetBranchPoint: return "BP";
     case SpecialPointType::kPeriodDoubling: return "PD";
     case SpecialPointType::kUserTestFunction: return "test";
+    case SpecialPointType::kGrazing: return "GR";
   }
   return "?";
 }

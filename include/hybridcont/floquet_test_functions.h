@@ -50,6 +50,11 @@ double PeriodDoublingTest(const Matrix& dr, const ShootingLayout& layout);
 // u. With physical_only, a branch point whose orbit is not physical (classification.h) or whose
 // event-driven replay does not return (replay.h) has NaN values: the multipliers of a non-physical orbit
 // mean nothing for the mechanical system. Trial points between two branch points are not classified.
+//
+// A model without first integral adds one kGrazing function per event, the normalized crossing speed
+// de_i·f_i / (|de_i| |f_i|) at the end of segment i (negative on a physical orbit, zero where the event is
+// met tangentially), defined on both sides of the grazing point. (Conservative models do not locate grazing
+// yet, so that their diagrams stay as they were.)
 class FloquetTestFunctions : public TestFunctions {
  public:
   // Keeps a reference to model (it must outlive this object and its clones). With free parameters

@@ -45,6 +45,7 @@ enum class SpecialPointType {
   kFloquetBranchPoint,  // a further Floquet multiplier crosses +1 (BP; floquet_test_functions.h)
   kPeriodDoubling,      // a Floquet multiplier crosses −1 (PD; floquet_test_functions.h)
   kUserTestFunction,    // a zero of a caller's test function
+  kGrazing,             // an event met tangentially: its normalized crossing speed de·f/(|de||f|) is 0
 };
 std::string ToString(SpecialPointType type);
 

@@ -56,7 +56,9 @@ FloquetTestFunctions::FloquetTestFunctions(const HybridModel& model, const Integ
 }
 
 std::vector<SpecialPointType> FloquetTestFunctions::types() const {
-  return {SpecialPointType::kFloquetBranchPoint, SpecialPointType::kPeriodDoubling};
+  std::vector<SpecialPointType> types = {SpecialPointType::kFloquetBranchPoint, SpecialPointType::kPeriodDoubling};
+  if (model_->num_first_integrals() == 0) types.insert(types.end(), model_->num_phases(), SpecialPointType::kGrazing);
+  return types;
 }
 
 bool FloquetTestFunctions::Physical(const Vector& u_free) const {
@@ -86,7 +88,21 @@ bool FloquetTestFunctions::Physical(const Vector& u_free) const {
 }
 
 void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* values) {
-  *values = Vector::Constant(2, std::numeric_limits<double>::quiet_NaN());
+  const int m = model_->num_phases();
+  const bool grazing = model_->num_first_integrals() == 0;
+  *values = Vector::Constant(2 + (grazing ? m : 0), std::numeric_limits<double>::quiet_NaN());
+  const bool evaluated = shooting_.Evaluate(u, nullptr, &dr_).ok;
+  if (grazing && evaluated) {  // every orbit, physical or not: the crossing speed changes sign at grazing
+    const HybridModel& model = shooting_.model();  // at u's parameter values
+    for (int i = 0; i < m; ++i) {
+      const Vector& x = shooting_.segment_flow(i).x;
+      RowVector de;
+      Vector f;
+      model.phase(i).Event(x, &de);
+      model.phase(i).VectorField(x, &f, nullptr);
+      (*values)(2 + i) = de.dot(f) / std::max(de.norm() * f.norm(), 1e-300);
+    }
+  }
   if (branch_point && physical_only_ && !Physical(u)) return;
   const FloquetResult floquet = ComputeFloquet(shooting_, u);
   if (!floquet.ok()) return;

@@ -14,6 +14,7 @@ constexpr internal::EnumName<SpecialPointType> kSpecialPointTypeNames[] = {
     {SpecialPointType::kSingularStart, "singular-start"},
     {SpecialPointType::kFloquetBranchPoint, "floquet-branch-point"},
     {SpecialPointType::kPeriodDoubling, "period-doubling"},
+    {SpecialPointType::kGrazing, "grazing"},
     {SpecialPointType::kUserTestFunction, "test-function-zero"},
 };
 
