@@ -190,6 +190,44 @@ void BM_LagrangianFullRun(benchmark::State& state) {
 }
 BENCHMARK(BM_LagrangianFullRun)->ArgsProduct({{0, 1}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
 
+// A model without first integral against a conservative one of the same size, in the same run: one r + dr
+// evaluation at a gait (orbit) of each, BM_DissipativeMap/<model>: 0 the simplest walker (4 states, one
+// phase, gamma free: no ξ, no H̄, one parameter column), 1 the bouncing pendulum (4 states, one phase, ξ
+// and H̄). Counters: RHS evaluations per map evaluation and the map's size.
+void BM_DissipativeMap(benchmark::State& state) {
+  const bool walker = state.range(0) == 0;
+  ModelFileOptions options;
+  options.cache_dir = std::filesystem::temp_directory_path() / "hybridcont-bench-cache";
+  const HybridModel model = LoadModelFile(
+      std::filesystem::path(HYBRIDCONT_SOURCE_DIR) / "models" / (walker ? "simplest-walker.toml" : "bouncing-pendulum.toml"),
+      options);
+  TimeBasedShooting shooting(model, IntegratorOptions{}, walker ? FreeParameters{{"gamma"}, {}} : FreeParameters{});
+  const ShootingLayout& layout = shooting.layout();
+  Vector u = Vector::Zero(layout.num_unknowns());
+  if (walker) {  // the long-period gait at gamma = 0.009 (tests/dissipative_models_test.cc)
+    u << 2.0507748199878604, 0.20031090054455519, 0.40062180108911039, -0.19983247300537216, -0.015822999948390645,
+        1.8316889328761317, -8.89e-29, -0.053210379845986026, -0.059377176638781719, -0.33977530977991061, 0.009;
+  } else {  // the vertical bouncing at H = 0.5 with the pendulum swinging slightly (a non-trivial flow)
+    u(layout.time_index(0)) = u(layout.time_index(1)) = std::sqrt(0.5);
+    u(layout.state_offset(0)) = 0.25;
+    u(layout.state_offset(0) + 1) = 0.1;
+    u(layout.state_offset(1) + 2) = std::sqrt(0.5);
+    u(layout.H_index()) = 0.5;
+  }
+  Vector r;
+  Matrix dr;
+  for (auto _ : state) {
+    u(0) += 1e-15;  // defeat the cache: a new point each time
+    if (!shooting.Evaluate(u, &r, &dr).ok) state.SkipWithError("evaluation failed");
+    benchmark::DoNotOptimize(dr.data());
+  }
+  state.SetLabel(walker ? "simplest walker (no first integral)" : "bouncing pendulum (conservative)");
+  state.counters["rhs_per_eval"] =
+      static_cast<double>(shooting.counters().rhs_evaluations) / static_cast<double>(shooting.num_evaluations());
+  state.counters["N"] = shooting.num_equations();
+}
+BENCHMARK(BM_DissipativeMap)->DenseRange(0, 1)->Unit(benchmark::kMicrosecond);
+
 // What the first use of a model file costs: parse, generate, compile with the system compiler and load,
 // into an empty cache (later uses load the cached library: BM_ModelFileLoad).
 void ModelFileLoad(benchmark::State& state, bool cold) {
