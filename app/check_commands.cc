@@ -72,7 +72,11 @@ std::string ConservationTable(const ConservationReport& report) {
     if (!e.passed(ConservationReport::kTolerance)) os << " at " << e.worst_state;
     os << "\n";
   }
-  os << (report.passed() ? "every flow and reset conserves the first integrals\n" : "THE ENERGY IS NOT CONSERVED\n");
+  if (report.entries.empty()) {
+    os << "the model has no first integral (conservative = false): nothing to conserve\n";
+  } else {
+    os << (report.passed() ? "every flow and reset conserves the first integrals\n" : "THE ENERGY IS NOT CONSERVED\n");
+  }
   return os.str();
 }
 

@@ -274,16 +274,6 @@ int FinishAndDraw(const RunArguments& args, const BifurcationDiagram& diagram, R
   return diagram.status == ExplorationStatus::kStartFailed ? 1 : 0;
 }
 
-// Each special point's free-parameter values as fields of their own, e.g. "k": 31.5 (also in "u").
-void AddParameterValues(const ShootingLayout& layout, nlohmann::json* special_points) {
-  for (nlohmann::json& sp : *special_points) {
-    if (!sp.contains("u") || !sp["u"].is_array() || sp["u"].size() != static_cast<size_t>(layout.num_unknowns())) continue;
-    for (int i = 0; i < layout.num_free_parameters(); ++i) {
-      sp[layout.unknown_names()[layout.parameter_index(i)]] = sp["u"][layout.parameter_index(i)];
-    }
-  }
-}
-
 // ---- 2. compute, streaming every accepted point; 3. summary, key-frame orbits, report, figures
 int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulation formulation,
                     const RunSetup& setup, ModelExploration& exploration, ResultsWriter& writer, std::ostream& out,
@@ -327,7 +317,6 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   if (!setup.curve_parameter.empty()) {
     writer.Annotate("curves", TraceParameterCurves(model, setup, diagram, writer.dir(), &curves_report));
   }
-  AddParameterValues(layout, &special_points);
   writer.SetSpecialPoints(special_points);
   WriteKeyframeOrbits(diagram, stream.log(), model, setup, layout, writer);
   const std::string report =

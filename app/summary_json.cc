@@ -95,6 +95,12 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
                         {"duplicate_of", sp.duplicate_of},
                         {"message", sp.message}};
     j["u"] = std::vector<double>(sp.u.data(), sp.u.data() + sp.u.size());
+    // Each free parameter's value as a field of its own, e.g. "k": 31.5 (also in "u").
+    if (sp.u.size() == layout.num_unknowns()) {
+      for (int i = 0; i < layout.num_free_parameters(); ++i) {
+        j[layout.unknown_names()[layout.parameter_index(i)]] = sp.u(layout.parameter_index(i));
+      }
+    }
     list.push_back(j);
   }
   return list;
