@@ -15,13 +15,18 @@
 #include <complex>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
 
 #include "hybridcont/exploration.h"
+#include "hybridcont/expression_model.h"
 #include "hybridcont/floquet.h"
 #include "hybridcont/model_file.h"
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/simulation_start.h"
+#include "hybridcont/timebased_shooting.h"
 #include "model_exploration.h"
 #include "orbit_start.h"
 #include "run_setup.h"
@@ -231,6 +236,51 @@ TEST(ForcedImpactOscillator, GrazingFrequenciesMatchTheClosedForm) {
   EXPECT_NEAR(found[1], high, 1e-9);
   std::printf("grazing at w = %.12f and %.12f; closed form %.12f and %.12f (errors %.1e, %.1e)\n", found[0], found[1],
               low, high, found[0] - low, found[1] - high);
+}
+
+// The oscillator written from its mechanics (mechanics.h) without first integral: T = v²/2, V = k x²/2, the
+// damping and forcing as a generalized force, the forcing phase an explicit state beside the mechanical
+// ones, and the impact as Newton's law with restitution e at the contact d − x = 0. Its map is the explicit
+// file's, r and dr to 1e-12 at random points with the frequency free.
+TEST(ForcedImpactOscillator, LagrangianFormWithRestitutionIsTheExplicitModel) {
+  std::ifstream in(std::filesystem::path(HYBRIDCONT_SOURCE_DIR) / "models" / "forced-impact-oscillator.toml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string lagrangian = text.str();
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = lagrangian.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    lagrangian.replace(at, from.size(), to);
+  };
+  const std::string mechanics = "coordinates = [\"x\"]\nvelocities = [\"v\"]\n"
+                                "kinetic = \"0.5*v^2\"\npotential = \"0.5*k*x^2\"\n"
+                                "forces = { x = \"-c*v + A*cos(s)\" }\node = { s = \"w\" }\n";
+  // approach: its field, event and reset from the mechanics and the impact law
+  replace("ode = { x = \"v\", v = \"-k*x - c*v + A*cos(s)\", s = \"w\" }\nevent = \"d - x\"", mechanics +
+          "impact = { constraint = \"d - x\", restitution = \"e\" }");
+  replace("reset = { x = \"x\", v = \"-e*v\", s = \"s\" }\n", "");
+  // rebound: its field from the mechanics, its wrap written out
+  replace("ode = { x = \"v\", v = \"-k*x - c*v + A*cos(s)\", s = \"w\" }\nevent = \"pi - s\"", mechanics +
+          "event = \"pi - s\"");
+  const HybridModel explicit_model = Load("forced-impact-oscillator");
+  const HybridModel mechanical = BuildExpressionModel(ParseModelText(lagrangian, "oscillator-lagrangian.toml"));
+  const FreeParameters free{{"w"}, {}};
+  TimeBasedShooting a(explicit_model, IntegratorOptions{}, free), b(mechanical, IntegratorOptions{}, free);
+  ASSERT_EQ(a.layout().unknown_names(), b.layout().unknown_names());
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> d(-0.3, 0.3);
+  for (int trial = 0; trial < 10; ++trial) {
+    Vector u(a.layout().num_unknowns());
+    for (int i = 0; i < u.size(); ++i) u(i) = d(rng);
+    for (int i = 0; i < a.layout().num_segments(); ++i) u(a.layout().time_index(i)) = 0.5 + std::abs(u(a.layout().time_index(i)));
+    u(a.layout().parameter_index(0)) = 0.9 + d(rng) / 3;
+    Vector ra, rb;
+    Matrix da, db;
+    ASSERT_TRUE(a.Evaluate(u, &ra, &da).ok);
+    ASSERT_TRUE(b.Evaluate(u, &rb, &db).ok);
+    EXPECT_LE((ra - rb).lpNorm<Eigen::Infinity>(), 1e-12 * (1 + ra.lpNorm<Eigen::Infinity>())) << trial;
+    EXPECT_LE((da - db).lpNorm<Eigen::Infinity>(), 1e-12 * (1 + da.lpNorm<Eigen::Infinity>())) << trial;
+  }
 }
 
 }  // namespace

@@ -70,8 +70,10 @@ void CheckMechanics(const MechanicalSystem& system, const EquationsOfMotion& equ
 
 // The post-impact velocities q̇⁺ (n) at the constraint g (an expression of q; throws ModelInputError at
 // `where` if g does not depend on q or depends on a velocity).
+// The restitution e is an expression of the parameters (a number, or a parameter to continue in).
 std::vector<ExprPtr> ImpactVelocities(const MechanicalSystem& system, const EquationsOfMotion& equations,
-                                      const ExprPtr& constraint, double restitution, const SourceLocation& where);
+                                      const ExprPtr& constraint, const ExprPtr& restitution,
+                                      const SourceLocation& where);
 
 // Why M is not positive definite at a state, from its entries there (n × n, row-major): "" if it is.
 // Names the coordinates (names[i] for q_i) and the values: "the mass matrix is not positive definite at

@@ -149,7 +149,7 @@ void CheckMechanics(const MechanicalSystem& s, const EquationsOfMotion& eq, int 
 }
 
 std::vector<ExprPtr> ImpactVelocities(const MechanicalSystem& s, const EquationsOfMotion& eq, const ExprPtr& g,
-                                      double restitution, const SourceLocation& where) {
+                                      const ExprPtr& restitution, const SourceLocation& where) {
   const int n = static_cast<int>(s.coordinates.size());
   for (int v : s.velocities) {
     if (DependsOnInput(g, v)) throw ModelInputError(where, "the contact constraint g(q) depends on a velocity");
@@ -164,7 +164,7 @@ std::vector<ExprPtr> ImpactVelocities(const MechanicalSystem& s, const Equations
   if (!depends) throw ModelInputError(where, "the contact constraint g(q) does not depend on the coordinates");
   const std::vector<ExprPtr> w = CholeskySolve(eq.mass_matrix, G);  // M⁻¹ Gᵀ
   // The impulse factor (1 + e) (G q̇) / (G M⁻¹ Gᵀ).
-  const ExprPtr factor = Div(Mul(MakeConstant(1.0 + restitution), Dot(G, dq)), Dot(G, w));
+  const ExprPtr factor = Div(Mul(Add(MakeConstant(1.0), restitution), Dot(G, dq)), Dot(G, w));
   std::vector<ExprPtr> after(n);
   for (int i = 0; i < n; ++i) after[i] = Sub(dq[i], Mul(w[i], factor));
   return after;

@@ -161,14 +161,20 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
     if (g == nullptr) Fail(impact, field + ".constraint", "missing field 'constraint' (the contact's g(q); impact at g = 0)");
     out.constraint = ParsePhaseExpression(i, *g, field + ".constraint");
     out.constraint_where = At(g, field + ".constraint");
-    const double e = OptionalNumber(*impact, "restitution", field, 1.0);
-    if (!(e >= 0.0 && e <= 1.0)) {
-      Fail(impact->get("restitution"), field + ".restitution", "restitution " + FormatNumber(e) + " is outside [0, 1]");
-    }
-    if (conservative_ && e != 1.0) {
-      Fail(impact->get("restitution"), field + ".restitution",
-           "restitution " + FormatNumber(e) + ": only the elastic law (1), which conserves the energy, is "
-           "possible in a conservative model (declare conservative = false for a dissipative one)");
+    // e: a number in [0, 1] or an expression of the parameters (a parameter to continue in).
+    ExprPtr e = MakeConstant(1.0);
+    if (const toml::node* r = impact->get("restitution")) {
+      const std::string rf = field + ".restitution";
+      e = ParseExpression(ExpressionText(*r, rf), [this](const std::string& name) { return GlobalSymbol(name); },
+                          At(r, rf));
+      if (e->op == ExprOp::kConstant && !(e->value >= 0.0 && e->value <= 1.0)) {
+        Fail(r, rf, "restitution " + FormatNumber(e->value) + " is outside [0, 1]");
+      }
+      if (conservative_ && !IsConstant(e, 1.0)) {
+        const std::string shown = e->op == ExprOp::kConstant ? FormatNumber(e->value) : ExpressionText(*r, rf);
+        Fail(r, rf, "restitution " + shown + ": only the elastic law (1), which conserves the "
+                    "energy, is possible in a conservative model (declare conservative = false for a dissipative one)");
+      }
     }
     const std::vector<ExprPtr> after = ImpactVelocities(system, eq, out.constraint, e, out.constraint_where);
     // Into the next phase: a state named like one of this phase's takes its value after the impact.
