@@ -22,6 +22,7 @@
 #include "hybridcont/exploration.h"
 #include "hybridcont/expression_model.h"
 #include "hybridcont/floquet.h"
+#include "hybridcont/model_builder.h"
 #include "hybridcont/model_file.h"
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/shooting_layout.h"
@@ -238,6 +239,80 @@ TEST(ForcedImpactOscillator, GrazingFrequenciesMatchTheClosedForm) {
               low, high, found[0] - low, found[1] - high);
 }
 
+// The time-based maps of two models with the same layout and free parameter agree, r and dr to 1e-12, at
+// random points: states and durations near 0 and `min_time` + |·|, the parameter in p0 ± spread.
+void ExpectSameMap(const HybridModel& x, const HybridModel& y, const FreeParameters& free, double min_time,
+                   double p0, double spread) {
+  TimeBasedShooting a(x, IntegratorOptions{}, free), b(y, IntegratorOptions{}, free);
+  ASSERT_EQ(a.layout().unknown_names(), b.layout().unknown_names());
+  const ShootingLayout& layout = a.layout();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> d(-0.3, 0.3);
+  for (int trial = 0; trial < 10; ++trial) {
+    Vector u(layout.num_unknowns());
+    for (int i = 0; i < u.size(); ++i) u(i) = d(rng);
+    for (int i = 0; i < layout.num_segments(); ++i) u(layout.time_index(i)) = min_time + std::abs(u(layout.time_index(i)));
+    u(layout.parameter_index(0)) = p0 + spread * d(rng) / 0.3;
+    Vector ra, rb;
+    Matrix da, db;
+    ASSERT_TRUE(a.Evaluate(u, &ra, &da).ok) << trial;
+    ASSERT_TRUE(b.Evaluate(u, &rb, &db).ok) << trial;
+    EXPECT_LE((ra - rb).lpNorm<Eigen::Infinity>(), 1e-12 * (1 + ra.lpNorm<Eigen::Infinity>())) << trial;
+    EXPECT_LE((da - db).lpNorm<Eigen::Infinity>(), 1e-12 * (1 + da.lpNorm<Eigen::Infinity>())) << trial;
+  }
+}
+
+// The walker in C++ (model_builder.h): a phase functor whose FirstIntegrals are none (an empty vector) is a
+// model without first integral. Its map with gamma free equals the model file's.
+template <class T>
+struct WalkerParameters {
+  T gamma = 0.009;
+};
+struct WalkerStep {
+  template <class T, class Q>
+  static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
+    using std::cos, std::sin;
+    const T a = sin(x(0) - p.gamma);
+    StateVector<T> f(4);
+    f << x(2), x(3), a, a + x(2) * x(2) * sin(x(1)) - cos(x(0) - p.gamma) * sin(x(1));
+    return f;
+  }
+  template <class T, class Q>
+  static StateVector<T> FirstIntegrals(const StateVector<T>&, const Q&) {
+    return StateVector<T>(0);
+  }
+  template <class T, class Q>
+  static T Event(const StateVector<T>& x, const Q&) {
+    return 2.0 * x(0) - x(1);
+  }
+  template <class T, class Q>
+  static StateVector<T> Reset(const StateVector<T>& x, const Q&) {
+    using std::cos;
+    const T c2 = cos(2.0 * x(0));
+    StateVector<T> y(4);
+    y << -x(0), -2.0 * x(0), c2 * x(2), c2 * (1.0 - c2) * x(2);
+    return y;
+  }
+};
+struct WalkerSection {
+  template <class T, class Q>
+  static T Anchor(const StateVector<T>& x, const Q&) {
+    return 2.0 * x(2) - x(3);
+  }
+};
+
+TEST(SimplestWalker, CppModelWithoutFirstIntegralIsTheModelFile) {
+  ModelBuilder<WalkerParameters<double>> b("simplest-walker", "C++ walker");
+  b.Parameter("gamma", [](auto& p) -> auto& { return p.gamma; }, "slope");
+  b.AddPhase<WalkerStep>("step", {"theta", "phi", "dtheta", "dphi"}, (Vector(4) << 0.1, 0.25, -0.2, 0.05).finished());
+  b.SetAnchor<WalkerSection>();
+  const HybridModel cpp = b.Build();
+  EXPECT_EQ(cpp.num_first_integrals(), 0);
+  const HybridModel file = Load("simplest-walker");
+  const FreeParameters free{{"gamma"}, {}};
+  ExpectSameMap(cpp, file, free, 1.0, 0.01, 0.005);
+}
+
 // The oscillator written from its mechanics (mechanics.h) without first integral: T = v²/2, V = k x²/2, the
 // damping and forcing as a generalized force, the forcing phase an explicit state beside the mechanical
 // ones, and the impact as Newton's law with restitution e at the contact d − x = 0. Its map is the explicit
@@ -265,22 +340,7 @@ TEST(ForcedImpactOscillator, LagrangianFormWithRestitutionIsTheExplicitModel) {
   const HybridModel explicit_model = Load("forced-impact-oscillator");
   const HybridModel mechanical = BuildExpressionModel(ParseModelText(lagrangian, "oscillator-lagrangian.toml"));
   const FreeParameters free{{"w"}, {}};
-  TimeBasedShooting a(explicit_model, IntegratorOptions{}, free), b(mechanical, IntegratorOptions{}, free);
-  ASSERT_EQ(a.layout().unknown_names(), b.layout().unknown_names());
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> d(-0.3, 0.3);
-  for (int trial = 0; trial < 10; ++trial) {
-    Vector u(a.layout().num_unknowns());
-    for (int i = 0; i < u.size(); ++i) u(i) = d(rng);
-    for (int i = 0; i < a.layout().num_segments(); ++i) u(a.layout().time_index(i)) = 0.5 + std::abs(u(a.layout().time_index(i)));
-    u(a.layout().parameter_index(0)) = 0.9 + d(rng) / 3;
-    Vector ra, rb;
-    Matrix da, db;
-    ASSERT_TRUE(a.Evaluate(u, &ra, &da).ok);
-    ASSERT_TRUE(b.Evaluate(u, &rb, &db).ok);
-    EXPECT_LE((ra - rb).lpNorm<Eigen::Infinity>(), 1e-12 * (1 + ra.lpNorm<Eigen::Infinity>())) << trial;
-    EXPECT_LE((da - db).lpNorm<Eigen::Infinity>(), 1e-12 * (1 + da.lpNorm<Eigen::Infinity>())) << trial;
-  }
+  ExpectSameMap(explicit_model, mechanical, free, 0.5, 0.9, 0.1);
 }
 
 }  // namespace
