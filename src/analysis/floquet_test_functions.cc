@@ -107,7 +107,7 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
   const FloquetResult floquet = ComputeFloquet(shooting_, u);
   if (!floquet.ok()) return;
   (*values)(0) = floquet.bp_test;
-  if (shooting_.Evaluate(u, nullptr, &dr_).ok) (*values)(1) = PeriodDoublingTest(dr_, shooting_.layout());
+  if (evaluated) (*values)(1) = PeriodDoublingTest(dr_, shooting_.layout());  // dr_ from the evaluation above
 }
 
 std::unique_ptr<TestFunctions> FloquetTestFunctions::Clone() const {
