@@ -6,7 +6,10 @@
 //     of Garcia et al. (1998), Newton on the stride map with a finite-difference Jacobian);
 //   - the published stability bound of the long-period gait (stable for 0 < gamma < 0.015 rad): its
 //     period-doubling point, located, and the period-doubled gait starting at twice the period;
-//   - the oscillator's two grazing frequencies against the closed form of the non-impacting response.
+//   - the oscillator's two grazing frequencies against the closed form of the non-impacting response;
+//   - the compass gait's heel strike, which the tool derives in extended coordinates, against the
+//     angular-momentum balance written here in Cartesian terms; its gaits, multipliers, first period
+//     doubling and period-doubled gait against a simulation-and-root-solve with hand-derived equations.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -66,9 +69,71 @@ ParameterRun Explore(const HybridModel& model) {
   return run;
 }
 
+// The run's one period-doubling point, checked located to 1e-8; null if there is none.
+const SpecialPoint* OnlyPeriodDoubling(const BifurcationDiagram& diagram) {
+  const SpecialPoint* pd = nullptr;
+  for (const SpecialPoint& sp : diagram.special_points) {
+    if (sp.type == SpecialPointType::kPeriodDoubling) {
+      EXPECT_EQ(pd, nullptr) << "a second PD point: " << sp.BriefReport();
+      pd = &sp;
+    }
+  }
+  if (pd != nullptr) {
+    EXPECT_EQ(pd->status, LocationStatus::kLocated);
+    EXPECT_LT(pd->precision(), 1e-8);
+  }
+  return pd;
+}
+
+// The period-doubled family from `pd`, `points` points of it, in the run's free parameter.
+struct DoubledRun {
+  std::unique_ptr<HybridModel> model;  // the exploration refers to it
+  std::unique_ptr<app::ModelExploration> exploration;
+  BifurcationDiagram diagram;
+};
+DoubledRun ExplorePeriodDoubled(const HybridModel& model, const ParameterRun& run, const SpecialPoint& pd,
+                                int points) {
+  DoubledRun out;
+  out.model = std::make_unique<HybridModel>(RepeatedModel(model, 2));
+  const app::Scenario scenario = app::DefaultScenario(*out.model);
+  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+  options.threads = 1;
+  options.continuation.max_points = points;
+  out.exploration = std::make_unique<app::ModelExploration>(*out.model, scenario, IntegratorOptions{}, options,
+                                                            app::Formulation::kTimeBased, run.setup.free);
+  out.diagram = out.exploration->RunPeriodDoubled(run.exploration->shooting().layout(), pd.u);
+  return out;
+}
+
 // ---- the walker by hand: state (theta, phi, theta', phi') right after a heel strike, phi = 2 theta.
 constexpr double kGamma = 0.009;
 using State = std::array<double, 4>;
+
+// Integrates x from t = 0 (odeint's dopri5 with dense output, tolerances 1e-13) to the first zero of the
+// guard e crossed downward where `ahead` holds, located by bisection on the dense output to 1e-15 in time.
+// False if there is none before t_max.
+template <class Rhs, class Guard, class Ahead>
+bool IntegrateToEvent(const State& x, Rhs rhs, Guard e, Ahead ahead, double t_max, State* at, double* t) {
+  auto stepper = odeint::make_dense_output(1e-13, 1e-13, odeint::runge_kutta_dopri5<State>());
+  stepper.initialize(x, 0.0, 1e-3);
+  for (int steps = 0; steps < 100000 && stepper.current_time() < t_max; ++steps) {
+    stepper.do_step(rhs);
+    const State& a = stepper.previous_state();
+    const State& b = stepper.current_state();
+    if (ahead(b) && e(a) > 0 && e(b) <= 0) {
+      double lo = stepper.previous_time(), hi = stepper.current_time();
+      for (int it = 0; it < 200 && hi - lo > 1e-15; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        stepper.calc_state(mid, *at);
+        (e(*at) > 0 ? lo : hi) = mid;
+      }
+      stepper.calc_state(hi, *at);
+      *t = hi;
+      return true;
+    }
+  }
+  return false;
+}
 
 void WalkerRhs(const State& x, State& dx, double) {
   const double a = std::sin(x[0] - kGamma);
@@ -78,27 +143,12 @@ void WalkerRhs(const State& x, State& dx, double) {
 // The stride map on (theta, theta') after heel strike: integrate to the next heel strike (2 theta - phi
 // crossing zero downward with theta < 0), located by bisection on the dense output, then the heel strike.
 Eigen::Vector2d Stride(const Eigen::Vector2d& z, double* period) {
-  State x = {z(0), 2 * z(0), z(1), (1 - std::cos(2 * z(0))) * z(1)};
-  auto stepper = odeint::make_dense_output(1e-13, 1e-13, odeint::runge_kutta_dopri5<State>());
-  stepper.initialize(x, 0.0, 1e-3);
-  const auto e = [](const State& s) { return 2 * s[0] - s[1]; };
-  for (int steps = 0; steps < 100000; ++steps) {
-    stepper.do_step(WalkerRhs);
-    const State& a = stepper.previous_state();
-    const State& b = stepper.current_state();
-    if (b[0] < 0 && e(a) > 0 && e(b) <= 0) {
-      double lo = stepper.previous_time(), hi = stepper.current_time();
-      State s;
-      for (int it = 0; it < 200 && hi - lo > 1e-15; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        stepper.calc_state(mid, s);
-        (e(s) > 0 ? lo : hi) = mid;
-      }
-      stepper.calc_state(hi, s);
-      *period = hi;
-      const double c = std::cos(2 * s[0]);
-      return {-s[0], c * s[2]};
-    }
+  const State x = {z(0), 2 * z(0), z(1), (1 - std::cos(2 * z(0))) * z(1)};
+  State s;
+  if (IntegrateToEvent(x, WalkerRhs, [](const State& y) { return 2 * y[0] - y[1]; },
+                       [](const State& y) { return y[0] < 0; }, 1e3, &s, period)) {
+    const double c = std::cos(2 * s[0]);
+    return {-s[0], c * s[2]};
   }
   *period = NAN;
   return {NAN, NAN};
@@ -178,29 +228,17 @@ TEST(SimplestWalker, LongPeriodGaitLosesStabilityByPeriodDoublingAtThePublishedS
   }
   EXPECT_EQ(long_period, 2);
   EXPECT_EQ(short_period, 2);
-  const SpecialPoint* pd = nullptr;
-  for (const SpecialPoint& sp : run.diagram.special_points) {
-    if (sp.type == SpecialPointType::kPeriodDoubling) {
-      EXPECT_EQ(pd, nullptr) << "a second PD point: " << sp.BriefReport();
-      pd = &sp;
-    }
-  }
+  const SpecialPoint* pd = OnlyPeriodDoubling(run.diagram);
   ASSERT_NE(pd, nullptr) << run.diagram.FullReport();
-  EXPECT_EQ(pd->status, LocationStatus::kLocated);
-  EXPECT_LT(pd->precision(), 1e-8);
   // "stable when 0 < gamma < 0.015 rad": the bound, to the digits published.
   EXPECT_NEAR(pd->u(p), 0.0151, 5e-5) << pd->BriefReport();
   const FloquetResult at_pd = ComputeFloquet(run.exploration->shooting(), pd->u);
   ASSERT_TRUE(at_pd.ok());
   EXPECT_NEAR(at_pd.nontrivial.front().real(), -1.0, 1e-6);
   // The period-doubled gait: starts at twice the period, is stable at first (the paper's period-two gait).
-  const HybridModel doubled = RepeatedModel(model, 2);
-  const app::Scenario scenario = app::DefaultScenario(doubled);
-  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
-  options.threads = 1;
-  options.continuation.max_points = 20;
-  app::ModelExploration ex2(doubled, scenario, IntegratorOptions{}, options, app::Formulation::kTimeBased, run.setup.free);
-  const BifurcationDiagram d2 = ex2.RunPeriodDoubled(layout, pd->u);
+  DoubledRun doubled = ExplorePeriodDoubled(model, run, *pd, 20);
+  const BifurcationDiagram& d2 = doubled.diagram;
+  app::ModelExploration& ex2 = *doubled.exploration;
   ASSERT_EQ(d2.status, ExplorationStatus::kCompleted) << d2.message;
   ASSERT_FALSE(d2.branches.empty());
   const ShootingLayout& layout2 = ex2.shooting().layout();
@@ -341,6 +379,215 @@ TEST(ForcedImpactOscillator, LagrangianFormWithRestitutionIsTheExplicitModel) {
   const HybridModel mechanical = BuildExpressionModel(ParseModelText(lagrangian, "oscillator-lagrangian.toml"));
   const FreeParameters free{{"w"}, {}};
   ExpectSameMap(explicit_model, mechanical, free, 0.5, 0.9, 0.1);
+}
+
+
+// ---- The compass gait by hand (Goswami et al. 1998; angles from the slope normal, positive forward; legs
+// of mass m with their centre at a from the foot and inertia I about it, hip mass mH). Equations derived
+// on paper: M(q) q̈ = h with
+//     M = [[m a² + (mH + m) l² + I, m l b cos(θs + θw)], [m l b cos(θs + θw), m b² + I]],
+//     h = (m l b sin(θs + θw) θ̇w² + g (m a + (mH + m) l) sin(θs + γ),
+//          m l b sin(θs + θw) θ̇s² − g m b sin(θw − γ)).
+struct CompassGait {
+  double gamma = 0.03, m = 5, mH = 10, a = 0.5, b = 0.5, I = 5.0 / 12.0, g = 9.81;
+  double l() const { return a + b; }
+
+  void Rhs(const State& x, State& dx) const {
+    const double S = std::sin(x[0] + x[1]), C = std::cos(x[0] + x[1]);
+    Eigen::Matrix2d M;
+    M << m * a * a + (mH + m) * l() * l() + I, m * l() * b * C, m * l() * b * C, m * b * b + I;
+    const Eigen::Vector2d h(m * l() * b * S * x[3] * x[3] + g * (m * a + (mH + m) * l()) * std::sin(x[0] + gamma),
+                            m * l() * b * S * x[2] * x[2] - g * m * b * std::sin(x[1] - gamma));
+    const Eigen::Vector2d acc = M.ldlt().solve(h);
+    dx = {x[2], x[3], acc(0), acc(1)};
+  }
+
+  // Angular momentum (about `at`) of the bodies listed (0 stance leg, 1 hip, 2 swing leg) at state x with the
+  // stance foot at `foot`: Σ m (r − at) × v + I ω, ω = −θ̇s for the stance leg, +θ̇w for the swing leg.
+  double AngularMomentum(const State& x, const Eigen::Vector2d& foot, const Eigen::Vector2d& at,
+                         std::initializer_list<int> bodies) const {
+    const Eigen::Vector2d es(std::sin(x[0]), std::cos(x[0])), ds(std::cos(x[0]), -std::sin(x[0]));
+    const Eigen::Vector2d ew(std::sin(x[1]), -std::cos(x[1])), dw(std::cos(x[1]), std::sin(x[1]));
+    const Eigen::Vector2d hip = foot + l() * es, v_hip = l() * x[2] * ds;
+    const auto cross = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q) { return p(0) * q(1) - p(1) * q(0); };
+    double L = 0;
+    for (int k : bodies) {
+      if (k == 0) L += m * cross(foot + a * es - at, a * x[2] * ds) - I * x[2];
+      if (k == 1) L += mH * cross(hip - at, v_hip);
+      if (k == 2) L += m * cross(hip + b * ew - at, v_hip + b * x[3] * dw) + I * x[3];
+    }
+    return L;
+  }
+
+  // The plastic heel strike: the whole walker's angular momentum about the new foot and the trailing leg's
+  // about the hip are kept; the legs exchange their roles (θs' = −θw, θw' = −θs). Solved for the two new
+  // rates from the linear balance, column by column.
+  State HeelStrike(const State& x) const {
+    const Eigen::Vector2d foot(0, 0);
+    const Eigen::Vector2d hip = l() * Eigen::Vector2d(std::sin(x[0]), std::cos(x[0]));
+    const Eigen::Vector2d new_foot = hip + l() * Eigen::Vector2d(std::sin(x[1]), -std::cos(x[1]));
+    const Eigen::Vector2d before(AngularMomentum(x, foot, new_foot, {0, 1, 2}), AngularMomentum(x, foot, hip, {0}));
+    const auto after = [&](double ws, double ww) {
+      const State y = {-x[1], -x[0], ws, ww};
+      return Eigen::Vector2d(AngularMomentum(y, new_foot, new_foot, {0, 1, 2}),
+                             AngularMomentum(y, new_foot, hip, {2}));
+    };
+    Eigen::Matrix2d A;
+    A << after(1, 0), after(0, 1);
+    const Eigen::Vector2d w = A.lu().solve(before);
+    return {-x[1], -x[0], w(0), w(1)};
+  }
+
+  // The stride map on z = (α, θ̇s, θ̇w) right after a heel strike (θs = θw = −α): to the next heel strike
+  // (θw − θs crossing zero downward with θs > 0, located by bisection on the dense output), then the strike.
+  Eigen::Vector3d Stride(const Eigen::Vector3d& z, double* period) const {
+    State x = {-z(0), -z(0), z(1), z(2)};
+    State s;
+    if (IntegrateToEvent(x, [this](const State& y, State& dy, double) { Rhs(y, dy); },
+                         [](const State& y) { return y[1] - y[0]; }, [](const State& y) { return y[0] > 0; }, 10, &s,
+                         period)) {
+      const State y = HeelStrike(s);
+      return {-y[0], y[2], y[3]};
+    }
+    *period = NAN;
+    return Eigen::Vector3d::Constant(NAN);
+  }
+
+  Eigen::Matrix3d StrideJacobian(const Eigen::Vector3d& z, double h) const {
+    Eigen::Matrix3d J;
+    double t;
+    for (int j = 0; j < 3; ++j) {
+      Eigen::Vector3d zp = z, zm = z;
+      zp(j) += h;
+      zm(j) -= h;
+      J.col(j) = (Stride(zp, &t) - Stride(zm, &t)) / (2 * h);
+    }
+    return J;
+  }
+
+  // Newton on z -> Stride(z) − z with a finite-difference Jacobian.
+  Eigen::Vector3d FixedPoint(Eigen::Vector3d z) const {
+    double t;
+    for (int it = 0; it < 30; ++it) {
+      const Eigen::Vector3d r = Stride(z, &t) - z;
+      if (r.norm() < 1e-13) break;
+      z -= (StrideJacobian(z, 1e-7) - Eigen::Matrix3d::Identity()).lu().solve(r);
+    }
+    return z;
+  }
+};
+
+// The state of the compass gait's step right after a heel strike, from the tool's unknowns.
+Eigen::Vector3d AfterHeelStrike(const ShootingLayout& layout, const Vector& u, int segment) {
+  const int x = layout.state_offset(segment);
+  return {-u(x), u(x + 2), u(x + 3)};
+}
+
+// The derived heel strike (extended coordinates, e = 0 on the new foot's two constraints, relabelling) is
+// the angular-momentum law, at random pre-impact states on the guard, to rounding.
+TEST(CompassGait, DerivedHeelStrikeIsTheAngularMomentumLaw) {
+  const HybridModel model = Load("compass-gait");
+  const CompassGait hand;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> angle(0.05, 0.5), rate(-2.0, 2.0);
+  double worst = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const double alpha = angle(rng);
+    const State x = {alpha, alpha, rate(rng), rate(rng)};
+    Vector xt = Eigen::Map<const Vector>(x.data(), 4), next;
+    model.phase(0).Reset(xt, &next, nullptr);
+    const State y = hand.HeelStrike(x);
+    for (int k = 0; k < 4; ++k) worst = std::max(worst, std::abs(next(k) - y[k]) / (1 + std::abs(y[k])));
+  }
+  EXPECT_LT(worst, 1e-13);
+  std::printf("compass gait: derived heel strike vs angular-momentum law, worst relative difference %.1e\n", worst);
+}
+
+TEST(CompassGait, GaitsMultipliersAndPeriodDoublingAgreeWithAnIndependentRootSolve) {
+  const HybridModel model = Load("compass-gait");
+  const ParameterRun run = Explore(model);
+  ASSERT_EQ(run.diagram.status, ExplorationStatus::kCompleted) << run.diagram.message;
+  const ShootingLayout& layout = run.exploration->shooting().layout();
+  const int p = layout.parameter_index(0);
+  CompassGait hand;
+  // Both gaits at gamma = 0.03: the first point of each start's branch.
+  int checked = 0;
+  for (const Branch& b : run.diagram.branches) {
+    if (b.points.empty() || b.direction != 1) continue;
+    const Vector& u = b.points.front().u;
+    ASSERT_NEAR(u(p), 0.03, 1e-14);
+    const Eigen::Vector3d tool = AfterHeelStrike(layout, u, 1);
+    const Eigen::Vector3d z = hand.FixedPoint(tool + Eigen::Vector3d(1e-3, -2e-3, 2e-3));
+    double T;
+    hand.Stride(z, &T);
+    EXPECT_LT((tool - z).lpNorm<Eigen::Infinity>(), 1e-9) << tool.transpose() << " vs " << z.transpose();
+    EXPECT_NEAR(layout.Period(u), T, 1e-9);
+    // Multipliers: the stride map's three are the tool's (its fourth, of the section map in the full
+    // state, is 0: the heel strike puts θs = θw).
+    const Eigen::Vector3cd mu = hand.StrideJacobian(z, 1e-6).eigenvalues();
+    const FloquetResult f = ComputeFloquet(run.exploration->shooting(), u);
+    ASSERT_TRUE(f.ok()) << f.message;
+    int matched = 0;
+    for (const std::complex<double>& m : f.nontrivial) {
+      if (std::abs(m) < 1e-9) continue;
+      double d = 1e300;
+      for (int i = 0; i < 3; ++i) d = std::min(d, std::abs(m - mu(i)));
+      EXPECT_LT(d, 1e-6 * (1 + std::abs(m))) << m << " vs " << mu.transpose();
+      ++matched;
+    }
+    EXPECT_EQ(matched, 3);
+    std::printf("compass gait at gamma = 0.03: alpha = %.12f, period %.12f (tool - root solve %.1e, %.1e), "
+                "multipliers |mu| max %.9f (root solve %.9f)\n",
+                z(0), T, (tool - z).lpNorm<Eigen::Infinity>(), layout.Period(u) - T, f.max_modulus,
+                mu.cwiseAbs().maxCoeff());
+    ++checked;
+  }
+  EXPECT_EQ(checked, 2);
+
+  // The first period doubling, on the long-step gait: the root solve's stride map has the multiplier −1
+  // there; its slope, found from the root solve alone by the secant method on that multiplier, agrees.
+  const SpecialPoint* pd = OnlyPeriodDoubling(run.diagram);
+  ASSERT_NE(pd, nullptr) << run.diagram.FullReport();
+  const auto most_negative = [&](double gamma, Eigen::Vector3d* z) {
+    hand.gamma = gamma;
+    *z = hand.FixedPoint(*z);
+    const Eigen::Vector3cd mu = hand.StrideJacobian(*z, 1e-6).eigenvalues();
+    double v = 1e300;
+    for (int i = 0; i < 3; ++i) {
+      if (std::abs(mu(i).imag()) < 1e-9) v = std::min(v, mu(i).real());
+    }
+    return v;
+  };
+  Eigen::Vector3d z = AfterHeelStrike(layout, pd->u, 1);
+  double g0 = 0.038, g1 = 0.040;
+  double f0 = most_negative(g0, &z) + 1, f1 = most_negative(g1, &z) + 1;
+  for (int it = 0; it < 8 && std::abs(g1 - g0) > 1e-12; ++it) {
+    const double g2 = g1 - f1 * (g1 - g0) / (f1 - f0);
+    g0 = g1, f0 = f1;
+    g1 = g2, f1 = most_negative(g1, &z) + 1;
+  }
+  EXPECT_NEAR(pd->u(p), g1, 1e-7);
+  std::printf("compass gait: first PD at gamma = %.12f (precision %.1e); root solve's multiplier -1 at %.12f\n",
+              pd->u(p), pd->precision(), g1);
+
+  // The period-doubled gait beyond it: two different steps, each the root solve's stride of the other.
+  DoubledRun doubled = ExplorePeriodDoubled(model, run, *pd, 8);
+  const BifurcationDiagram& d2 = doubled.diagram;
+  app::ModelExploration& ex2 = *doubled.exploration;
+  ASSERT_EQ(d2.status, ExplorationStatus::kCompleted) << d2.message;
+  ASSERT_FALSE(d2.branches.empty());
+  const ShootingLayout& layout2 = ex2.shooting().layout();
+  const Vector& u2 = d2.branches.front().points.back().u;
+  hand.gamma = u2(layout2.parameter_index(0));
+  EXPECT_GT(std::abs(hand.gamma - pd->u(p)), 1e-3);
+  const Eigen::Vector3d z1 = AfterHeelStrike(layout2, u2, 1), z2 = AfterHeelStrike(layout2, u2, 3);
+  EXPECT_GT((z1 - z2).norm(), 1e-3);
+  double T1, T2;
+  EXPECT_LT((hand.Stride(z1, &T1) - z2).lpNorm<Eigen::Infinity>(), 1e-9);
+  EXPECT_LT((hand.Stride(z2, &T2) - z1).lpNorm<Eigen::Infinity>(), 1e-9);
+  EXPECT_NEAR(layout2.Period(u2), T1 + T2, 1e-9);
+  std::printf("compass gait: period-doubled gait at gamma = %.6f, steps alpha = %.9f and %.9f, period %.12f "
+              "(root solve %.12f)\n", hand.gamma, z1(0), z2(0), layout2.Period(u2), T1 + T2);
 }
 
 }  // namespace

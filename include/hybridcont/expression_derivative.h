@@ -14,6 +14,7 @@
 #ifndef HYBRIDCONT_EXPRESSION_DERIVATIVE_H_
 #define HYBRIDCONT_EXPRESSION_DERIVATIVE_H_
 
+#include <functional>
 #include <vector>
 
 #include "hybridcont/expression.h"
@@ -40,6 +41,10 @@ bool DependsOnInput(const ExprPtr& e, int index);
 // ∂e/∂x_input, simplified. Throws ModelInputError at `where` where e uses an operation without a
 // derivative (comparisons, logic, min, max).
 ExprPtr Differentiate(const ExprPtr& e, int input, const SourceLocation& where);
+
+// e with each input k replaced by replace(k) where that is non-null (the tree rebuilt with the simplifying
+// constructors, so that a factor that becomes 0 drops out; shared nodes stay shared).
+ExprPtr SubstituteInputs(const ExprPtr& e, const std::function<ExprPtr(int input)>& replace);
 
 // x = A⁻¹ b for a symmetric positive definite A (n × n, rows of expressions; only the lower triangle is
 // read) by the Cholesky factorization A = L Lᵀ written out as expressions: O(n³) nodes, shared by the

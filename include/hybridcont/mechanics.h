@@ -16,6 +16,18 @@
 // M⁻¹Gᵀ,
 //         q⁺ = q,   q̇⁺ = q̇ − (1 + e) M⁻¹Gᵀ (G q̇) / (G M⁻¹ Gᵀ),
 // so that G q̇⁺ = −e G q̇ and, for e = 1, T(q, q̇⁺) = T(q, q̇).
+//
+// A contact of several constraints g(q) ∈ R^k (a point foot that neither slips nor rebounds: k = 2) takes
+// the impulse Gᵀλ with G = ∂g/∂q (k × n) and λ from the k × k system (G M⁻¹ Gᵀ) λ = (1 + e) G q̇:
+//         q̇⁺ = q̇ − M⁻¹Gᵀ λ,  G q̇⁺ = −e G q̇.
+// Walking models add pinned coordinates p (the stance foot's position): at rest while the phase lasts (the
+// equations of motion are those of T and V with p = 0, ṗ = 0, the constraint substituted into the
+// Lagrangian), but free in the impact, which acts in the extended coordinates (q, p) with the mass matrix
+// M_e = ∂²T/∂(q̇, ṗ)² and ṗ⁻ = 0. The plastic heel strike (e = 0 on the new foot's position, k = 2) then
+// conserves the angular momentum about the new contact point, which is how the literature states it
+// (Garcia et al. 1998, eq. 4; Goswami et al. 1998), and the new stance foot is at rest afterwards, while the
+// old one leaves the ground without an impulse. A relabelling q' = S(q) (the legs exchange their roles)
+// carries the velocities by its Jacobian, q̇' = (∂S/∂q) q̇⁺.
 #ifndef HYBRIDCONT_MECHANICS_H_
 #define HYBRIDCONT_MECHANICS_H_
 
@@ -44,6 +56,9 @@ struct MechanicalSystem {
   std::vector<std::vector<ExprPtr>> mass_matrix;
   // Q (Lagrangian) or h (mass-matrix form); n entries, null entries zero.
   std::vector<ExprPtr> forces;
+  // Pinned coordinates p and their velocities ṗ (Lagrangian form only): inputs numbered from the phase's
+  // state dimension on (they are not states), 0 while the phase lasts, free in an impact.
+  std::vector<int> pinned_coordinates, pinned_velocities;
   // Where each field came from, for messages: kinetic, potential, mass_matrix, forces.
   SourceLocation kinetic_where, potential_where, mass_matrix_where, forces_where;
 };
@@ -56,7 +71,11 @@ struct EquationsOfMotion {
   ExprPtr energy;
 };
 
-// Derives the equations. Throws ModelInputError (at the field concerned) for bad mechanics that shows in
+// The system while its pinned coordinates are at rest: p = 0 and ṗ = 0 substituted into T, V and Q, no
+// pinned coordinates left. The system itself when it has none.
+MechanicalSystem PinnedAtRest(const MechanicalSystem& system);
+
+// Derives the equations (of PinnedAtRest(system)). Throws ModelInputError (at the field concerned) for bad mechanics that shows in
 // the structure: T or M depending on a velocity, V depending on a velocity, a non-smooth operation, a mass
 // matrix of the wrong size. CheckMechanics finds what only shows in values.
 EquationsOfMotion DeriveEquationsOfMotion(const MechanicalSystem& system);
@@ -68,12 +87,19 @@ void CheckMechanics(const MechanicalSystem& system, const EquationsOfMotion& equ
                     const std::vector<Vector>& states, const std::vector<double>& p,
                     const std::vector<std::string>& state_names);
 
-// The post-impact velocities q̇⁺ (n) at the constraint g (an expression of q; throws ModelInputError at
-// `where` if g does not depend on q or depends on a velocity).
-// The restitution e is an expression of the parameters (a number, or a parameter to continue in).
+// The post-impact velocities q̇⁺ (n, the coordinates that are not pinned) at the contact g = 0, one
+// expression of q (and p) per constraint row; throws ModelInputError at `where` if a row does not depend on
+// the coordinates or depends on a velocity. The restitution e is an expression of the parameters (a
+// number, or a parameter to continue in).
 std::vector<ExprPtr> ImpactVelocities(const MechanicalSystem& system, const EquationsOfMotion& equations,
-                                      const ExprPtr& constraint, const ExprPtr& restitution,
+                                      const std::vector<ExprPtr>& constraints, const ExprPtr& restitution,
                                       const SourceLocation& where);
+
+// The velocities after the relabelling q' = S(q): relabel[i] is S_i (null: q'_i = q_i), an expression of
+// the coordinates; the result is q̇'_i = Σ_j ∂S_i/∂q_j · velocities[j]. Throws ModelInputError at `where`
+// if some S_i depends on a velocity.
+std::vector<ExprPtr> RelabelVelocities(const MechanicalSystem& system, const std::vector<ExprPtr>& relabel,
+                                       const std::vector<ExprPtr>& velocities, const SourceLocation& where);
 
 // Why M is not positive definite at a state, from its entries there (n × n, row-major): "" if it is.
 // Names the coordinates (names[i] for q_i) and the values: "the mass matrix is not positive definite at

@@ -166,6 +166,37 @@ ExprPtr Differentiate(const ExprPtr& e, int input, const SourceLocation& where) 
   return Differentiator(input, where).D(e);
 }
 
+ExprPtr SubstituteInputs(const ExprPtr& e, const std::function<ExprPtr(int input)>& replace) {
+  std::unordered_map<const ExprNode*, ExprPtr> memo;
+  const std::function<ExprPtr(const ExprPtr&)> visit = [&](const ExprPtr& n) -> ExprPtr {
+    if (auto it = memo.find(n.get()); it != memo.end()) return it->second;
+    ExprPtr out = n;
+    if (n->op == ExprOp::kInput) {
+      if (ExprPtr r = replace(n->index)) out = r;
+    } else if (!n->args.empty()) {
+      std::vector<ExprPtr> args;
+      bool changed = false;
+      for (const ExprPtr& a : n->args) {
+        args.push_back(visit(a));
+        changed = changed || args.back().get() != a.get();
+      }
+      if (changed) {
+        switch (n->op) {
+          case ExprOp::kNeg: out = Neg(args[0]); break;
+          case ExprOp::kAdd: out = Add(args[0], args[1]); break;
+          case ExprOp::kSub: out = Sub(args[0], args[1]); break;
+          case ExprOp::kMul: out = Mul(args[0], args[1]); break;
+          case ExprOp::kDiv: out = Div(args[0], args[1]); break;
+          default: out = MakeNode(n->op, std::move(args)); break;
+        }
+      }
+    }
+    memo[n.get()] = out;
+    return out;
+  };
+  return visit(e);
+}
+
 namespace {
 // An expression as a scalar of internal::CholeskySolveInto: its operations build simplified trees.
 struct Symbol {

@@ -1,5 +1,6 @@
 #include "hybridcont/mechanics.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -24,7 +25,31 @@ std::string FormatState(const std::vector<std::string>& names, const Vector& x) 
 
 }  // namespace
 
-EquationsOfMotion DeriveEquationsOfMotion(const MechanicalSystem& s) {
+MechanicalSystem PinnedAtRest(const MechanicalSystem& system) {
+  if (system.pinned_coordinates.empty()) return system;
+  if (!system.kinetic) {
+    throw ModelInputError(system.mass_matrix_where,
+                          "pinned coordinates need the Lagrangian form (kinetic): the impact's mass matrix in the "
+                          "extended coordinates is derived from T");
+  }
+  std::vector<int> pinned = system.pinned_coordinates;
+  pinned.insert(pinned.end(), system.pinned_velocities.begin(), system.pinned_velocities.end());
+  const auto at_rest = [&](int input) {
+    return std::find(pinned.begin(), pinned.end(), input) != pinned.end() ? MakeConstant(0.0) : nullptr;
+  };
+  MechanicalSystem s = system;
+  s.pinned_coordinates.clear();
+  s.pinned_velocities.clear();
+  s.kinetic = SubstituteInputs(system.kinetic, at_rest);
+  if (system.potential) s.potential = SubstituteInputs(system.potential, at_rest);
+  for (ExprPtr& f : s.forces) {
+    if (f) f = SubstituteInputs(f, at_rest);
+  }
+  return s;
+}
+
+EquationsOfMotion DeriveEquationsOfMotion(const MechanicalSystem& system) {
+  const MechanicalSystem s = PinnedAtRest(system);
   const int n = static_cast<int>(s.coordinates.size());
   if (static_cast<int>(s.velocities.size()) != n) {
     throw ModelInputError(s.kinetic_where, "as many velocities as coordinates are needed");
@@ -148,26 +173,101 @@ void CheckMechanics(const MechanicalSystem& s, const EquationsOfMotion& eq, int 
   }
 }
 
-std::vector<ExprPtr> ImpactVelocities(const MechanicalSystem& s, const EquationsOfMotion& eq, const ExprPtr& g,
-                                      const ExprPtr& restitution, const SourceLocation& where) {
+std::vector<ExprPtr> ImpactVelocities(const MechanicalSystem& s, const EquationsOfMotion& eq,
+                                      const std::vector<ExprPtr>& constraints, const ExprPtr& restitution,
+                                      const SourceLocation& where) {
   const int n = static_cast<int>(s.coordinates.size());
-  for (int v : s.velocities) {
-    if (DependsOnInput(g, v)) throw ModelInputError(where, "the contact constraint g(q) depends on a velocity");
+  const int k = static_cast<int>(constraints.size());
+  // The extended coordinates (q, p), their velocities (q̇, ṗ) with ṗ⁻ = 0, and M_e.
+  std::vector<int> coordinates = s.coordinates, velocities = s.velocities;
+  coordinates.insert(coordinates.end(), s.pinned_coordinates.begin(), s.pinned_coordinates.end());
+  velocities.insert(velocities.end(), s.pinned_velocities.begin(), s.pinned_velocities.end());
+  const int ne = static_cast<int>(coordinates.size());
+  const auto pinned_at_rest = [&](const ExprPtr& e) {
+    if (s.pinned_coordinates.empty()) return e;
+    return SubstituteInputs(e, [&](int input) -> ExprPtr {
+      for (int j = n; j < ne; ++j) {
+        if (input == coordinates[j] || input == velocities[j]) return MakeConstant(0.0);
+      }
+      return nullptr;
+    });
+  };
+  std::vector<std::vector<ExprPtr>> M = eq.mass_matrix;
+  if (ne > n) {
+    M.assign(ne, std::vector<ExprPtr>(ne));
+    for (int i = 0; i < ne; ++i) {
+      const ExprPtr p = Differentiate(s.kinetic, velocities[i], s.kinetic_where);
+      for (int j = 0; j <= i; ++j) {
+        const ExprPtr mij = Differentiate(p, velocities[j], s.kinetic_where);
+        for (int v : velocities) {
+          if (DependsOnInput(mij, v)) {
+            throw ModelInputError(s.kinetic_where, "the kinetic energy is not quadratic in the velocities of the "
+                                                   "coordinates and the pinned coordinates");
+          }
+        }
+        M[i][j] = M[j][i] = pinned_at_rest(mij);
+      }
+    }
   }
-  std::vector<ExprPtr> G(n), dq(n);
-  bool depends = false;
-  for (int i = 0; i < n; ++i) {
-    G[i] = Differentiate(g, s.coordinates[i], where);
-    dq[i] = MakeInput(s.velocities[i]);
-    depends = depends || !IsZero(G[i]);
+  std::vector<ExprPtr> dq(ne);
+  for (int i = 0; i < ne; ++i) dq[i] = i < n ? MakeInput(velocities[i]) : MakeConstant(0.0);
+  // G (k × ne) and W = M_e⁻¹ Gᵀ (its columns).
+  std::vector<std::vector<ExprPtr>> G(k), W(k);
+  for (int r = 0; r < k; ++r) {
+    for (int v : velocities) {
+      if (DependsOnInput(constraints[r], v)) {
+        throw ModelInputError(where, "the contact constraint g(q) depends on a velocity");
+      }
+    }
+    bool depends = false;
+    for (int i = 0; i < ne; ++i) {
+      G[r].push_back(pinned_at_rest(Differentiate(constraints[r], coordinates[i], where)));
+      depends = depends || !IsZero(G[r][i]);
+    }
+    if (!depends) {
+      throw ModelInputError(where, "the contact constraint g(q)" + (k > 1 ? " (row " + std::to_string(r + 1) + ")" : std::string()) +
+                                       " does not depend on the coordinates");
+    }
+    W[r] = CholeskySolve(M, G[r]);
   }
-  if (!depends) throw ModelInputError(where, "the contact constraint g(q) does not depend on the coordinates");
-  const std::vector<ExprPtr> w = CholeskySolve(eq.mass_matrix, G);  // M⁻¹ Gᵀ
-  // The impulse factor (1 + e) (G q̇) / (G M⁻¹ Gᵀ).
-  const ExprPtr factor = Div(Mul(Add(MakeConstant(1.0), restitution), Dot(G, dq)), Dot(G, w));
+  const ExprPtr one_plus_e = Add(MakeConstant(1.0), restitution);
   std::vector<ExprPtr> after(n);
-  for (int i = 0; i < n; ++i) after[i] = Sub(dq[i], Mul(w[i], factor));
+  if (k == 1) {
+    // The impulse factor (1 + e) (G q̇) / (G M⁻¹ Gᵀ).
+    const ExprPtr factor = Div(Mul(one_plus_e, Dot(G[0], dq)), Dot(G[0], W[0]));
+    for (int i = 0; i < n; ++i) after[i] = Sub(dq[i], Mul(W[0][i], factor));
+    return after;
+  }
+  // λ = (G M⁻¹ Gᵀ)⁻¹ (1 + e) G q̇, symmetric positive definite where the rows are independent.
+  std::vector<std::vector<ExprPtr>> A(k, std::vector<ExprPtr>(k));
+  std::vector<ExprPtr> b(k);
+  for (int r = 0; r < k; ++r) {
+    for (int c = 0; c < k; ++c) A[r][c] = Dot(G[r], W[c]);
+    b[r] = Mul(one_plus_e, Dot(G[r], dq));
+  }
+  const std::vector<ExprPtr> lambda = CholeskySolve(A, b);
+  for (int i = 0; i < n; ++i) {
+    ExprPtr impulse = MakeConstant(0.0);
+    for (int r = 0; r < k; ++r) impulse = Add(impulse, Mul(W[r][i], lambda[r]));
+    after[i] = Sub(dq[i], impulse);
+  }
   return after;
+}
+
+std::vector<ExprPtr> RelabelVelocities(const MechanicalSystem& s, const std::vector<ExprPtr>& relabel,
+                                       const std::vector<ExprPtr>& velocities, const SourceLocation& where) {
+  const int n = static_cast<int>(s.coordinates.size());
+  std::vector<ExprPtr> out = velocities;
+  for (int i = 0; i < n; ++i) {
+    if (!relabel[i]) continue;
+    for (int v : s.velocities) {
+      if (DependsOnInput(relabel[i], v)) throw ModelInputError(where, "the relabelling depends on a velocity");
+    }
+    ExprPtr sum = MakeConstant(0.0);
+    for (int j = 0; j < n; ++j) sum = Add(sum, Mul(Differentiate(relabel[i], s.coordinates[j], where), velocities[j]));
+    out[i] = sum;
+  }
+  return out;
 }
 
 std::string ExplainMassMatrix(const std::vector<double>& entries, const std::vector<std::string>& names,

@@ -190,7 +190,20 @@ ExprPtr Reader::PhaseSymbol(int phase, const std::string& name) {
   if (auto it = std::find(states.begin(), states.end(), name); it != states.end()) {
     return MakeInput(static_cast<int>(it - states.begin()));
   }
-  const std::string key = std::to_string(phase) + ":" + name;
+  if (phase < static_cast<int>(mechanical_names_.size())) {
+    // Pinned coordinates, then their velocities, numbered after the states; elsewhere they are unknown.
+    const MechanicalNames& mech = mechanical_names_[phase];
+    const int dim = static_cast<int>(states.size()), np = static_cast<int>(mech.pinned.size());
+    for (int k = 0; k < np; ++k) {
+      for (int which = 0; which < 2; ++which) {
+        if (name == (which == 0 ? mech.pinned : mech.pinned_velocities)[k]) {
+          return pinned_symbols_phase_ == phase ? MakeInput(dim + which * np + k) : nullptr;
+        }
+      }
+    }
+  }
+  // A quantity read with the pinned coordinates as symbols is cached apart: elsewhere it is unknown.
+  const std::string key = std::to_string(phase) + (pinned_symbols_phase_ == phase ? "+pinned:" : ":") + name;
   if (auto it = lets_.find(key); it != lets_.end()) return it->second;
   if (const toml::table* let = phase_lets_[phase]) {
     if (const toml::node* n = let->get(name)) {

@@ -113,6 +113,9 @@ class Reader {
   struct MechanicalNames {
     std::vector<std::string> coordinates, velocities;  // empty: the phase is given by its ode
     std::set<std::string> ignorable;                   // coordinates that are not states (cyclic)
+    // Pinned coordinates (at rest in the phase, free in its impact) and their velocities ("d" + name):
+    // symbols of kinetic, potential, forces and the impact's constraint only.
+    std::vector<std::string> pinned, pinned_velocities;
   };
   // coordinates and velocities (default: "d" + coordinate), checked as names.
   MechanicalNames ReadMechanicalNames(const toml::table& t, const std::string& pf) const;
@@ -153,6 +156,8 @@ class Reader {
   std::vector<const toml::table*> phase_lets_;
   int num_integrals_ = 1;
   std::vector<MechanicalNames> mechanical_names_;
+  // The phase whose pinned coordinates are symbols (while its energies and contact are read), or -1.
+  int pinned_symbols_phase_ = -1;
   // `conservative = false`: no phase has a first integral; families are continued in run.parameter.
   bool conservative_ = true;
 };

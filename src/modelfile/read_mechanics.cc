@@ -13,7 +13,7 @@ Reader::MechanicalNames Reader::ReadMechanicalNames(const toml::table& t, const 
   MechanicalNames names;
   const toml::node* coordinates = t.get("coordinates");
   if (coordinates == nullptr) {
-    for (const char* key : {"velocities", "ignorable", "kinetic", "potential", "mass_matrix", "forces", "impact"}) {
+    for (const char* key : {"velocities", "ignorable", "pinned", "kinetic", "potential", "mass_matrix", "forces", "impact"}) {
       if (const toml::node* n = t.get(key)) {
         Fail(n, pf + "." + key, std::string("'") + key + "' needs 'coordinates' (a phase given by its mechanics)");
       }
@@ -40,6 +40,14 @@ Reader::MechanicalNames Reader::ReadMechanicalNames(const toml::table& t, const 
       names.ignorable.insert(q);
     }
   }
+  if (const toml::node* pinned = t.get("pinned")) {
+    names.pinned = StringArray(*pinned, pf + ".pinned");
+    if (!t.get("kinetic")) {
+      Fail(pinned, pf + ".pinned", "pinned coordinates need 'kinetic' (the impact's mass matrix in the extended "
+                                   "coordinates is derived from T)");
+    }
+    for (const std::string& q : names.pinned) names.pinned_velocities.push_back("d" + q);
+  }
   if (!t.get("kinetic") && !t.get("mass_matrix")) {
     Fail(&t, pf + ".kinetic", "a phase with coordinates needs 'kinetic' (T, a Lagrangian) or 'mass_matrix' (M)");
   }
@@ -47,12 +55,20 @@ Reader::MechanicalNames Reader::ReadMechanicalNames(const toml::table& t, const 
     Fail(t.get("mass_matrix"), pf + ".mass_matrix", "give 'kinetic' (T, M derived from it) or 'mass_matrix', not both");
   }
   std::set<std::string> seen;
-  for (const std::vector<std::string>* list : {&names.coordinates, &names.velocities}) {
+  for (const std::vector<std::string>* list :
+       {&names.coordinates, &names.velocities, &names.pinned, &names.pinned_velocities}) {
     for (const std::string& s : *list) {
-      const std::string field = pf + (list == &names.coordinates ? ".coordinates" : ".velocities");
-      const toml::node* at = list == &names.coordinates || !t.get("velocities") ? coordinates : t.get("velocities");
+      const bool pinned = list == &names.pinned || list == &names.pinned_velocities;
+      const std::string field = pf + (pinned                          ? ".pinned"
+                                      : list == &names.coordinates ? ".coordinates"
+                                                                   : ".velocities");
+      const toml::node* at = pinned ? t.get("pinned")
+                             : list == &names.coordinates || !t.get("velocities") ? coordinates
+                                                                                  : t.get("velocities");
       CheckName(at, field, s);
-      if (!seen.insert(s).second) Fail(at, field, "'" + s + "' is both a coordinate and a velocity, or listed twice");
+      if (!seen.insert(s).second) {
+        Fail(at, field, "'" + s + "' is listed twice (as a coordinate, velocity or pinned coordinate or its velocity)");
+      }
     }
   }
   return names;
@@ -85,6 +101,14 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
     system.coordinates.push_back(index(names.coordinates[k]));
     system.velocities.push_back(index(names.velocities[k]));
   }
+  // The pinned coordinates and their velocities are inputs after the states (PhaseSymbol), known to the
+  // energies, forces and contact only.
+  const int np = static_cast<int>(names.pinned.size());
+  for (int k = 0; k < np; ++k) {
+    system.pinned_coordinates.push_back(dim + k);
+    system.pinned_velocities.push_back(dim + np + k);
+  }
+  if (np > 0) pinned_symbols_phase_ = i;  // until the contact is read (a failure ends the reading)
   if (const toml::node* kinetic = t.get("kinetic")) {
     system.kinetic = ParsePhaseExpression(i, *kinetic, pf + ".kinetic");
     system.kinetic_where = At(kinetic, pf + ".kinetic");
@@ -127,6 +151,29 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
       system.forces[it - names.coordinates.begin()] = ParsePhaseExpression(i, node, pf + ".forces." + name);
     }
   }
+  const toml::table* impact = OptionalTable(t, "impact", pf);
+  const std::string field = pf + ".impact";
+  std::vector<ExprPtr> constraints;
+  if (impact) {
+    CheckKeys(*impact, field, {"constraint", "restitution", "relabel"});
+    const toml::node* g = impact->get("constraint");
+    if (g == nullptr) {
+      Fail(impact, field + ".constraint", "missing field 'constraint' (the contact's g(q); impact at g = 0)");
+    }
+    out.constraint_where = At(g, field + ".constraint");
+    if (g->is_array()) {  // a contact of several constraints: a point that neither slips nor rebounds
+      const toml::array& rows = *g->as_array();
+      if (rows.empty()) Fail(g, field + ".constraint", "an empty list of constraints");
+      for (std::size_t r = 0; r < rows.size(); ++r) {
+        constraints.push_back(
+            ParsePhaseExpression(i, *rows.get(r), field + ".constraint[" + std::to_string(r) + "]"));
+      }
+    } else {
+      constraints.push_back(ParsePhaseExpression(i, *g, field + ".constraint"));
+      out.constraint = constraints[0];
+    }
+  }
+  pinned_symbols_phase_ = -1;
   const EquationsOfMotion eq = DeriveEquationsOfMotion(system);
 
   // Values only: T quadratic in q̇, M symmetric; at the typical state and two others around it.
@@ -139,7 +186,7 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
     for (int v : system.velocities) x(v) *= k == 2 ? -1.7 : 1.0;
     states.push_back(x);
   }
-  CheckMechanics(system, eq, dim, states, values, p.state_names);
+  CheckMechanics(PinnedAtRest(system), eq, dim, states, values, p.state_names);
 
   out.vector_field.assign(dim, nullptr);
   for (int k = 0; k < n; ++k) {
@@ -154,13 +201,7 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
   p.mass_matrix = ExpressionProgram(entries, dim, false, {});
   p.coordinates = system.coordinates;
 
-  if (const toml::table* impact = OptionalTable(t, "impact", pf)) {
-    const std::string field = pf + ".impact";
-    CheckKeys(*impact, field, {"constraint", "restitution"});
-    const toml::node* g = impact->get("constraint");
-    if (g == nullptr) Fail(impact, field + ".constraint", "missing field 'constraint' (the contact's g(q); impact at g = 0)");
-    out.constraint = ParsePhaseExpression(i, *g, field + ".constraint");
-    out.constraint_where = At(g, field + ".constraint");
+  if (impact) {
     // e: a number in [0, 1] or an expression of the parameters (a parameter to continue in).
     ExprPtr e = MakeConstant(1.0);
     if (const toml::node* r = impact->get("restitution")) {
@@ -176,13 +217,31 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
                     "energy, is possible in a conservative model (declare conservative = false for a dissipative one)");
       }
     }
-    const std::vector<ExprPtr> after = ImpactVelocities(system, eq, out.constraint, e, out.constraint_where);
+    std::vector<ExprPtr> after = ImpactVelocities(system, eq, constraints, e, out.constraint_where);
+    // The relabelling q' = S(q): keyed by coordinate, an expression of the coordinates.
+    std::vector<ExprPtr> relabel(n);
+    if (const toml::table* rl = OptionalTable(*impact, "relabel", field)) {
+      for (auto&& [key, node] : *rl) {
+        const std::string name(key.str());
+        const std::string rf = field + ".relabel." + name;
+        const auto it = std::find(names.coordinates.begin(), names.coordinates.end(), name);
+        if (it == names.coordinates.end() || names.ignorable.count(name)) {
+          Fail(&node, rf, "'" + name + "' is not a coordinate of phase '" + p.name + "' that is a state (the " +
+                              "relabelling gives coordinates after the impact: " + JoinNames(names.coordinates) + ")");
+        }
+        relabel[it - names.coordinates.begin()] = ParsePhaseExpression(i, node, rf);
+      }
+      after = RelabelVelocities(system, relabel, after, At(rl, field + ".relabel"));
+    }
     // Into the next phase: a state named like one of this phase's takes its value after the impact.
     const ExpressionPhaseSpec& next = spec_.phases[(i + 1) % spec_.phases.size()];
     for (const std::string& s : next.state_names) {
       const auto v = std::find(names.velocities.begin(), names.velocities.end(), s);
+      const auto q = std::find(names.coordinates.begin(), names.coordinates.end(), s);
       if (v != names.velocities.end()) {
         out.reset.push_back(after[v - names.velocities.begin()]);
+      } else if (q != names.coordinates.end() && relabel[q - names.coordinates.begin()]) {
+        out.reset.push_back(relabel[q - names.coordinates.begin()]);
       } else if (index(s) >= 0 && index(s) < dim) {
         out.reset.push_back(MakeInput(index(s)));
       } else {

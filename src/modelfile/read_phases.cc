@@ -16,7 +16,8 @@ void Reader::ReadPhaseHeaders() {
     if (!a.get(i)->is_table()) Fail(a.get(i), field, "expected a [[phases]] table, got " + TypeName(*a.get(i)));
     const toml::table& t = *a.get(i)->as_table();
     CheckKeys(t, field, {"name", "states", "typical", "let", "ode", "energy", "integrals", "event", "reset", "anchor",
-                         "coordinates", "velocities", "ignorable", "kinetic", "potential", "mass_matrix", "forces", "impact"});
+                         "coordinates", "velocities", "ignorable", "pinned", "kinetic", "potential", "mass_matrix", "forces",
+                         "impact"});
     ExpressionPhaseSpec p;
     p.name = RequiredString(t, "name", field);
     if (p.name.empty() || !names.insert(p.name).second) {
@@ -119,7 +120,11 @@ void Reader::ReadLets(int i) {
           parameter_index_.count(name)) {
         Fail(&node, pf + ".let." + name, "'" + name + "' is also a state or a parameter");
       }
+      // Checked where the pinned coordinates are known (a quantity of the energies may use them); a use
+      // elsewhere is checked where it is made.
+      if (!mechanical_names_[i].pinned.empty()) pinned_symbols_phase_ = i;
       PhaseSymbol(i, name);
+      pinned_symbols_phase_ = -1;
     }
   }
 }
