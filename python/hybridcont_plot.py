@@ -371,16 +371,27 @@ def branch_colour(position):
     return cycle[position % len(cycle)]
 
 
+# The paper's models are written in units of a mass m_o, a length l_o and gravity g; other models (model
+# files of the user's own) carry the units of their parameters, which the figures do not guess.
+PAPER_MODELS = {"bouncing-ball", "rocking-block", "bouncing-rod", "slip", "ball-chain"}
+UNITS = {"on": True}
+
+
+def time_unit():
+    return r"\ \ [\sqrt{l_\mathrm{o}/g}]" if UNITS["on"] else ""
+
+
 def axis_label(name):
+    energy_unit = r"\ \ [m_\mathrm{o} g\, l_\mathrm{o}]" if UNITS["on"] else ""
     labels = {
-        "H": r"energy $\bar{H}\ \ [m_\mathrm{o} g\, l_\mathrm{o}]$",
-        "T": r"period $T\ \ [\sqrt{l_\mathrm{o}/g}]$",
+        "H": r"energy $\bar{H}%s$" % energy_unit,
+        "T": r"period $T%s$" % time_unit(),
         "xi": r"$\xi$",
     }
     if name in labels:
         return labels[name]
     if name.startswith("t") and name[1:].isdigit():
-        return r"$t_{%s}\ \ [\sqrt{l_\mathrm{o}/g}]$" % name[1:]
+        return r"$t_{%s}%s$" % (name[1:], time_unit())
     return name
 
 
@@ -399,7 +410,7 @@ def axis_label_of(names):
     if len(names) == 1:
         return axis_label(names[0])
     if all(n.startswith("t") and n[1:].isdigit() for n in names):
-        return "durations " + ", ".join(column_symbol(n) for n in names) + r"$\ \ [\sqrt{l_\mathrm{o}/g}]$"
+        return "durations " + ", ".join(column_symbol(n) for n in names) + ("$%s$" % time_unit() if UNITS["on"] else "")
     return ", ".join(names)
 
 
@@ -518,6 +529,7 @@ class Results:
         self.summary, self.summary_path = load_summary(results_dir)
         self.presentation = read_presentation(self.summary, self.summary_path)
         self.model = str(self.summary.get("model") or "unknown")
+        UNITS["on"] = self.model in PAPER_MODELS
         self.parameters = {k: to_float(v) for k, v in (self.summary.get("parameters") or {}).items()}
         self.phases = phases_of(self.summary)
         self.m = len(self.phases)
@@ -1181,8 +1193,8 @@ def figure_keyframes(res, svg, written, n_frames=9):
             T = rows[-1][0] - rows[0][0]
         title = label
         if finite(H):
-            title += r",  $\bar{H}=%.4g\ m_\mathrm{o} g l_\mathrm{o}$" % H
-        title += r",  $T=%.4g\ \sqrt{l_\mathrm{o}/g}$" % T
+            title += r",  $\bar{H}=%.4g%s$" % (H, r"\ m_\mathrm{o} g l_\mathrm{o}" if UNITS["on"] else "")
+        title += r",  $T=%.4g%s$" % (T, r"\ \sqrt{l_\mathrm{o}/g}" if UNITS["on"] else "")
         if "branch" in o:
             title += "  (branch %s)" % o.get("branch")
         ax.set_title(title, fontsize=9.5, loc="left")

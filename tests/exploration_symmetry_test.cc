@@ -232,7 +232,7 @@ TEST(ExplorationSymmetry, BranchesCrossingAtSmallAnglesAreNotImages) {
       const Branch& source = mapped.branches[b.image_of];
       EXPECT_EQ(b.points.back().u(1), -source.points.back().u(1));
       if (std::abs(b.points.back().u(1)) == 40) {
-        EXPECT_EQ(b.message, b.points.back().u(1) > 0 ? "reached lambda <= 40.000000" : "reached lambda >= -40.000000")
+        EXPECT_EQ(b.message, b.points.back().u(1) > 0 ? "reached lambda <= 40" : "reached lambda >= -40")
             << source.message;
         ++messages;
       }

@@ -9,11 +9,14 @@
 #define HYBRIDCONT_SRC_CONTINUATION_LINEAR_STOP_H_
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
 #include "hybridcont/continuation.h"
 #include "hybridcont/corrector.h"
+#include "hybridcont/scaled_problem.h"
 #include "hybridcont/zero_problem.h"
 
 namespace hybridcont::internal {
@@ -25,7 +28,7 @@ struct LinearStop {
   Vector c;
   double value = 0;
   Kind kind = Kind::kTarget;
-  std::string label;  // e.g. "H <= 2.000000", "t1+t2+t3 >= -20.000000", "H = 1.500000"
+  std::string label;  // e.g. "H <= 2", "t1+t2+t3 >= -20", "H = 1.5", in the problem's own units
 
   double f(const Vector& u) const { return c.dot(u) - value; }
   bool Crossed(double f_a, double f_b) const {
@@ -44,17 +47,31 @@ struct LinearStop {
   }
 };
 
-// Targets, then bounds, then sum bounds (finite sides only), in the order of the options.
+// Targets, then bounds, then sum bounds (finite sides only), in the order of the options. Values are in
+// the problem's unknowns; labels show them in the user's (a ScaledProblem's scales undone), with the
+// shortest decimal that reads back.
 inline std::vector<LinearStop> LinearStops(const ContinuationOptions& options, const ZeroProblem& problem) {
   const int n = problem.num_unknowns();
+  const auto* scaled = dynamic_cast<const ScaledProblem*>(&problem);
+  const auto shown = [&](const Vector& c, double value) {
+    int k = 0;
+    c.cwiseAbs().maxCoeff(&k);
+    const double v = scaled ? value * scaled->scales()(k) : value;
+    char buffer[32];
+    for (int digits = 6; digits <= 17; ++digits) {
+      std::snprintf(buffer, sizeof buffer, "%.*g", digits, v);
+      if (std::strtod(buffer, nullptr) == v) break;
+    }
+    return std::string(buffer);
+  };
   std::vector<LinearStop> stops;
   for (const ComponentTarget& target : options.targets) {
-    stops.push_back({Vector::Unit(n, problem.UnknownIndex(target.component)), target.value,
-                     LinearStop::Kind::kTarget, target.component + " = " + std::to_string(target.value)});
+    const Vector c = Vector::Unit(n, problem.UnknownIndex(target.component));
+    stops.push_back({c, target.value, LinearStop::Kind::kTarget, target.component + " = " + shown(c, target.value)});
   }
-  auto add_bounds = [&stops](const Vector& c, double lower, double upper, const std::string& label) {
-    if (std::isfinite(lower)) stops.push_back({c, lower, LinearStop::Kind::kLower, label + " >= " + std::to_string(lower)});
-    if (std::isfinite(upper)) stops.push_back({c, upper, LinearStop::Kind::kUpper, label + " <= " + std::to_string(upper)});
+  auto add_bounds = [&](const Vector& c, double lower, double upper, const std::string& label) {
+    if (std::isfinite(lower)) stops.push_back({c, lower, LinearStop::Kind::kLower, label + " >= " + shown(c, lower)});
+    if (std::isfinite(upper)) stops.push_back({c, upper, LinearStop::Kind::kUpper, label + " <= " + shown(c, upper)});
   };
   for (const ComponentBound& bound : options.bounds) {
     add_bounds(Vector::Unit(n, problem.UnknownIndex(bound.component)), bound.lower, bound.upper, bound.component);
