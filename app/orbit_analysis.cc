@@ -64,6 +64,7 @@ void AnalyzePhysicalOrbit(const HybridModel& model, TimeBasedShooting& floquet_m
   }
   const FloquetResult floquet = ComputeFloquet(floquet_map, u);
   if (!floquet.ok()) return;
+  record->stability = floquet.stability.ToString();
   record->extra[1].second = floquet.stable ? 1 : 0;
   record->extra[2].second = floquet.normal ? 1 : 0;
   record->extra[3].second = floquet.num_unit;

@@ -166,7 +166,7 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
     for (int i = 0; i < layout.num_segments(); ++i) {
       for (int c = 0; c < layout.dim(i); ++c) f << "," << names[layout.state_offset(i) + c];
     }
-    f << ",physical,classification,residual,newton_iterations,step";
+    f << ",physical,classification,stability,residual,newton_iterations,step";
     for (const auto& [name, value] : p.extra) f << "," << name;
     for (const std::string& name : presentation.quantity_names()) f << "," << name;
     f << "\n";
@@ -182,8 +182,8 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
   for (int i = 0; i < layout.num_segments(); ++i) {
     for (int c = 0; c < layout.dim(i); ++c) f << fmt::format(",{:.17g}", u(layout.state_offset(i) + c));
   }
-  f << fmt::format(",{},{},{:.3e},{},{:.6g}", p.classification.physical ? 1 : 0, ToString(p.classification.reason),
-                   p.residual, p.newton_iterations, p.step);
+  f << fmt::format(",{},{},{},{:.3e},{},{:.6g}", p.classification.physical ? 1 : 0, ToString(p.classification.reason),
+                   p.stability, p.residual, p.newton_iterations, p.step);
   for (const auto& [name, value] : p.extra) {
     if (std::isfinite(value)) f << fmt::format(",{:.10g}", value);
     else f << ",";  // not defined for this point (e.g. Floquet data of a non-physical orbit)

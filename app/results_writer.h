@@ -48,6 +48,9 @@ struct PointRecord {
   int index = 0;
   Vector u;
   Classification classification;
+  // The Floquet stability class of a physical orbit ("asymptotically stable", "unstable (saddle)", ...;
+  // StabilityClass::ToString); empty where there are no multipliers.
+  std::string stability;
   double residual = 0.0;
   int newton_iterations = 0;
   double step = 0.0;

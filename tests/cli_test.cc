@@ -86,7 +86,7 @@ TEST(Cli, RunBouncingBallWritesClassifiedBranchesThatMatchTheClosedForm) {
     std::string line;
     std::getline(csv, line);
     // header: index,H,T,xi,t1,t2,x1_y,x1_dy,x2_y,x2_dy,physical,classification,...
-    EXPECT_EQ(line.rfind("index,H,T,xi,t1,t2,x1_y,x1_dy,x2_y,x2_dy,physical,classification,residual", 0), 0u) << line;
+    EXPECT_EQ(line.rfind("index,H,T,xi,t1,t2,x1_y,x1_dy,x2_y,x2_dy,physical,classification,stability,residual", 0), 0u) << line;
     while (std::getline(csv, line)) {
       std::vector<std::string> cells;
       std::stringstream ss(line);

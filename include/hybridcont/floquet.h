@@ -22,6 +22,23 @@
 // flow direction f; B is then an orthonormal basis of f^⊥ (n1 − 1 columns), M = B^T Phi_T B carries the
 // n1 − 1 multipliers of the Poincaré map, and an orbit can be asymptotically stable (all |mu| < 1).
 //
+// Multipliers accurate relative to their own size. Eigenvalues of one matrix are accurate relative to its
+// norm, so a multiplier far inside the unit circle, computed from Phi_T beside one of modulus 1e7, keeps
+// only ~eps·1e7 of its own digits (the bouncing rod's symplectic pair μ, 1/μ then has a product 1.002
+// instead of 1). The monodromy is a product of factors, Phi_T = Phi_{m+1} S_m ... S_1 Phi_1, each of
+// modest norm; where every factor is invertible (elastic resets, no singular saltation) the inverse
+// product Phi_T^{-1} = Phi_1^{-1} S_1^{-1} ... Phi_{m+1}^{-1} is formed from the inverted factors and its
+// deflated matrix B^T Phi_T^{-1} B (= M^{-1}: Phi_T^{-1} keeps ker dH and fixes f too) gives the multipliers
+// inside the unit circle as reciprocals of its large eigenvalues, accurate relative to their own size. A
+// plastic impact (a rank-deficient reset) has no inverse: its multipliers then come from M alone
+// (`product_inverse`, on by default).
+//
+// Stability class (FloquetResult::stability), from the nontrivial multipliers (with a first integral: on
+// the orbit's energy level): asymptotically stable (every nontrivial |μ| < 1), neutrally
+// stable (none outside, some on the unit circle: the best a conservative orbit can be), or unstable with
+// the kind of the multipliers outside: a real one above +1 (saddle), a real one below −1 (flip), a complex
+// pair (oscillatory).
+//
 // Tolerances (FloquetOptions) and why:
 //   unit_tolerance   = 1e-6:  a nontrivial multiplier within this of +1 counts as a further unit multiplier
 //                             (normal := none does). Simple multipliers are accurate to ~1e-9 at rtol 1e-10;
@@ -60,6 +77,8 @@ struct FloquetOptions {
   double unit_tolerance = 1e-6;      // |mu - 1| for a further unit multiplier (see the header comment)
   double circle_tolerance = 1e-6;    // |mu| <= 1 + this for linear stability
   double min_transversality = 1e-8;  // saltation refused below this crossing sine
+  // The multipliers inside the unit circle from the inverse product where every factor is invertible.
+  bool product_inverse = true;
 
   std::string Validate() const;
 };
@@ -72,6 +91,22 @@ enum class FloquetStatus {
   kEigenFailed,          // Eigen's eigensolver did not converge
 };
 std::string ToString(FloquetStatus status);
+
+// See the header comment. Unstable classes may combine (a saddle and a flip multiplier at once).
+struct StabilityClass {
+  bool asymptotically_stable = false;
+  bool neutrally_stable = false;  // none outside, some on the unit circle
+  // With a first integral: the class is that of the orbit on its energy level (the trivial pair, which
+  // moves along the family, is left out), so an asymptotically stable orbit attracts the orbits of its
+  // own energy (a non-symplectic return map, e.g. the SLIP's massless swing leg).
+  bool on_level = false;
+  int saddle = 0;                 // real multipliers > 1 + tolerance (not counting the trivial ones)
+  int flip = 0;                   // real multipliers < −1 − tolerance
+  int oscillatory = 0;            // complex pairs outside the unit circle
+  bool unstable() const { return saddle + flip + oscillatory > 0; }
+  // "asymptotically stable", "neutrally stable", "unstable (saddle)", "unstable (flip, 2 oscillatory)", ...
+  std::string ToString() const;
+};
 
 struct FloquetResult {
   FloquetStatus status = FloquetStatus::kSuccess;
@@ -90,6 +125,9 @@ struct FloquetResult {
   // All nontrivial multipliers inside the unit circle by more than the tolerance: perturbations decay
   // (possible only without first integral; a conservative orbit is at best neutrally stable).
   bool asymptotically_stable = false;
+  StabilityClass stability;
+  // True where the multipliers inside the unit circle came from the inverse product (see the header).
+  bool from_inverse_product = false;
   int num_trivial = 2;     // trivial multipliers deflated: 2 (with a first integral) or 1 (without)
   double max_modulus = 0;  // largest |mu| of the nontrivial multipliers (1 if there are none)
   double bp_test = 0;      // prod (mu - 1) over the nontrivial multipliers
@@ -108,9 +146,9 @@ struct FloquetResult {
 FloquetResult ComputeFloquet(TimeBasedShooting& shooting, const Vector& u, const FloquetOptions& options = {});
 
 // The analysis part alone, for a monodromy from elsewhere (e.g. the state-based map's Phi(t^A, x0)):
-// f0 = f(x0), dH0 = dH_1(x0).
+// f0 = f(x0), dH0 = dH_1(x0). inverse: Phi_T^{-1} formed from inverted factors, or null.
 FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const RowVector& dH0,
-                               const FloquetOptions& options = {});
+                               const FloquetOptions& options = {}, const Matrix* inverse = nullptr);
 
 }  // namespace hybridcont
 

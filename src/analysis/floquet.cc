@@ -48,8 +48,22 @@ std::string FloquetResult::BriefReport() const {
   return os.str();
 }
 
+std::string StabilityClass::ToString() const {
+  if (asymptotically_stable) return on_level ? "asymptotically stable on its energy level" : "asymptotically stable";
+  if (!unstable()) return neutrally_stable ? "neutrally stable" : "stable";
+  std::string kinds;
+  const auto add = [&](int count, const char* name) {
+    if (count == 0) return;
+    kinds += (kinds.empty() ? "" : ", ") + (count > 1 ? std::to_string(count) + " " : std::string()) + name;
+  };
+  add(saddle, "saddle");
+  add(flip, "flip");
+  add(oscillatory, "oscillatory");
+  return "unstable (" + kinds + ")";
+}
+
 FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const RowVector& dH0,
-                               const FloquetOptions& options) {
+                               const FloquetOptions& options, const Matrix* inverse) {
   FloquetResult res;
   res.monodromy = monodromy;
   const int n = static_cast<int>(monodromy.rows());
@@ -96,6 +110,26 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
       return res;
     }
     for (int i = 0; i < reduced_dim; ++i) res.nontrivial.push_back(reduced.eigenvalues()(i));
+    if (inverse != nullptr && inverse->allFinite()) {
+      // The multipliers inside the unit circle as reciprocals of B^T Phi_T^{-1} B's outside it, when both
+      // count the same number there (they do, but for multipliers on the circle within rounding).
+      Eigen::EigenSolver<Matrix> dual(Matrix(B.transpose() * *inverse * B), false);
+      if (dual.info() == Eigen::Success) {
+        std::vector<std::complex<double>> outside, inside;
+        for (const auto& mu : res.nontrivial) {
+          if (std::abs(mu) >= 1.0) outside.push_back(mu);
+        }
+        for (int i = 0; i < reduced_dim; ++i) {
+          const std::complex<double> nu = dual.eigenvalues()(i);
+          if (std::abs(nu) > 1.0) inside.push_back(1.0 / nu);
+        }
+        if (outside.size() + inside.size() == static_cast<std::size_t>(reduced_dim)) {
+          outside.insert(outside.end(), inside.begin(), inside.end());
+          res.nontrivial = std::move(outside);
+          res.from_inverse_product = true;
+        }
+      }
+    }
   }
   std::sort(res.nontrivial.begin(), res.nontrivial.end(), [](const auto& a, const auto& b) {
     const double ma = std::abs(a), mb = std::abs(b);
@@ -111,9 +145,23 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
     bp *= mu - 1.0;
     pd *= mu + 1.0;
     if (std::abs(mu - 1.0) <= options.unit_tolerance) ++res.num_unit;
-    if (std::abs(mu) > 1.0 + options.circle_tolerance) res.stable = false;
+    if (std::abs(mu) > 1.0 + options.circle_tolerance) {
+      res.stable = false;
+      // A conjugate pair counts once (its member with the positive imaginary part).
+      if (std::abs(mu.imag()) > options.circle_tolerance * std::abs(mu)) {
+        if (mu.imag() > 0) ++res.stability.oscillatory;
+      } else {
+        ++(mu.real() > 0 ? res.stability.saddle : res.stability.flip);
+      }
+    }
     if (!(std::abs(mu) < 1.0 - options.circle_tolerance)) res.asymptotically_stable = false;
   }
+  res.stability.on_level = conservative;
+  res.stability.asymptotically_stable =
+      !res.nontrivial.empty() &&
+      std::all_of(res.nontrivial.begin(), res.nontrivial.end(),
+                  [&](const std::complex<double>& mu) { return std::abs(mu) < 1.0 - options.circle_tolerance; });
+  res.stability.neutrally_stable = res.stable && !res.stability.asymptotically_stable;
   if (!res.nontrivial.empty()) res.max_modulus = std::abs(res.nontrivial.front());
   res.bp_test = bp.real();  // conjugate pairs make the products real up to round-off
   res.pd_test = pd.real();
@@ -140,6 +188,22 @@ FloquetResult ComputeFloquet(TimeBasedShooting& shooting, const Vector& u, const
   Matrix D, S;
   RowVector de;
   Matrix Phi_T = Matrix::Identity(layout.dim(0), layout.dim(0));
+  // Phi_T^{-1} from the inverted factors (see the header), while every factor is invertible: a factor
+  // whose reciprocal condition number is below 1e-12 (a rank-deficient reset) ends it.
+  Matrix inverse = Matrix::Identity(layout.dim(0), layout.dim(0));
+  bool invertible = options.product_inverse;
+  const auto invert_after = [&](const Matrix& factor) {  // inverse := inverse * factor^{-1}
+    if (!invertible || factor.rows() != factor.cols()) {  // phases of different dimensions: no inverse
+      invertible = false;
+      return;
+    }
+    const Eigen::PartialPivLU<Matrix> lu(factor);
+    if (!(lu.rcond() > 1e-12)) {
+      invertible = false;
+      return;
+    }
+    inverse = Matrix(lu.transpose().solve(Matrix(inverse.transpose()))).transpose();  // (F^{-T} inverseᵀ)ᵀ
+  };
   for (int i = 0; i < m; ++i) {
     const Phase& phase = model.phase(i);
     const PhaseFlowResult& flow = shooting.segment_flow(i);
@@ -157,8 +221,11 @@ FloquetResult ComputeFloquet(TimeBasedShooting& shooting, const Vector& u, const
     }
     res.saltations.push_back(S);
     Phi_T = S * (flow.Phi * Phi_T);
+    invert_after(flow.Phi);
+    invert_after(S);
   }
   Phi_T = shooting.segment_flow(m).Phi * Phi_T;
+  invert_after(shooting.segment_flow(m).Phi);
 
   const auto x1 = u.segment(layout.state_offset(0), layout.dim(0));
   Vector f0, H;
@@ -166,7 +233,8 @@ FloquetResult ComputeFloquet(TimeBasedShooting& shooting, const Vector& u, const
   model.phase(0).UnfoldedVectorField(x1, xi, &f0, nullptr, nullptr);
   model.phase(0).FirstIntegrals(x1, &H, &dH, nullptr);
   std::vector<Matrix> saltations = std::move(res.saltations);
-  res = AnalyzeMonodromy(Phi_T, f0, k > 0 ? RowVector(dH.row(0)) : RowVector(), options);
+  res = AnalyzeMonodromy(Phi_T, f0, k > 0 ? RowVector(dH.row(0)) : RowVector(), options,
+                         invertible ? &inverse : nullptr);
   res.saltations = std::move(saltations);
   return res;
 }

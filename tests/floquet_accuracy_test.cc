@@ -1,0 +1,83 @@
+// Multipliers accurate relative to their own size (floquet.h, "Multipliers accurate relative to their own
+// size") and the stability class of each orbit.
+//
+// The bouncing rod's return map is symplectic (elastic impacts, a Hamiltonian flow), so its nontrivial
+// multipliers come in pairs μ, 1/μ: the product of the pair is 1 exactly, whatever the orbit. Along every
+// family of the rod's diagram, with multipliers up to 1e8 in modulus, the product computed from the
+// monodromy alone drifts from 1 (the small one loses its digits), and from the inverse product it stays 1.
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include "hybridcont/exploration.h"
+#include "hybridcont/floquet.h"
+#include "hybridcont/models.h"
+#include "model_exploration.h"
+
+namespace hybridcont {
+namespace {
+
+TEST(FloquetAccuracy, RodPairProductIsOneAlongEveryFamily) {
+  const HybridModel model = MakeBuiltinModel("bouncing-rod");
+  const app::Scenario scenario = app::DefaultScenario(model);
+  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+  options.threads = 1;
+  app::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
+  const BifurcationDiagram diagram = exploration.Run();
+  TimeBasedShooting& shooting = exploration.shooting();
+  FloquetOptions monodromy_only;
+  monodromy_only.product_inverse = false;
+  double worst_before = 0, worst_after = 0, largest = 0;
+  int points = 0;
+  for (const Branch& branch : diagram.branches) {
+    for (const auto& point : branch.points) {
+      if (std::abs(point.u(shooting.UnknownIndex("xi"))) > 1e-8) continue;  // multipliers need ξ = 0
+      const FloquetResult before = ComputeFloquet(shooting, point.u, monodromy_only);
+      const FloquetResult after = ComputeFloquet(shooting, point.u);
+      if (!before.ok() || !after.ok()) continue;
+      ASSERT_EQ(after.nontrivial.size(), 2u);
+      const double modulus = std::abs(after.nontrivial[0]);
+      if (modulus > 1e8) continue;
+      // Off the unit circle the small one comes from the inverse product (on it both are of modulus 1
+      // and the monodromy gives them to its own accuracy).
+      if (modulus > 1.0 + 1e-6) EXPECT_TRUE(after.from_inverse_product) << modulus;
+      // The large multiplier is the same number either way.
+      EXPECT_LT(std::abs(after.nontrivial[0] - before.nontrivial[0]), 1e-12 * modulus);
+      const double pb = std::abs(before.nontrivial[0] * before.nontrivial[1] - 1.0);
+      const double pa = std::abs(after.nontrivial[0] * after.nontrivial[1] - 1.0);
+      EXPECT_LT(pa, 1e-8) << "|mu| = " << modulus << " at H = " << point.u(shooting.UnknownIndex("H"));
+      worst_before = std::max(worst_before, pb);
+      worst_after = std::max(worst_after, pa);
+      largest = std::max(largest, modulus);
+      ++points;
+    }
+  }
+  EXPECT_GT(points, 100);
+  EXPECT_GT(largest, 1e4);
+  std::printf("rod: %d orbits, |mu| up to %.3g; |mu1 mu2 - 1| at most %.2e from the monodromy alone, %.2e from "
+              "the inverse product\n", points, largest, worst_before, worst_after);
+}
+
+TEST(FloquetAccuracy, StabilityClassNamesTheKindOfInstability) {
+  FloquetOptions options;
+  const Vector f0 = Vector::Unit(4, 0);
+  const auto classify = [&](const Matrix& M) {
+    // A monodromy with the flow direction e0 fixed (one trivial multiplier, no first integral) and M on
+    // the other three coordinates.
+    Matrix P = Matrix::Identity(4, 4);
+    P.bottomRightCorner(3, 3) = M;
+    return AnalyzeMonodromy(P, f0, RowVector(), options).stability.ToString();
+  };
+  EXPECT_EQ(classify(Eigen::Vector3d(0.5, -0.2, 0.1).asDiagonal()), "asymptotically stable");
+  EXPECT_EQ(classify(Eigen::Vector3d(1.0 + 1e-3, 0.2, 0.1).asDiagonal()), "unstable (saddle)");
+  EXPECT_EQ(classify(Eigen::Vector3d(-1.5, -2.0, 0.1).asDiagonal()), "unstable (2 flip)");
+  Matrix rotation = Matrix::Zero(3, 3);  // a complex pair of modulus 1.2 and a saddle multiplier 3
+  rotation << 0, -1.2, 0, 1.2, 0, 0, 0, 0, 3;
+  EXPECT_EQ(classify(rotation), "unstable (saddle, oscillatory)");
+  rotation(0, 1) = -1, rotation(1, 0) = 1, rotation(2, 2) = 0.3;  // a pair on the unit circle
+  EXPECT_EQ(classify(rotation), "neutrally stable");
+}
+
+}  // namespace
+}  // namespace hybridcont
