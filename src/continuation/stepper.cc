@@ -181,22 +181,50 @@ class ContinuationStepper::Impl {
   // deceleration factor accepts the step: *b is the new point (without its arclength), *next_h the step
   // proposed after it. Returns kFinished when the branch ends instead (step too small, or a start along
   // a curve of singular points).
+  static constexpr std::size_t kJumpHistory = 8;  // accepted steps that size a jump across a singular point
+
   std::optional<StepStatus> Advance(const ContinuationPoint& a, ContinuationPoint* b, double* next_h) {
     const ContinuationPoint* previous = branch_.points.size() >= 2 ? &branch_.points[branch_.points.size() - 2] : nullptr;
     const Vector direction = internal::PredictorDirection(options_.predictor, a, previous);
     double sb_reference = 0;
     std::string last_failure;
     const int rejected_before = branch_.rejected_steps;
+    bool jumping = false;
+    Vector jump_direction;
     for (;;) {
       const double h = controller_.h();
       if (controller_.below_min_step()) {
+        // Next to a singular point (an SB point, a turning point that is one) Newton's basin shrinks with
+        // the distance to it, so steps that halve towards it fail down to min_step (and the accepted ones
+        // before them shrink as they close in). Before giving up, one step across it: four times the
+        // largest of the last kJumpHistory steps (at most max_step), accepted whatever its deceleration
+        // factor; the special points inside are located as on any step (docs/design/continuation.md,
+        // "Jump across a singular point").
+        // Its direction is the secant over those steps: the tangents next to the singular point are set
+        // by noise.
+        double recent = 0;
+        std::size_t back = branch_.points.size() - 1;
+        for (std::size_t n = 0; back > 0 && n < kJumpHistory; ++n, --back) {
+          recent = std::max(recent, branch_.points[back].step);
+        }
+        const Vector secant = a.u - branch_.points[back].u;
+        if (!jumping && recent > 0 && secant.norm() > 0) {
+          jumping = true;
+          jump_direction = secant.normalized();
+          last_failure += " (then a jump across: ";
+          controller_.set_h(std::min(options_.max_step, 4 * recent));
+          continue;
+        }
         return Finish(TerminationReason::kStepTooSmall,
                       "step fell below min_step = " + std::to_string(options_.min_step) + "; last failure: " +
-                          last_failure);
+                          last_failure + (jumping ? ")" : ""));
       }
       Vector predictor = a.u + h * direction;
       Vector normal = direction;
-      if (options_.predictor == PredictorType::kHermite && previous != nullptr) {
+      if (jumping) {
+        predictor = a.u + h * jump_direction;
+        normal = jump_direction;
+      } else if (options_.predictor == PredictorType::kHermite && previous != nullptr) {
         internal::HermitePredictor(*previous, a, h, &predictor, &normal);
       }
       corrector_.set_max_distance(options_.max_corrector_distance * h);
@@ -216,7 +244,7 @@ class ContinuationStepper::Impl {
         continue;
       }
       const double f = controller_.DecelerationFactor(result, a.tangent, b->tangent);
-      if (f > 2 && !controller_.at_min_step()) {
+      if (f > 2 && !controller_.at_min_step() && !jumping) {
         last_failure = "h = " + std::to_string(h) + ": step control rejected (f = " + std::to_string(f) + ")";
         Reject(std::max(0.5 / (f / 2), 0.25));  // h / f, but never below h / 4
         continue;
