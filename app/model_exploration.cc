@@ -90,12 +90,16 @@ class EngineFloquetTests : public TestFunctions {
   EngineFloquetTests& operator=(const EngineFloquetTests&) = delete;
   std::vector<SpecialPointType> types() const override { return floquet_->types(); }
   void Evaluate(const Vector& v, bool branch_point, Vector* values) override {
-    Vector u = v.cwiseProduct(scales_);
-    if (state_ && !state_->ToTimeBased(Vector(u), &u).ok) {
+    Vector u;
+    if (!TimeBased(v, &u)) {
       *values = Vector::Constant(static_cast<Eigen::Index>(types().size()), std::nan(""));
       return;
     }
     floquet_->Evaluate(u, branch_point, values);
+  }
+  bool Keep(int function, const Vector& v, std::string* note) override {
+    Vector u;
+    return !TimeBased(v, &u) || floquet_->Keep(function, u, note);
   }
   std::unique_ptr<TestFunctions> Clone() const override {
     return std::make_unique<EngineFloquetTests>(floquet_->Clone(), scales_, state_prototype_, sink_);
@@ -106,6 +110,12 @@ class EngineFloquetTests : public TestFunctions {
   void AddCurveWork(const ZeroProblem& copy) override { sink_->AddCurveWork(copy); }
 
  private:
+  // The time-based point of the continued (scaled, perhaps state-based) point v; false if there is none.
+  bool TimeBased(const Vector& v, Vector* u) {
+    *u = v.cwiseProduct(scales_);
+    return !state_ || state_->ToTimeBased(Vector(*u), u).ok;
+  }
+
   std::unique_ptr<FloquetTestFunctions> floquet_;
   Vector scales_;
   const StateBasedShooting* state_prototype_;  // the exploration's map, cloned per copy

@@ -223,7 +223,8 @@ std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayou
   int count = 0;
   for (const auto& [type, code] : {std::pair{SpecialPointType::kFloquetBranchPoint, "BP"},
                                    std::pair{SpecialPointType::kPeriodDoubling, "PD"},
-                                   std::pair{SpecialPointType::kGrazing, "GR"}}) {
+                                   std::pair{SpecialPointType::kGrazing, "GR"},
+                                   std::pair{SpecialPointType::kNeimarkSacker, "NS"}}) {
     for (const SpecialPoint& sp : diagram.special_points) {
       if (sp.type != type || sp.u.size() == 0) continue;
       const double precision = sp.interval_width.size() ? sp.interval_width.norm() : sp.precision();

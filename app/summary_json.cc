@@ -17,6 +17,7 @@ std::string SpecialPointTypeCode(SpecialPointType type) {
     case SpecialPointType::kPeriodDoubling: return "PD";
     case SpecialPointType::kUserTestFunction: return "test";
     case SpecialPointType::kGrazing: return "GR";
+    case SpecialPointType::kNeimarkSacker: return "NS";
   }
   return "?";
 }

@@ -421,6 +421,7 @@ def special_point_style(kind, bracketed):
         "BP": dict(marker="s", s=40, facecolor="black", edgecolor="black", name="BP branch point"),
         "PD": dict(marker="D", s=38, facecolor="#d62728", edgecolor="black", name="PD period doubling"),
         "GR": dict(marker="v", s=46, facecolor="#17becf", edgecolor="black", name="GR grazing"),
+        "NS": dict(marker="h", s=48, facecolor="#9467bd", edgecolor="black", name="NS Neimark-Sacker"),
         "start": dict(marker="*", s=120, facecolor="gold", edgecolor="black", name="start point"),
     }
     style = dict(styles.get(kind, dict(marker="X", s=46, facecolor="#9467bd", edgecolor="black",

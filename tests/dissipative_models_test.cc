@@ -590,5 +590,55 @@ TEST(CompassGait, GaitsMultipliersAndPeriodDoublingAgreeWithAnIndependentRootSol
               "(root solve %.12f)\n", hand.gamma, z1(0), z2(0), layout2.Period(u2), T1 + T2);
 }
 
+// A Neimark–Sacker point with a known place: a clock phase whose reset rotates (x, y) by theta and scales
+// it by a. The orbit x = y = 0 exists for every a; its return map has the multipliers a e^{±i theta}, so
+// the complex pair crosses the unit circle at a = 1 exactly (ns_test = a² − 1 there, floquet.h).
+TEST(NeimarkSacker, ComplexPairCrossesTheUnitCircleWhereTheClosedFormSays) {
+  const char* text = R"toml(
+hybridcont = 1
+name = "rotation-map"
+conservative = false
+
+[parameters]
+a = { value = 0.8, range = "(0, inf)" }
+theta = { value = 1.0, range = "(-inf, inf)" }
+
+[[phases]]
+name = "tick"
+states = ["s", "x", "y"]
+typical = [0.5, 0.1, 0.1]
+ode = { s = "1", x = "0.1*x*y", y = "-0.1*x*x" }
+event = "1 - s"
+anchor = "0.5 - s"
+reset = { s = "0", x = "a*(cos(theta)*x - sin(theta)*y)", y = "a*(sin(theta)*x + cos(theta)*y)" }
+
+[start]
+kind = "guess"
+values = { t1 = 0.5, t2 = 0.5, x1_s = 0.5 }
+
+[run]
+parameter = "a"
+bounds = { a = [0.5, 1.5], period = [0, 10] }
+)toml";
+  const HybridModel model = BuildExpressionModel(ParseModelText(text, "rotation-map.toml"));
+  const ParameterRun run = Explore(model);
+  ASSERT_EQ(run.diagram.status, ExplorationStatus::kCompleted) << run.diagram.message;
+  const ShootingLayout& layout = run.exploration->shooting().layout();
+  std::vector<const SpecialPoint*> ns;
+  for (const SpecialPoint& sp : run.diagram.special_points) {
+    if (sp.type == SpecialPointType::kNeimarkSacker && sp.duplicate_of < 0) ns.push_back(&sp);
+  }
+  ASSERT_EQ(ns.size(), 1u) << run.diagram.FullReport();
+  EXPECT_EQ(ns[0]->status, LocationStatus::kLocated);
+  EXPECT_NEAR(ns[0]->u(layout.parameter_index(0)), 1.0, 1e-10) << ns[0]->BriefReport();
+  const FloquetResult f = ComputeFloquet(run.exploration->shooting(), ns[0]->u);
+  ASSERT_TRUE(f.ok());
+  ASSERT_EQ(f.nontrivial.size(), 2u);
+  EXPECT_NEAR(std::abs(f.nontrivial[0]), 1.0, 1e-10);
+  EXPECT_NEAR(std::abs(std::arg(f.nontrivial[0])), 1.0, 1e-10);  // the rotation angle theta
+  std::printf("rotation map: NS at a = %.13f (exact 1), multipliers %.12f%+.12fi\n",
+              ns[0]->u(layout.parameter_index(0)), f.nontrivial[0].real(), f.nontrivial[0].imag());
+}
+
 }  // namespace
 }  // namespace hybridcont

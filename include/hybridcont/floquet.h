@@ -58,6 +58,12 @@
 //                                                    (l, 1/l): -(l-1)^2/l < 0). Compare the SB points.
 //   pd_test = prod over all mu of (mu + 1)            (the trivial pair contributes 2 * 2 = 4 exactly)
 //                                                    changes sign when a multiplier crosses -1.
+//   ns_test = prod over nontrivial pairs i < j of (mu_i mu_j - 1)   (the bialternate product: real, smooth in
+//                                                    the monodromy) vanishes where a complex pair crosses
+//                                                    the unit circle (Neimark–Sacker: mu mu-bar = 1) and
+//                                                    where two real multipliers have product 1 (a neutral
+//                                                    saddle, no bifurcation); on a symplectic map, whose
+//                                                    multipliers come in pairs mu, 1/mu, it is 0 everywhere.
 //
 //   TimeBasedShooting shooting(model, IntegratorOptions{});
 //   FloquetResult fl = ComputeFloquet(shooting, u);
@@ -132,6 +138,9 @@ struct FloquetResult {
   double max_modulus = 0;  // largest |mu| of the nontrivial multipliers (1 if there are none)
   double bp_test = 0;      // prod (mu - 1) over the nontrivial multipliers
   double pd_test = 0;      // 2^num_trivial * prod (mu + 1) over the nontrivial multipliers
+  double ns_test = 1;      // prod (mu_i mu_j - 1) over pairs of nontrivial multipliers (1 with fewer than 2)
+  // A complex pair of modulus 1 within `tolerance`: what makes a zero of ns_test a Neimark–Sacker point.
+  bool HasUnitComplexPair(double tolerance = 1e-6) const;
   // Residuals of the theory on this orbit (|Phi_T f - f| / |f|, |dH Phi_T - dH| / |dH|): ~integration
   // error on a periodic orbit; large values mean u is not a periodic orbit at xi = 0.
   double flow_residual = 0;

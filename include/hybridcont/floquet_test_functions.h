@@ -51,6 +51,9 @@ double PeriodDoublingTest(const Matrix& dr, const ShootingLayout& layout);
 // event-driven replay does not return (replay.h) has NaN values: the multipliers of a non-physical orbit
 // mean nothing for the mechanical system. Trial points between two branch points are not classified.
 //
+// Last, a kNeimarkSacker function: FloquetResult::ns_test (floquet.h), NaN at a branch point where it is
+// below kNeimarkSackerUndefined (on a symplectic map it is 0 everywhere but for the multipliers' errors).
+//
 // A model without first integral adds one kGrazing function per event, the normalized crossing speed
 // de_i·f_i / (|de_i| |f_i|) at the end of segment i (negative on a physical orbit, zero where the event is
 // met tangentially), defined on both sides of the grazing point. (Conservative models do not locate grazing
@@ -64,6 +67,12 @@ class FloquetTestFunctions : public TestFunctions {
 
   std::vector<SpecialPointType> types() const override;
   void Evaluate(const Vector& u, bool branch_point, Vector* values) override;
+  // A zero of the Neimark–Sacker function is kept where a complex pair lies on the unit circle (within
+  // kUnitPairTolerance); a zero from two real multipliers of product 1 (a neutral saddle) is dropped.
+  bool Keep(int function, const Vector& u, std::string* note) override;
+  // |ns_test| below this at a branch point: undefined there (the map is symplectic, see Evaluate).
+  static constexpr double kNeimarkSackerUndefined = 1e-8;
+  static constexpr double kUnitPairTolerance = 1e-6;
   std::unique_ptr<TestFunctions> Clone() const override;
   // The integrator tolerances times factor.
   std::unique_ptr<TestFunctions> Refined(double factor) const override;

@@ -46,6 +46,7 @@ enum class SpecialPointType {
   kPeriodDoubling,      // a Floquet multiplier crosses −1 (PD; floquet_test_functions.h)
   kUserTestFunction,    // a zero of a caller's test function
   kGrazing,             // an event met tangentially: its normalized crossing speed de·f/(|de||f|) is 0
+  kNeimarkSacker,       // a complex pair of Floquet multipliers crosses the unit circle (NS; floquet.h)
 };
 std::string ToString(SpecialPointType type);
 

@@ -51,6 +51,13 @@ class TestFunctions {
   // branch_point: u is an accepted branch point (a provider checks there what must hold along a whole step,
   // e.g. that the orbit is physical); otherwise u is a trial point of the root finder between two of them.
   virtual void Evaluate(const Vector& u, bool branch_point, Vector* values) = 0;
+  // Called once for each zero of function `function` located at u: false drops it (a zero that marks no
+  // special point of its type, e.g. a neutral saddle of a Neimark–Sacker test); *note is added to its
+  // message. The default keeps every zero.
+  virtual bool Keep(int function, const Vector& u, std::string* note) {
+    (void)function, (void)u, (void)note;
+    return true;
+  }
   // An independent copy for another stepper (another thread): its own scratch space.
   virtual std::unique_ptr<TestFunctions> Clone() const = 0;
   // A copy whose evaluation error is `factor` < 1 times this one's (ZeroProblem::Refined): estimates the

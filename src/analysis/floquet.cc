@@ -48,6 +48,12 @@ std::string FloquetResult::BriefReport() const {
   return os.str();
 }
 
+bool FloquetResult::HasUnitComplexPair(double tolerance) const {
+  return std::any_of(nontrivial.begin(), nontrivial.end(), [&](const std::complex<double>& mu) {
+    return std::abs(mu.imag()) > tolerance && std::abs(std::abs(mu) - 1.0) <= tolerance;
+  });
+}
+
 std::string StabilityClass::ToString() const {
   if (asymptotically_stable) return on_level ? "asymptotically stable on its energy level" : "asymptotically stable";
   if (!unstable()) return neutrally_stable ? "neutrally stable" : "stable";
@@ -163,6 +169,11 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
                   [&](const std::complex<double>& mu) { return std::abs(mu) < 1.0 - options.circle_tolerance; });
   res.stability.neutrally_stable = res.stable && !res.stability.asymptotically_stable;
   if (!res.nontrivial.empty()) res.max_modulus = std::abs(res.nontrivial.front());
+  std::complex<double> ns = 1.0;
+  for (std::size_t i = 0; i < res.nontrivial.size(); ++i) {
+    for (std::size_t j = i + 1; j < res.nontrivial.size(); ++j) ns *= res.nontrivial[i] * res.nontrivial[j] - 1.0;
+  }
+  res.ns_test = ns.real();
   res.bp_test = bp.real();  // conjugate pairs make the products real up to round-off
   res.pd_test = pd.real();
   res.normal = res.num_unit == res.num_trivial;

@@ -58,6 +58,7 @@ FloquetTestFunctions::FloquetTestFunctions(const HybridModel& model, const Integ
 std::vector<SpecialPointType> FloquetTestFunctions::types() const {
   std::vector<SpecialPointType> types = {SpecialPointType::kFloquetBranchPoint, SpecialPointType::kPeriodDoubling};
   if (model_->num_first_integrals() == 0) types.insert(types.end(), model_->num_phases(), SpecialPointType::kGrazing);
+  types.push_back(SpecialPointType::kNeimarkSacker);
   return types;
 }
 
@@ -90,7 +91,8 @@ bool FloquetTestFunctions::Physical(const Vector& u_free) const {
 void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* values) {
   const int m = model_->num_phases();
   const bool grazing = model_->num_first_integrals() == 0;
-  *values = Vector::Constant(2 + (grazing ? m : 0), std::numeric_limits<double>::quiet_NaN());
+  const int ns = 2 + (grazing ? m : 0);  // the Neimark–Sacker function, last
+  *values = Vector::Constant(ns + 1, std::numeric_limits<double>::quiet_NaN());
   const bool evaluated = shooting_.Evaluate(u, nullptr, &dr_).ok;
   if (grazing && evaluated) {  // every orbit, physical or not: the crossing speed changes sign at grazing
     const HybridModel& model = shooting_.model();  // at u's parameter values
@@ -108,6 +110,18 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
   if (!floquet.ok()) return;
   (*values)(0) = floquet.bp_test;
   if (evaluated) (*values)(1) = PeriodDoublingTest(dr_, shooting_.layout());  // dr_ from the evaluation above
+  // On a symplectic map ns_test is 0 up to the multipliers' errors everywhere: no sign there (NaN) at
+  // branch points, so that noise marks no point; a crossing elsewhere has |ns_test| of order 1 at the
+  // branch points around it and keeps its values in between.
+  (*values)(ns) = branch_point && std::abs(floquet.ns_test) < kNeimarkSackerUndefined ? std::nan("") : floquet.ns_test;
+}
+
+bool FloquetTestFunctions::Keep(int function, const Vector& u, std::string* note) {
+  if (types()[function] != SpecialPointType::kNeimarkSacker) return true;
+  const FloquetResult floquet = ComputeFloquet(shooting_, u);
+  if (!floquet.ok()) return true;
+  (void)note;
+  return floquet.HasUnitComplexPair(kUnitPairTolerance);  // else a neutral saddle: no bifurcation
 }
 
 std::unique_ptr<TestFunctions> FloquetTestFunctions::Clone() const {

@@ -15,6 +15,7 @@ constexpr internal::EnumName<SpecialPointType> kSpecialPointTypeNames[] = {
     {SpecialPointType::kFloquetBranchPoint, "floquet-branch-point"},
     {SpecialPointType::kPeriodDoubling, "period-doubling"},
     {SpecialPointType::kGrazing, "grazing"},
+    {SpecialPointType::kNeimarkSacker, "neimark-sacker"},
     {SpecialPointType::kUserTestFunction, "test-function-zero"},
 };
 

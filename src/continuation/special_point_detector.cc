@@ -82,6 +82,15 @@ void SpecialPointDetector::Detect(size_t index, bool from_singular, Branch* bran
 void SpecialPointDetector::Insert(std::vector<SpecialPoint> found, Branch* branch) {
   std::vector<SpecialPoint>& list = branch->special_points;
   for (SpecialPoint& point : found) {
+    const bool of_test_function = functions_ && point.type != SpecialPointType::kSimpleBifurcation &&
+                                  point.type != SpecialPointType::kTurningPoint && point.component_index >= 0 &&
+                                  point.component_index < static_cast<int>(function_types_.size()) &&
+                                  function_types_[point.component_index] == point.type;
+    if (of_test_function) {
+      std::string note;
+      if (!functions_->Keep(point.component_index, point.u, &note)) continue;
+      if (!note.empty()) point.message += (point.message.empty() ? "" : "; ") + note;
+    }
     const auto at = std::upper_bound(list.begin(), list.end(), point.arclength,
                                      [](double s, const SpecialPoint& p) { return s < p.arclength; });
     list.insert(at, std::move(point));

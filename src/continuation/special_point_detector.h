@@ -128,7 +128,9 @@ class SpecialPointDetector {
   SpecialPoint TouchingZero(int j, const CurveSample& lo, const CurveSample& hi, const CurveMinimum& minimum,
                             double scale, Branch* branch);
   double TestValue(int j, const Vector& u);
-  static void Insert(std::vector<SpecialPoint> found, Branch* branch);
+  // Adds the found points to the branch in arclength order, except zeros of test functions that the
+  // functions do not keep (TestFunctions::Keep).
+  void Insert(std::vector<SpecialPoint> found, Branch* branch);
   // A turning point at an SB point of the same step keeps its root finder's bracket (bracket_only) and
   // takes the SB point's interval and their distance on both sides instead of its own estimate.
   static void PlaceTurningPointsAtSbPoints(double step, const std::vector<SpecialPoint>& bracket_only,
