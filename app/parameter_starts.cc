@@ -1,5 +1,7 @@
 #include "parameter_starts.h"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "hybridcont/corrector.h"
@@ -12,9 +14,17 @@ namespace hybridcont::app {
 ParameterStarts FindParameterStarts(const HybridModel& model, const RunSetup& setup, TimeBasedShooting& free_map) {
   ParameterStarts starts;
   const ShootingLayout& free_layout = free_map.layout();
-  const int h = free_layout.H_index(), p = free_layout.parameter_index(0);
+  const std::string& fixed = setup.free.fixed.front().first;
+  const std::vector<std::string>& names = free_layout.unknown_names();
+  const int h = static_cast<int>(std::find(names.begin(), names.end(), fixed) - names.begin());
+  const int p = free_layout.parameter_index(0);
   const int n = ShootingLayout(model).num_unknowns();
   const double c = setup.free.fixed.front().second;
+  // A duration held at 0 is the boundary where that phase vanishes: its crossings leave the physical
+  // family (the points there are zero-duration orbits), so one physical side suffices.
+  bool duration = false;
+  for (int i = 0; i < free_layout.num_segments(); ++i) duration = duration || h == free_layout.time_index(i);
+  const bool boundary = duration && c == 0.0;
   const double p0 = model.parameter_value(free_layout.parameter_model_index(0));
   ModelExploration ordinary(model, DefaultScenario(model), setup.integrator, setup.seed_exploration);
   const BifurcationDiagram diagram = ordinary.Run();
@@ -25,13 +35,14 @@ ParameterStarts FindParameterStarts(const HybridModel& model, const RunSetup& se
       const Vector &ua = b.points[i].u, &ub = b.points[i + 1].u;
       const double da = ua(h) - c, db = ub(h) - c;
       if (da * db > 0 || da == db || db == 0) continue;  // a point exactly at c counts once, as the chord's start
-      if (!IsPhysical(model, ua, setup.integrator) || !IsPhysical(model, ub, setup.integrator)) continue;
+      const bool pa = IsPhysical(model, ua, setup.integrator), pb = IsPhysical(model, ub, setup.integrator);
+      if (boundary ? !(pa || pb) : !(pa && pb)) continue;
       ++starts.crossings;
       Vector guess(free_layout.num_unknowns());
       guess << ua + (da / (da - db)) * (ub - ua), p0;
       Vector u;
       const CorrectorResult result = corrector.CorrectFixedComponent(guess, p, p0, &u);
-      if (!result.converged() || !IsPhysical(model, u.head(n), setup.integrator)) continue;
+      if (!result.converged() || (!boundary && !IsPhysical(model, u.head(n), setup.integrator))) continue;
       const bool known = std::any_of(starts.points.begin(), starts.points.end(), [&](const Vector& s) {
         return (s - u).lpNorm<Eigen::Infinity>() <= 1e-6 * (1 + u.lpNorm<Eigen::Infinity>());
       });
@@ -41,9 +52,9 @@ ParameterStarts FindParameterStarts(const HybridModel& model, const RunSetup& se
                                    starts.points.size() - 1, b.id, i, i + 1, free_layout.Period(u));
     }
   }
-  starts.report = fmt::format("starts at H = {:g}: {} physical crossings on {} half-branches of the run in H, {} "
-                              "distinct\n",
-                              c, starts.crossings, starts.ordinary_branches, starts.points.size()) +
+  starts.report = fmt::format("starts at {} = {:g}: {} {} on {} half-branches of the run in H, {} distinct\n", fixed, c,
+                              starts.crossings, boundary ? "crossings out of physical families" : "physical crossings",
+                              starts.ordinary_branches, starts.points.size()) +
                   starts.report;
   return starts;
 }

@@ -69,8 +69,9 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
   NonEmpty(run->add_option("--free", args->free,
                            "continue the families in a model parameter instead of H, e.g. k (needs --fix)"));
   NonEmpty(run->add_option("--fix", args->fix,
-                           "the unknown held fixed while --free varies, NAME=VALUE, e.g. H=1.5; starts are the "
-                           "physical families' crossings of that value in the ordinary run"));
+                           "the unknown held fixed while --free varies, NAME=VALUE: H=1.5, a state x2_dx=0.8, or a "
+                           "duration t2=0 (where that phase vanishes); starts are the physical families' crossings "
+                           "of that value in the ordinary run"));
   NonEmpty(run->add_option("--curves", args->curves,
                            "after the run, continue every turning and SB point of the physical families in (H, "
                            "PARAMETER), e.g. w2 (bounds: --bound PARAMETER=LO:HI)"));

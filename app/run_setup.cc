@@ -168,7 +168,16 @@ void ApplyFreeParameter(const RunArguments& args, const HybridModel& model, RunS
                                             model.name()));
   }
   const auto [name, value] = ParseAssignment("--fix", args.fix);
-  if (name != "H") throw std::invalid_argument("--fix '" + args.fix + "': only H can be held fixed");
+  // Any unknown of the orbit: H (families over the parameter at one energy), a duration (t2=0: the curve
+  // where that phase vanishes, a boundary of the physical families), a state component (x1_dx=1.2: the
+  // families at one apex speed).
+  const std::vector<std::string> names = ShootingLayout(model).unknown_names();
+  if (std::find(names.begin(), names.end(), name) == names.end() || name == "xi") {
+    std::string known;
+    for (const std::string& n : names) known += n == "xi" ? "" : (known.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("--fix '" + args.fix + "': '" + name + "' is not an unknown of model '" + model.name() +
+                                "' that can be held fixed (" + known + ")");
+  }
   setup->free = FreeParameters{{args.free}, {{name, value}}};
   ContinuationOptions& seed = setup->seed_exploration.continuation;
   for (ComponentBound& b : seed.bounds) {

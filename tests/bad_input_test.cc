@@ -273,7 +273,7 @@ const std::vector<BadInputCase>& Cases() {
       {"FixWithoutFree", Run("slip", {"--fix", "H=1.5"}), 2, "--fix 'H=1.5': needs --free PARAMETER"},
       {"FreeUnknownParameter", Run("slip", {"--free", "kk", "--fix", "H=1.5"}), 2,
        "--free 'kk': model 'slip' has no such parameter"},
-      {"FixNotH", Run("slip", {"--free", "k", "--fix", "t1=1"}), 2, "--fix 't1=1': only H can be held fixed"},
+      {"FixNotAnUnknown", Run("slip", {"--free", "k", "--fix", "speed=1"}), 2, "--fix 'speed=1': 'speed' is not an unknown of model 'slip' that can be held fixed"},
       {"FixNotANumber", Run("slip", {"--free", "k", "--fix", "H=x"}), 2, "--fix 'H=x': value 'x' is not a number"},
       {"FreeStateFormulation", Run("slip", {"--free", "k", "--fix", "H=1.5", "--formulation", "state"}), 2,
        "--formulation state: --free 'k' needs the time-based formulation"},

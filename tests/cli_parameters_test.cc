@@ -16,6 +16,7 @@
 
 #include "cli_runner.h"
 #include "hybridcont/models.h"
+#include "hybridcont/timebased_shooting.h"
 #include "known_orbits.h"
 
 namespace hybridcont::app {
@@ -100,6 +101,45 @@ TEST(CliParameters, SlipHoppingInPlaceInStiffnessMatchesTheClosedForm) {
     if (sp["type"] == "SB") sb = sp.contains("k") && sp["H"] == 1.5;
   }
   EXPECT_TRUE(sb);
+}
+
+// Forward hopping at a fixed flight speed (the state component x2_dx = 0.8) continued in k: every point
+// holds the speed exactly while k and H̄ vary, and is an orbit of the SLIP at its k (the base map's residual
+// there).
+TEST(CliParameters, SlipAtFixedFlightSpeedInStiffness) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_cli_fix_speed";
+  const CliResult r = RunTool({"run", "slip", "--free", "k", "--fix", "x2_dx=0.8", "--bound", "k=15:100", "--out",
+                               dir.string(), "--quiet", "--no-plots", "--threads", "1", "--overwrite"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json summary = ReadSummary(dir);
+  EXPECT_EQ(summary["options"]["fixed"]["x2_dx"], 0.8);
+  const ShootingLayout layout(MakeBuiltinModel("slip"));
+  const std::vector<std::string> names = layout.unknown_names();
+  int points = 0;
+  double worst_speed = 0, worst_residual = 0, k_min = 1e300, k_max = -1e300, H_min = 1e300, H_max = -1e300;
+  for (const nlohmann::json& b : summary["branches"]) {
+    const auto columns = ReadColumns(dir / b["file"].get<std::string>());
+    for (std::size_t row = 0; row < columns.at("k").size(); ++row) {
+      const double k = columns.at("k")[row], H = columns.at("H")[row];
+      worst_speed = std::max(worst_speed, std::abs(columns.at("x2_dx")[row] - 0.8));
+      HybridModel at_k = MakeBuiltinModel("slip");
+      at_k.SetParameter("k", k);
+      TimeBasedShooting map(at_k, IntegratorOptions{});
+      Vector u(layout.num_unknowns()), res;
+      for (int j = 0; j < layout.num_unknowns(); ++j) u(j) = columns.at(names[j])[row];
+      ASSERT_TRUE(map.Evaluate(u, &res, nullptr).ok);
+      worst_residual = std::max(worst_residual, res.norm());
+      k_min = std::min(k_min, k), k_max = std::max(k_max, k), H_min = std::min(H_min, H), H_max = std::max(H_max, H);
+      ++points;
+    }
+  }
+  EXPECT_GE(points, 20);
+  EXPECT_LT(worst_speed, 1e-12);
+  EXPECT_LT(worst_residual, 1e-9);
+  EXPECT_GT(k_max - k_min, 10.0);
+  EXPECT_GT(H_max - H_min, 0.01);
+  std::printf("SLIP at flight speed 0.8: %d points, k in [%.3f, %.3f], H in [%.4f, %.4f]; speed off by %.1e, "
+              "residual %.1e\n", points, k_min, k_max, H_min, H_max, worst_speed, worst_residual);
 }
 
 // The SLIP's first SB point (H̄ = 1 + π²/40 at w2 = 5) continued in (w2, H̄) over [2, 10]: along the whole
