@@ -92,6 +92,34 @@ TEST(FloquetAccuracy, RodPairProductIsOneAlongEveryFamily) {
               "the inverse product\n", points, largest, worst_before, worst_after);
 }
 
+// The SLIP's return map is not symplectic: along hopping in place two real multipliers pass through a
+// product of 1 near H̄ = 1.71 (1.94 · 0.499 → 2.40 · 0.444), so the bialternate product changes sign there,
+// but no complex pair is on the unit circle: a neutral saddle, which must not be reported as an NS point.
+TEST(FloquetAccuracy, SlipNeutralSaddleIsNoNeimarkSackerPoint) {
+  const HybridModel model = MakeBuiltinModel("slip");
+  const app::Scenario scenario = app::DefaultScenario(model);
+  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+  options.threads = 1;
+  app::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
+  const BifurcationDiagram diagram = exploration.Run();
+  for (const SpecialPoint& sp : diagram.special_points) {
+    EXPECT_NE(sp.type, SpecialPointType::kNeimarkSacker) << sp.BriefReport();
+  }
+  TimeBasedShooting& shooting = exploration.shooting();
+  int sign_changes = 0;
+  for (const Branch& branch : diagram.branches) {
+    double previous = std::nan("");
+    for (const auto& point : branch.points) {
+      const FloquetResult f = ComputeFloquet(shooting, point.u);
+      if (!f.ok() || f.nontrivial.size() != 2) continue;
+      const bool real_pair = f.nontrivial[0].imag() == 0 && f.nontrivial[1].imag() == 0;
+      if (real_pair && std::isfinite(previous) && std::signbit(previous) != std::signbit(f.ns_test)) ++sign_changes;
+      previous = real_pair ? f.ns_test : std::nan("");
+    }
+  }
+  EXPECT_GE(sign_changes, 1);  // the neutral saddle is there, and dropped
+}
+
 TEST(FloquetAccuracy, StabilityClassNamesTheKindOfInstability) {
   FloquetOptions options;
   const Vector f0 = Vector::Unit(4, 0);
