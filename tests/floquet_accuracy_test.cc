@@ -7,6 +7,8 @@
 // monodromy alone drifts from 1 (the small one loses its digits), and from the inverse product it stays 1.
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -18,14 +20,25 @@
 namespace hybridcont {
 namespace {
 
+// The default exploration of a built-in model, on one thread.
+struct DefaultRun {
+  explicit DefaultRun(const std::string& name) : model(MakeBuiltinModel(name)) {
+    const app::Scenario scenario = app::DefaultScenario(model);
+    ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+    options.threads = 1;
+    exploration = std::make_unique<app::ModelExploration>(model, scenario, IntegratorOptions{}, options);
+    diagram = exploration->Run();
+  }
+  HybridModel model;
+  std::unique_ptr<app::ModelExploration> exploration;
+  BifurcationDiagram diagram;
+};
+
 TEST(FloquetAccuracy, RodPairProductIsOneAlongEveryFamily) {
-  const HybridModel model = MakeBuiltinModel("bouncing-rod");
-  const app::Scenario scenario = app::DefaultScenario(model);
-  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
-  options.threads = 1;
-  app::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
-  const BifurcationDiagram diagram = exploration.Run();
-  TimeBasedShooting& shooting = exploration.shooting();
+  DefaultRun run("bouncing-rod");
+  const HybridModel& model = run.model;
+  const BifurcationDiagram& diagram = run.diagram;
+  TimeBasedShooting& shooting = run.exploration->shooting();
   FloquetOptions monodromy_only;
   monodromy_only.product_inverse = false;
   double worst_before = 0, worst_after = 0, largest = 0;
@@ -96,16 +109,12 @@ TEST(FloquetAccuracy, RodPairProductIsOneAlongEveryFamily) {
 // product of 1 near H̄ = 1.71 (1.94 · 0.499 → 2.40 · 0.444), so the bialternate product changes sign there,
 // but no complex pair is on the unit circle: a neutral saddle, which must not be reported as an NS point.
 TEST(FloquetAccuracy, SlipNeutralSaddleIsNoNeimarkSackerPoint) {
-  const HybridModel model = MakeBuiltinModel("slip");
-  const app::Scenario scenario = app::DefaultScenario(model);
-  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
-  options.threads = 1;
-  app::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
-  const BifurcationDiagram diagram = exploration.Run();
+  DefaultRun run("slip");
+  const BifurcationDiagram& diagram = run.diagram;
   for (const SpecialPoint& sp : diagram.special_points) {
     EXPECT_NE(sp.type, SpecialPointType::kNeimarkSacker) << sp.BriefReport();
   }
-  TimeBasedShooting& shooting = exploration.shooting();
+  TimeBasedShooting& shooting = run.exploration->shooting();
   int sign_changes = 0;
   for (const Branch& branch : diagram.branches) {
     double previous = std::nan("");
