@@ -590,6 +590,17 @@ TEST(CompassGait, GaitsMultipliersAndPeriodDoublingAgreeWithAnIndependentRootSol
               "(root solve %.12f)\n", hand.gamma, z1(0), z2(0), layout2.Period(u2), T1 + T2);
 }
 
+// The compiled entry points with the parameters as jets (runs in a parameter) are the interpreter's
+// EvaluateWithParameterJets: r and dr, the parameter column included, agree at random points.
+TEST(CompassGait, CompiledParameterJetsAreTheInterpreter) {
+  ModelFileOptions interpreted;
+  interpreted.compile = false;
+  const HybridModel plain = LoadModelFile(std::filesystem::path(HYBRIDCONT_SOURCE_DIR) / "models" / "compass-gait.toml",
+                                          interpreted);
+  const HybridModel compiled = Load("compass-gait");
+  ExpectSameMap(compiled, plain, FreeParameters{{"gamma"}, {}}, 0.2, 0.03, 0.01);
+}
+
 // A Neimark–Sacker point with a known place: a clock phase whose reset rotates (x, y) by theta and scales
 // it by a. The orbit x = y = 0 exists for every a; its return map has the multipliers a e^{±i theta}, so
 // the complex pair crosses the unit circle at a = 1 exactly (ns_test = a² − 1 there, floquet.h).

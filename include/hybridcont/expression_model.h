@@ -77,9 +77,14 @@ constexpr ScalarKind KindOf() {
 // Entry points of compiled programs: fn(x, p, out) with x, out arrays of the scalar type. A null entry
 // runs the interpreter.
 using CompiledProgramFn = void (*)(const void* x, const double* p, void* out);
+// Entry points with the parameters as ParamJets too (derivatives in one model parameter, on the runs in a
+// parameter): fn(x, p, out), x, p and out arrays of ParamJet. Null: interpreted.
+using CompiledParamJetFn = void (*)(const void* x, const void* p, void* out);
 struct CompiledPrograms {
   // [phase * 5 + ProgramKind][ScalarKind]; the anchor at [num_phases * 5 + kAnchor].
   std::vector<std::array<CompiledProgramFn, kNumScalarKinds>> entries;
+  // [phase * 5 + ProgramKind], like entries.
+  std::vector<CompiledParamJetFn> param_jet_entries;
   std::shared_ptr<void> library;  // keeps the loaded code alive
 };
 
@@ -91,6 +96,7 @@ struct ExpressionPhaseData {
   const ExpressionPhaseSpec* phase = nullptr;  // null for the anchor
   const double* parameters = nullptr;
   const std::array<CompiledProgramFn, kNumScalarKinds>* compiled[5] = {};
+  CompiledParamJetFn compiled_param_jets[5] = {};
 
   template <class T>
   void Run(ProgramKind kind, const T* x, T* out) const {
@@ -112,6 +118,12 @@ struct ExpressionJetData {
   const ExpressionPhaseData* base = nullptr;
   const S* parameters = nullptr;  // per-thread storage of the seeding block, valid until its next seeding
   void Run(ProgramKind kind, const S* x, S* out) const {
+    if constexpr (std::is_same_v<S, ParamJet>) {
+      if (CompiledParamJetFn fn = base->compiled_param_jets[static_cast<int>(kind)]) {
+        fn(x, parameters, out);
+        return;
+      }
+    }
     base->programs[static_cast<int>(kind)]->EvaluateWithParameterJets(x, parameters, out);
   }
 };

@@ -25,6 +25,11 @@ void BindPhaseData(ExpressionModelData* data) {
     if (!data->compiled) return nullptr;
     return &data->compiled->entries[5 * phase + static_cast<int>(kind)];
   };
+  const auto param_jet_entry = [&](int phase, ProgramKind kind) -> CompiledParamJetFn {
+    const std::size_t slot = 5 * phase + static_cast<int>(kind);
+    if (!data->compiled || slot >= data->compiled->param_jet_entries.size()) return nullptr;
+    return data->compiled->param_jet_entries[slot];
+  };
   data->phase_data.assign(m + 1, internal::ExpressionPhaseData{});
   for (int i = 0; i < m; ++i) {
     internal::ExpressionPhaseData& d = data->phase_data[i];
@@ -35,12 +40,16 @@ void BindPhaseData(ExpressionModelData* data) {
     d.programs[3] = &p.reset;
     d.phase = &p;
     d.parameters = data->values.data();
-    for (int k = 0; k < 4; ++k) d.compiled[k] = entry(i, static_cast<ProgramKind>(k));
+    for (int k = 0; k < 4; ++k) {
+      d.compiled[k] = entry(i, static_cast<ProgramKind>(k));
+      d.compiled_param_jets[k] = param_jet_entry(i, static_cast<ProgramKind>(k));
+    }
   }
   internal::ExpressionPhaseData& anchor = data->phase_data[m];
   anchor.programs[static_cast<int>(ProgramKind::kAnchor)] = &data->anchor;
   anchor.parameters = data->values.data();
   anchor.compiled[static_cast<int>(ProgramKind::kAnchor)] = entry(m, ProgramKind::kAnchor);
+  anchor.compiled_param_jets[static_cast<int>(ProgramKind::kAnchor)] = param_jet_entry(m, ProgramKind::kAnchor);
 }
 
 class ExpressionParameterBlock final : public ParameterBlock,

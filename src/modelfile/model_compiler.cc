@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <sstream>
 
@@ -59,6 +60,28 @@ std::string Operand(const ExpressionProgram::Operand& o) {
   return std::string(1, o.kind) + std::to_string(o.index);
 }
 
+// A program's register code and outputs over T, closing the function; first/second write a binary
+// operation's operands.
+void EmitRegisters(std::ostringstream& s, const ExpressionProgram& program,
+                   const std::function<std::string(const ExpressionProgram::Operand&)>& first,
+                   const std::function<std::string(const ExpressionProgram::Operand&)>& second) {
+  for (const auto& in : program.code()) {
+    s << "  const T r" << in.dst << " = ";
+    if (in.op == ExprOp::kInput) {
+      s << "x[" << in.a.index << "];\n";
+    } else if (in.b.index >= 0) {
+      s << "ApplyBinary<T>(ExprOp::" << OpName(in.op) << ", " << first(in.a) << ", " << second(in.b) << ");\n";
+    } else {
+      s << "ApplyUnary(ExprOp::" << OpName(in.op) << ", " << Operand(in.a) << ");\n";
+    }
+  }
+  for (int i = 0; i < program.num_outputs(); ++i) {
+    const auto& o = program.outputs()[i];
+    s << "  out[" << i << "] = " << (o.kind == 'r' ? Operand(o) : "T(" + Operand(o) + ")") << ";\n";
+  }
+  s << "}\n";
+}
+
 // One program as a function template `P<id>(x, p, out)`.
 void EmitProgram(std::ostringstream& s, const std::string& id, const ExpressionProgram& program) {
   s << "template <class T>\nvoid P" << id << "(const T* x, const double* p, T* out) {\n";
@@ -76,21 +99,54 @@ void EmitProgram(std::ostringstream& s, const std::string& id, const ExpressionP
         << (in.b.index >= 0 ? Operand(in.b) : std::string("0.0")) << ");\n";
     }
   }
-  for (const auto& in : program.code()) {
-    s << "  const T r" << in.dst << " = ";
-    if (in.op == ExprOp::kInput) {
-      s << "x[" << in.a.index << "];\n";
+  EmitRegisters(s, program, Operand, Operand);
+}
+
+// The same program with the parameters as jets too, `Q<id>(x, p, out)` over T = ParamJet: the operations of
+// ExpressionProgram::EvaluateWithParameterJets, instruction by instruction (a constant register that holds
+// no parameter, a literal, stays a double, so that x^2 is the exact product the interpreter forms).
+void EmitParamJetProgram(std::ostringstream& s, const std::string& id, const ExpressionProgram& program) {
+  s << "template <class T>\nvoid Q" << id << "(const T* x, const T* p, T* out) {\n";
+  s << "  (void)x; (void)p;\n";
+  std::vector<char> literal(program.constant_code().size() + program.code().size() + 64, 0);
+  const auto is_literal = [&](const ExpressionProgram::Operand& o) {
+    return o.kind == 'c' && o.index >= 0 && o.index < static_cast<int>(literal.size()) && literal[o.index];
+  };
+  const auto as_t = [&](const ExpressionProgram::Operand& o) {  // an operand as a T
+    return is_literal(o) ? "T(" + Operand(o) + ")" : Operand(o);
+  };
+  for (const auto& in : program.constant_code()) {
+    if (in.dst >= static_cast<int>(literal.size())) literal.resize(in.dst + 1, 0);
+    if (in.op == ExprOp::kParameter) {
+      literal[in.dst] = 0;
+      s << "  const T c" << in.dst << " = p[" << in.a.index << "];\n";
+    } else if (in.op == ExprOp::kConstant) {
+      literal[in.dst] = 1;
+      char buffer[64];
+      std::snprintf(buffer, sizeof buffer, "%a", in.value);
+      s << "  const double c" << in.dst << " = " << buffer << ";\n";
     } else if (in.b.index >= 0) {
-      s << "ApplyBinary<T>(ExprOp::" << OpName(in.op) << ", " << Operand(in.a) << ", " << Operand(in.b) << ");\n";
+      const bool a = is_literal(in.a), b = is_literal(in.b);
+      literal[in.dst] = a && b;
+      if (a && b) {
+        s << "  const double c" << in.dst << " = ApplyDouble(ExprOp::" << OpName(in.op) << ", " << Operand(in.a) << ", "
+          << Operand(in.b) << ");\n";
+      } else {
+        s << "  const T c" << in.dst << " = ApplyBinary<T>(ExprOp::" << OpName(in.op) << ", " << as_t(in.a) << ", "
+          << (b ? Operand(in.b) : as_t(in.b)) << ");\n";
+      }
     } else {
-      s << "ApplyUnary(ExprOp::" << OpName(in.op) << ", " << Operand(in.a) << ");\n";
+      literal[in.dst] = is_literal(in.a);
+      if (literal[in.dst]) {
+        s << "  const double c" << in.dst << " = ApplyDouble(ExprOp::" << OpName(in.op) << ", " << Operand(in.a)
+          << ", 0.0);\n";
+      } else {
+        s << "  const T c" << in.dst << " = ApplyUnary(ExprOp::" << OpName(in.op) << ", " << Operand(in.a) << ");\n";
+      }
     }
   }
-  for (int i = 0; i < program.num_outputs(); ++i) {
-    const auto& o = program.outputs()[i];
-    s << "  out[" << i << "] = " << (o.kind == 'r' ? Operand(o) : "T(" + Operand(o) + ")") << ";\n";
-  }
-  s << "}\n";
+  EmitRegisters(s, program, as_t,
+                [&](const ExpressionProgram::Operand& o) { return is_literal(o) ? Operand(o) : as_t(o); });
 }
 
 // Scalar types per kind for a phase of dimension n (expression_model.h, ScalarKind).
@@ -107,6 +163,7 @@ std::vector<std::pair<int, std::string>> ScalarTypes(int n, bool second_order) {
 }
 
 std::string EntryName(int slot, int kind) { return "hybridcont_model_" + std::to_string(slot) + "_" + std::to_string(kind); }
+std::string ParamJetEntryName(int slot) { return "hybridcont_model_" + std::to_string(slot) + "_param_jet"; }
 
 // FNV-1a, 64 bits: a stable name for the cache (not a security measure; the cache is the user's own).
 std::string Hash(const std::string& text) {
@@ -178,6 +235,10 @@ std::string GenerateModelSource(const ExpressionModelSpec& spec) {
       entries << "void " << EntryName(slot, kind) << "(const void* x, const double* p, void* out) { P" << id << "<"
               << type << ">(static_cast<const " << type << "*>(x), p, static_cast<" << type << "*>(out)); }\n";
     }
+    EmitParamJetProgram(s, id, program);
+    entries << "void " << ParamJetEntryName(slot) << "(const void* x, const void* p, void* out) { Q" << id
+            << "<ParamJet>(static_cast<const ParamJet*>(x), static_cast<const ParamJet*>(p), "
+            << "static_cast<ParamJet*>(out)); }\n";
   };
   for (int i = 0; i < m; ++i) {
     const ExpressionPhaseSpec& p = spec.phases[i];
@@ -254,7 +315,9 @@ std::shared_ptr<const CompiledPrograms> CompileModel(const ExpressionModelSpec& 
   });
   const int m = static_cast<int>(spec.phases.size());
   compiled->entries.resize(5 * m + 5);
+  compiled->param_jet_entries.resize(5 * m + 5);
   for (int slot = 0; slot < 5 * m + 5; ++slot) {
+    compiled->param_jet_entries[slot] = reinterpret_cast<CompiledParamJetFn>(dlsym(handle, ParamJetEntryName(slot).c_str()));
     for (int kind = 0; kind < kNumScalarKinds; ++kind) {
       compiled->entries[slot][kind] = reinterpret_cast<CompiledProgramFn>(dlsym(handle, EntryName(slot, kind).c_str()));
     }
