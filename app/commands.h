@@ -30,6 +30,7 @@ struct RunArguments {
   std::vector<std::string> assignments;
   std::vector<std::string> until;
   std::vector<std::string> bounds;     // NAME=LOWER:UPPER, replacing the model's bound on NAME
+  std::vector<std::string> monitors;   // OBSERVABLE=VALUE: located where the observable reaches VALUE
   std::string out_dir;
   std::optional<double> rtol;          // unset: library default
   std::optional<double> atol;

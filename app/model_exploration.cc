@@ -7,6 +7,7 @@
 #include "hybridcont/classification.h"
 #include "hybridcont/corrector.h"
 #include "hybridcont/floquet_test_functions.h"
+#include "hybridcont/observable_test_functions.h"
 #include "hybridcont/internal/enum_names.h"
 #include "hybridcont/period_doubling.h"
 
@@ -74,9 +75,10 @@ namespace {
 // its own: each stepper evaluates on its own thread). Each copy leaves its work in `sink` when destroyed.
 class EngineFloquetTests : public TestFunctions {
  public:
-  EngineFloquetTests(std::unique_ptr<TestFunctions> floquet, Vector scales, const StateBasedShooting* state,
-                     std::shared_ptr<ModelExploration::TestWorkSink> sink)
+  EngineFloquetTests(std::unique_ptr<TestFunctions> floquet, std::unique_ptr<TestFunctions> observables,
+                     Vector scales, const StateBasedShooting* state, std::shared_ptr<ModelExploration::TestWorkSink> sink)
       : floquet_(static_cast<FloquetTestFunctions*>(floquet.release())),  // Clone and Refined keep the type
+        observables_(std::move(observables)),
         scales_(std::move(scales)),
         state_prototype_(state),
         sink_(std::move(sink)) {
@@ -88,7 +90,15 @@ class EngineFloquetTests : public TestFunctions {
   }
   EngineFloquetTests(const EngineFloquetTests&) = delete;
   EngineFloquetTests& operator=(const EngineFloquetTests&) = delete;
-  std::vector<SpecialPointType> types() const override { return floquet_->types(); }
+  // The Floquet functions, then the observables' (monitors and constraints), if any.
+  std::vector<SpecialPointType> types() const override {
+    std::vector<SpecialPointType> types = floquet_->types();
+    if (observables_) {
+      const std::vector<SpecialPointType> more = observables_->types();
+      types.insert(types.end(), more.begin(), more.end());
+    }
+    return types;
+  }
   void Evaluate(const Vector& v, bool branch_point, Vector* values) override {
     Vector u;
     if (!TimeBased(v, &u)) {
@@ -96,16 +106,26 @@ class EngineFloquetTests : public TestFunctions {
       return;
     }
     floquet_->Evaluate(u, branch_point, values);
+    if (!observables_) return;
+    Vector more;
+    observables_->Evaluate(u, branch_point, &more);
+    values->conservativeResize(values->size() + more.size());
+    values->tail(more.size()) = more;
   }
   bool Keep(int function, const Vector& v, std::string* note) override {
     Vector u;
-    return !TimeBased(v, &u) || floquet_->Keep(function, u, note);
+    if (!TimeBased(v, &u)) return true;
+    const int floquet = static_cast<int>(floquet_->types().size());
+    return function < floquet ? floquet_->Keep(function, u, note) : observables_->Keep(function - floquet, u, note);
   }
   std::unique_ptr<TestFunctions> Clone() const override {
-    return std::make_unique<EngineFloquetTests>(floquet_->Clone(), scales_, state_prototype_, sink_);
+    return std::make_unique<EngineFloquetTests>(floquet_->Clone(), observables_ ? observables_->Clone() : nullptr,
+                                                scales_, state_prototype_, sink_);
   }
   std::unique_ptr<TestFunctions> Refined(double factor) const override {
-    return std::make_unique<EngineFloquetTests>(floquet_->Refined(factor), scales_, state_prototype_, sink_);
+    return std::make_unique<EngineFloquetTests>(floquet_->Refined(factor),
+                                                observables_ ? observables_->Refined(factor) : nullptr, scales_,
+                                                state_prototype_, sink_);
   }
   void AddCurveWork(const ZeroProblem& copy) override { sink_->AddCurveWork(copy); }
 
@@ -117,6 +137,7 @@ class EngineFloquetTests : public TestFunctions {
   }
 
   std::unique_ptr<FloquetTestFunctions> floquet_;
+  std::unique_ptr<TestFunctions> observables_;  // null: the model has no constraints and nothing is monitored
   Vector scales_;
   const StateBasedShooting* state_prototype_;  // the exploration's map, cloned per copy
   std::unique_ptr<StateBasedShooting> state_;
@@ -131,11 +152,12 @@ bool FromString(const std::string& text, Formulation* f) { return internal::Enum
 
 ModelExploration::ModelExploration(const HybridModel& model, const Scenario& scenario,
                                    const IntegratorOptions& integrator, ExplorationOptions options,
-                                   Formulation formulation, FreeParameters free)
+                                   Formulation formulation, FreeParameters free,
+                                   std::vector<std::pair<std::string, double>> monitors)
     : model_(model), scenario_(scenario), integrator_(integrator), formulation_(formulation),
       shooting_(model, integrator, free), options_(std::move(options)), time_options_(options_) {
-  if (!free.empty() && formulation_ == Formulation::kStateBased) {
-    throw std::invalid_argument("free parameters: the time-based formulation only");
+  if ((!free.empty() || !free.observables.empty()) && formulation_ == Formulation::kStateBased) {
+    throw std::invalid_argument("free parameters and observables as unknowns: the time-based formulation only");
   }
   if (const std::string why = options_.continuation.ValidateFor(shooting_.unknown_names()); !why.empty()) {
     throw std::invalid_argument(why);
@@ -190,8 +212,14 @@ ModelExploration::ModelExploration(const HybridModel& model, const Scenario& sce
   }
   if (const std::string why = options_.Validate(); !why.empty()) throw std::invalid_argument(why);
   test_work_ = std::make_shared<TestWorkSink>(base, scales);
-  c.test_functions = std::make_shared<EngineFloquetTests>(std::make_unique<FloquetTestFunctions>(model_, integrator_, true, shooting_.free_parameters()),
-                                                           scales, state_.get(), test_work_);
+  std::unique_ptr<TestFunctions> observable_tests;
+  if (!state_) {
+    auto tests = std::make_unique<ObservableTestFunctions>(model_, integrator_, shooting_.free_parameters(), monitors);
+    if (tests->size() > 0) observable_tests = std::move(tests);
+  }
+  c.test_functions = std::make_shared<EngineFloquetTests>(
+      std::make_unique<FloquetTestFunctions>(model_, integrator_, true, shooting_.free_parameters()),
+      std::move(observable_tests), scales, state_.get(), test_work_);
 }
 
 ZeroProblem& ModelExploration::problem() {
@@ -272,6 +300,7 @@ void ModelExploration::ToModelUnits(BifurcationDiagram* diagram) const {
 BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {
   ExplorationOptions options = EngineOptions(on_point);
   Vector start = scenario_.start;
+  if (!state_ && shooting_.layout().num_observables() > 0) start = shooting_.CompleteUnknowns(start);
   if (state_) {
     std::string why;
     const Vector physical = FindPhysicalStart(&why);
@@ -360,7 +389,11 @@ BifurcationDiagram ModelExploration::RunFromStarts(const std::vector<Vector>& st
   *skipped = 0;
   int started = 0;
   std::string failures;
-  for (const Vector& start : starts) {
+  for (Vector start : starts) {
+    // Starts without the observables that joined the unknowns get their values (shooting_layout.h).
+    if (start.size() == shooting_.num_unknowns() - shooting_.layout().num_observables()) {
+      start = shooting_.CompleteUnknowns(start);
+    }
     // A start whose image under a symmetry lies on a traced branch: its families are that branch's images,
     // which the exploration maps where it maps images (use_symmetries), so they are not traced twice.
     const std::vector<Symmetry> symmetries = options_.use_symmetries ? problem().symmetries() : std::vector<Symmetry>{};

@@ -53,7 +53,7 @@ class ModelExploration {
   // starts (RunFromStarts).
   ModelExploration(const HybridModel& model, const Scenario& scenario, const IntegratorOptions& integrator,
                    ExplorationOptions options, Formulation formulation = Formulation::kTimeBased,
-                   FreeParameters free = {});
+                   FreeParameters free = {}, std::vector<std::pair<std::string, double>> monitors = {});
 
   using PointCallback = std::function<void(const ProgressInfo& info, const Vector& u)>;
   // Explores from the start point; on_point sees every accepted point in model units and in the layout of

@@ -5,6 +5,7 @@
 
 #include "hybridcont/classification.h"
 #include "hybridcont/floquet.h"
+#include "hybridcont/orbit_observables.h"
 
 namespace hybridcont::app {
 
@@ -21,6 +22,22 @@ void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator,
   if (!ClassifyByUnknowns(model, u, ClassificationOptions{}, &record->classification)) {  // no trace needed
     const OrbitTrace trace(model, u, integrator);
     record->classification = ClassifyOrbit(model, u, trace, ClassificationOptions{});
+  }
+  // Observables: those that joined the unknowns from u, the others evaluated at the point.
+  const std::vector<Observable>& observables = model.observables();
+  if (!observables.empty()) {
+    const ShootingLayout& layout = floquet_map.layout();
+    ObservableEvaluator evaluator(model, layout, integrator);
+    for (int j = 0; j < static_cast<int>(observables.size()); ++j) {
+      const int k = layout.UnknownIndex(observables[j].name);
+      double value = std::nan("");
+      if (k >= 0) {
+        value = record->u(k);
+      } else if (!evaluator.Evaluate(j, record->u, &value, nullptr).ok) {
+        value = std::nan("");
+      }
+      record->observables.push_back({observables[j].name, value});
+    }
   }
   // Floquet data first: its r + dr evaluation leaves r in the map's cache, so the residual below costs no
   // second integration on physical points.

@@ -36,7 +36,7 @@ bool IsPhysical(const HybridModel& model, const Vector& u, const IntegratorOptio
 void SetFreeParameters(const ShootingLayout& layout, const Vector& u, HybridModel* model);
 // The orbit of a point u of `layout`: u without its free parameters (the model's own layout).
 inline Vector OrbitPart(const ShootingLayout& layout, const Vector& u) {
-  return u.head(layout.num_unknowns() - layout.num_free_parameters());
+  return u.head(layout.num_orbit_unknowns());
 }
 
 // Floquet multipliers, stability and the event-driven replay of a physical orbit. A physical point whose

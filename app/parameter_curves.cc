@@ -2,8 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <fstream>
+#include <map>
 
+#include "hybridcont/orbit_observables.h"
 #include "hybridcont/special_point_curve.h"
 #include "hybridcont/timebased_shooting.h"
 #include "orbit_analysis.h"
@@ -48,13 +51,70 @@ SpecialPoint OnBaseMap(const SpecialPoint& sp, double p0) {
   return point;
 }
 
+// A boundary of the physical families: where a phase duration or a constraint's interior minimum is 0.
+struct Boundary {
+  std::string name;        // "t2", "clearance"
+  bool observable = false; // a constraint (joins the unknowns) or a duration (an unknown already)
+};
+
+// The curve of orbits on a boundary in (H̄, p): the time-based map with p free, the boundary's quantity held
+// at 0 by a fixing row (a constraint joins the unknowns with its equation, shooting_layout.h), so that
+// r(u, p) = 0, q(u, p) = 0 is one curve. Regular where the family crosses the boundary transversally (q
+// changes sign along it, its gradient independent of dr's rows) — the defining system of a boundary, as a
+// fold's is r = 0 with a turning-point condition. Traced both ways from the corrected start.
+std::vector<Vector> TraceBoundary(const HybridModel& model, const RunSetup& setup, const Boundary& boundary,
+                                  const Vector& orbit, double p0, const ContinuationOptions& options,
+                                  std::vector<std::string>* names, std::string* why) {
+  const std::string& p = setup.curve_parameter;
+  TimeBasedShooting map(model, setup.integrator,
+                        FreeParameters{{p}, {{boundary.name, 0.0}},
+                                       boundary.observable ? std::vector<std::string>{boundary.name}
+                                                           : std::vector<std::string>{}});
+  *names = map.unknown_names();
+  Vector guess(map.num_unknowns() - map.layout().num_observables());
+  guess << orbit, p0;
+  const Vector start = map.layout().num_observables() > 0 ? map.CompleteUnknowns(guess) : guess;
+  std::vector<Vector> points;
+  for (const int direction : {-1, +1}) {
+    ContinuationOptions c = options;
+    c.direction = direction;
+    c.detect_bifurcations = false;
+    c.turning_point_components = {"H"};
+    const Branch half = TraceBranch(&map, start, c);
+    if (half.points.empty()) {
+      *why = half.message;
+      return {};
+    }
+    std::vector<Vector> us;
+    for (const ContinuationPoint& q : half.points) us.push_back(q.u);
+    if (direction < 0) {
+      points.assign(us.rbegin(), us.rend());
+    } else {
+      points.insert(points.end(), us.begin() + 1, us.end());
+    }
+  }
+  return points;
+}
+
+// Whether (H, p) of `u` lies on one of `curves` (within tol of a chord of its (H, p) polyline).
+bool OnCurve(const std::vector<std::vector<Eigen::Vector2d>>& curves, const Eigen::Vector2d& x, double tol) {
+  for (const auto& c : curves) {
+    for (std::size_t i = 0; i + 1 < c.size(); ++i) {
+      const Eigen::Vector2d d = c[i + 1] - c[i];
+      const double s = d.squaredNorm() > 0 ? std::clamp((x - c[i]).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+      if ((c[i] + s * d - x).norm() <= tol) return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
                                     const std::filesystem::path& dir, std::string* report) {
   const std::string& p = setup.curve_parameter;
   const double p0 = model.parameter(p);
-  TimeBasedShooting base(model, setup.integrator, FreeParameters{{p}, {{p, p0}}});
+  TimeBasedShooting base(model, setup.integrator, FreeParameters{{p}, {{p, p0}}, {}});
   const int fix_row = base.layout().fixed_row(0);
   SpecialPointCurveOptions options;
   ContinuationOptions& c = options.continuation;
@@ -106,6 +166,83 @@ nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& se
                            "points\n",
                            id, ToString(curve.kind), sp.id, sp.u(base.layout().H_index()), curve.points.size(),
                            ToString(curve.status), curve.codim_two_points.size());
+  }
+  // Boundaries of the physical families: a duration through 0 between two points of a branch with a
+  // physical side, and located constraint boundaries (CB). One curve per boundary and place.
+  const ShootingLayout layout(model);
+  std::map<std::string, std::vector<std::vector<Eigen::Vector2d>>> traced;
+  const auto trace = [&](const Boundary& boundary, const Vector& orbit, const std::string& from) {
+    std::vector<std::string> names;
+    std::string why;
+    std::vector<Vector> points;
+    try {
+      points = TraceBoundary(model, setup, boundary, orbit, p0, c, &names, &why);
+    } catch (const std::invalid_argument& e) {
+      why = e.what();
+    }
+    if (points.empty()) {
+      *report += fmt::format("  boundary {} = 0 from {}: not traced ({})\n", boundary.name, from, why);
+      return;
+    }
+    const int h = static_cast<int>(std::find(names.begin(), names.end(), "H") - names.begin());
+    const int q = static_cast<int>(std::find(names.begin(), names.end(), p) - names.begin());
+    std::vector<Eigen::Vector2d> polyline;
+    for (const Vector& u : points) polyline.emplace_back(u(h), u(q));
+    SpecialPointCurve curve;
+    curve.unknown_names = names;
+    curve.points = points;
+    const int id = static_cast<int>(curves.size());
+    const std::string file = "curve_" + std::to_string(id) + ".csv";
+    if (!WriteCurve(curve, p, dir / file)) throw std::runtime_error("writing " + (dir / file).string() + " failed");
+    curves.push_back({{"id", id},
+                      {"type", "boundary"},
+                      {"name", boundary.name + " = 0"},
+                      {"file", file},
+                      {"special_point", nullptr},
+                      {"status", "traced"},
+                      {"message", ""},
+                      {"points", points.size()},
+                      {"codim_two", nlohmann::json::array()}});
+    *report += fmt::format("  curve {} (boundary {} = 0) from {}: {} points, H in [{:.6f}, {:.6f}]\n", id,
+                           boundary.name, from, points.size(),
+                           std::min_element(polyline.begin(), polyline.end(),
+                                            [](const auto& a, const auto& b) { return a(0) < b(0); })->x(),
+                           std::max_element(polyline.begin(), polyline.end(),
+                                            [](const auto& a, const auto& b) { return a(0) < b(0); })->x());
+    traced[boundary.name].push_back(std::move(polyline));
+  };
+  const double tol = 1e-3 * (1 + std::abs(p0));
+  for (const Branch& b : diagram.branches) {
+    if (b.image_of >= 0) continue;  // an image's boundaries are the images of its source's
+    for (std::size_t i = 0; i + 1 < b.points.size(); ++i) {
+      const Vector ua = b.points[i].u.head(layout.num_unknowns()), ub = b.points[i + 1].u.head(layout.num_unknowns());
+      for (int s = 0; s < layout.num_segments(); ++s) {
+        const double ta = ua(layout.time_index(s)), tb = ub(layout.time_index(s));
+        if (!(ta * tb < 0)) continue;
+        if (!IsPhysical(model, ua, setup.integrator) && !IsPhysical(model, ub, setup.integrator)) continue;
+        const Vector orbit = ua + (ta / (ta - tb)) * (ub - ua);
+        const std::string name = "t" + std::to_string(s + 1);
+        if (OnCurve(traced[name], Eigen::Vector2d(orbit(layout.H_index()), p0), tol)) continue;
+        trace({name, false}, orbit, fmt::format("branch {} between points {} and {}", b.id, i, i + 1));
+      }
+    }
+  }
+  for (const SpecialPoint& sp : diagram.special_points) {
+    if (sp.type != SpecialPointType::kConstraintBoundary || sp.duplicate_of >= 0 || sp.u.size() == 0) continue;
+    // The constraint whose interior minimum vanishes there.
+    ObservableEvaluator evaluator(model, layout, setup.integrator);
+    const Vector u = sp.u.head(layout.num_unknowns());
+    int best = -1;
+    double smallest = 1e-6;
+    for (int j = 0; j < static_cast<int>(model.observables().size()); ++j) {
+      double v = 0;
+      if (!model.observables()[j].constraint || !evaluator.Evaluate(j, u, &v, nullptr).ok) continue;
+      if (evaluator.last_extremum_interior() && std::abs(v) < smallest) best = j, smallest = std::abs(v);
+    }
+    if (best < 0) continue;
+    const std::string& name = model.observables()[best].name;
+    if (OnCurve(traced[name], Eigen::Vector2d(sp.u(layout.H_index()), p0), tol)) continue;
+    trace({name, true}, sp.u.head(layout.num_unknowns()), fmt::format("special point {} (CB)", sp.id));
   }
   if (curves.empty()) *report += "  none\n";
   return curves;

@@ -10,8 +10,15 @@
 // run's diagram becomes a point of that map by appending p0. PD curves need a PD test function of the
 // library and are not traced.
 //
-// summary.json: "curves": [{"id", "type" ("fold" | "branch-point"), "file", "special_point", "status",
-// "points", "termination": [backward, forward], "codim_two": [{"type", "name", "status", "H", p}]}].
+// Boundaries of the physical families are traced too: where a physical family's phase duration t_i passes 0
+// (between two branch points) and where it crosses a constraint's boundary (a located CB point), the map
+// with p free and that quantity held at 0 (a constraint joins the unknowns: shooting_layout.h) is a curve
+// in (H̄, p) — the boundary of the region where the family exists and is physical. One curve per boundary
+// quantity and place (a start on a traced curve of the same quantity is skipped).
+//
+// summary.json: "curves": [{"id", "type" ("fold" | "branch-point" | "boundary"), "file", "special_point"
+// (null for a boundary), "name" (a boundary's "t2 = 0", "clearance = 0"), "status", "points", "termination":
+// [backward, forward], "codim_two": [{"type", "name", "status", "H", p}]}].
 // curve_<n>.csv: H, p, then the other curve unknowns (those of the map, and beta for branch points).
 #ifndef HYBRIDCONT_APP_PARAMETER_CURVES_H_
 #define HYBRIDCONT_APP_PARAMETER_CURVES_H_

@@ -1,10 +1,12 @@
 #include "parameter_starts.h"
 
-#include <algorithm>
-
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "hybridcont/corrector.h"
+#include "hybridcont/orbit_observables.h"
 #include "model_exploration.h"
 #include "orbit_analysis.h"
 
@@ -18,7 +20,17 @@ ParameterStarts FindParameterStarts(const HybridModel& model, const RunSetup& se
   const std::vector<std::string>& names = free_layout.unknown_names();
   const int h = static_cast<int>(std::find(names.begin(), names.end(), fixed) - names.begin());
   const int p = free_layout.parameter_index(0);
-  const int n = ShootingLayout(model).num_unknowns();
+  const ShootingLayout base(model);
+  const int n = base.num_unknowns();
+  // The fixed unknown's value at a point of the ordinary run: an entry of u, or an observable evaluated there.
+  const int observable = model.FindObservable(fixed);
+  ObservableEvaluator evaluator(model, base, setup.integrator);
+  const auto value_at = [&](const Vector& u) {
+    if (observable < 0) return u(h);
+    double v = std::nan("");
+    if (!evaluator.Evaluate(observable, u, &v, nullptr).ok) v = std::nan("");
+    return v;
+  };
   const double c = setup.free.fixed.front().second;
   // A duration held at 0 is the boundary where that phase vanishes: its crossings leave the physical
   // family (the points there are zero-duration orbits), so one physical side suffices.
@@ -33,13 +45,14 @@ ParameterStarts FindParameterStarts(const HybridModel& model, const RunSetup& se
   for (const Branch& b : diagram.branches) {
     for (std::size_t i = 0; i + 1 < b.points.size(); ++i) {
       const Vector &ua = b.points[i].u, &ub = b.points[i + 1].u;
-      const double da = ua(h) - c, db = ub(h) - c;
-      if (da * db > 0 || da == db || db == 0) continue;  // a point exactly at c counts once, as the chord's start
+      const double da = value_at(ua) - c, db = value_at(ub) - c;
+      if (!(da * db <= 0) || da == db || db == 0) continue;  // NaN: the observable is undefined there  // a point exactly at c counts once, as the chord's start
       const bool pa = IsPhysical(model, ua, setup.integrator), pb = IsPhysical(model, ub, setup.integrator);
       if (boundary ? !(pa || pb) : !(pa && pb)) continue;
       ++starts.crossings;
-      Vector guess(free_layout.num_unknowns());
+      Vector guess(free_layout.num_unknowns() - free_layout.num_observables());
       guess << ua + (da / (da - db)) * (ub - ua), p0;
+      if (free_layout.num_observables() > 0) guess = free_map.CompleteUnknowns(guess);
       Vector u;
       const CorrectorResult result = corrector.CorrectFixedComponent(guess, p, p0, &u);
       if (!result.converged() || (!boundary && !IsPhysical(model, u.head(n), setup.integrator))) continue;

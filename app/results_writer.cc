@@ -55,6 +55,16 @@ void ResultsWriter::PrepareDirectory(const fs::path& dir, const std::string& mod
 namespace {
 
 // What the figure script needs to know of the model's presentation (model_setup.h).
+// The model's observables and constraints: name, kind, whether a constraint (>= 0), description.
+nlohmann::json ObservablesJson(const HybridModel& model) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const Observable& o : model.observables()) {
+    list.push_back({{"name", o.name}, {"kind", ToString(o.kind)}, {"constraint", o.constraint},
+                    {"description", o.description}});
+  }
+  return list;
+}
+
 nlohmann::json PresentationJson(const HybridModel& model, const OrbitPresentation& presentation,
                                 const FreeParameters& free) {
   const ModelSetup& setup = model.setup();
@@ -71,6 +81,7 @@ nlohmann::json PresentationJson(const HybridModel& model, const OrbitPresentatio
   }
   return {{"title", setup.title.empty() ? model.name() : setup.title},
           {"quantities", presentation.quantity_names()},
+          {"observables", ObservablesJson(model)},
           {"families", presentation.family_names()},
           {"figures", figures},
           {"drawing",
@@ -169,6 +180,7 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
     f << ",physical,classification,stability,residual,newton_iterations,step";
     for (const auto& [name, value] : p.extra) f << "," << name;
     for (const std::string& name : presentation.quantity_names()) f << "," << name;
+    for (const auto& [name, value] : p.observables) f << "," << name;
     f << "\n";
   }
   std::ofstream& f = it->second;
@@ -188,7 +200,11 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
     if (std::isfinite(value)) f << fmt::format(",{:.10g}", value);
     else f << ",";  // not defined for this point (e.g. Floquet data of a non-physical orbit)
   }
-  for (const double value : presentation.Quantities(u.head(u.size() - layout.num_free_parameters()))) {
+  for (const double value : presentation.Quantities(u.head(layout.num_orbit_unknowns()))) {
+    if (std::isfinite(value)) f << fmt::format(",{:.17g}", value);
+    else f << ",";
+  }
+  for (const auto& [name, value] : p.observables) {
     if (std::isfinite(value)) f << fmt::format(",{:.17g}", value);
     else f << ",";
   }

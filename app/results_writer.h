@@ -56,6 +56,9 @@ struct PointRecord {
   double step = 0.0;
   // Extra named columns appended after the fixed ones (e.g. Floquet data); same names for every row.
   std::vector<std::pair<std::string, double>> extra;
+  // The model's observables and constraints at the point (observable.h), written after the quantities; NaN
+  // where one is undefined (a mean over zero durations, a failed integration).
+  std::vector<std::pair<std::string, double>> observables;
 };
 
 // The record of an accepted point u before its analysis: index, Newton iterations and step from `info`.

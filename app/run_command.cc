@@ -52,8 +52,11 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
                ->required());
   NonEmpty(run->add_option("--set", args->assignments, "override a model parameter, NAME=VALUE (repeatable)"));
   NonEmpty(run->add_option("--until", args->until,
-                           "end every branch exactly where a component of u reaches a value, NAME=VALUE, e.g. H=2 "
-                           "(repeatable)"));
+                           "end every branch exactly where an unknown or an observable of the model reaches a value, "
+                           "NAME=VALUE, e.g. H=2 or speed=1 (repeatable)"));
+  NonEmpty(run->add_option("--monitor", args->monitors,
+                           "locate the points where an observable of the model reaches a value, NAME=VALUE, e.g. "
+                           "speed=0.5 (repeatable; special points UZ)"));
   NonEmpty(run->add_option("--bound", args->bounds,
                            "replace the model's bound on an unknown, NAME=LOWER:UPPER (e.g. H=0:2.7; 'period' is the "
                            "sum of the durations; an empty end is unbounded) (repeatable)"));
@@ -69,8 +72,8 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
   NonEmpty(run->add_option("--free", args->free,
                            "continue the families in a model parameter instead of H, e.g. k (needs --fix)"));
   NonEmpty(run->add_option("--fix", args->fix,
-                           "the unknown held fixed while --free varies, NAME=VALUE: H=1.5, a state x2_dx=0.8, or a "
-                           "duration t2=0 (where that phase vanishes); starts are the physical families' crossings "
+                           "the unknown held fixed while --free varies, NAME=VALUE: H=1.5, a state x2_dx=0.8, a "
+                           "duration t2=0 (where that phase vanishes) or an observable speed=1; starts are the physical families' crossings "
                            "of that value in the ordinary run"));
   NonEmpty(run->add_option("--curves", args->curves,
                            "after the run, continue every turning and SB point of the physical families in (H, "
@@ -342,7 +345,7 @@ std::unique_ptr<ModelExploration> MakeExploration(const RunArguments& args, cons
                                                   const RunSetup& setup, Formulation formulation) {
   try {
     return std::make_unique<ModelExploration>(model, setup.scenario, setup.integrator, setup.exploration, formulation,
-                                              setup.free);
+                                              setup.free, setup.monitors);
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(std::string(args.until.empty() && args.bounds.empty() ? "" : "--until/--bound: ") +
                                 e.what());
@@ -377,6 +380,9 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   if (!args.free.empty() && formulation == Formulation::kStateBased) {
     throw std::invalid_argument("--formulation state: --free '" + args.free +
                                 "' needs the time-based formulation (the state-based map has no free parameters)");
+  }
+  if (!args.monitors.empty() && formulation == Formulation::kStateBased) {
+    throw std::invalid_argument("--monitor: needs the time-based formulation");
   }
   if (!args.free.empty() && args.period_doubling) {
     throw std::invalid_argument("--period-doubling: not with --free '" + args.free + "'");

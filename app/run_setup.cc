@@ -144,7 +144,7 @@ void ApplyFreeParameter(const RunArguments& args, const HybridModel& model, RunS
       throw std::invalid_argument(fmt::format("--free '{}': model '{}' has no parameter derivatives", parameter,
                                               model.name()));
     }
-    setup->free = FreeParameters{{parameter}, {}};
+    setup->free = FreeParameters{{parameter}, {}, {}};
     const double v = model.parameter(parameter);
     setup->scenario.unknown_scales.push_back({parameter, v != 0 ? std::abs(v) : 1.0});
     const bool bounded = std::any_of(setup->exploration.continuation.bounds.begin(),
@@ -172,13 +172,16 @@ void ApplyFreeParameter(const RunArguments& args, const HybridModel& model, RunS
   // where that phase vanishes, a boundary of the physical families), a state component (x1_dx=1.2: the
   // families at one apex speed).
   const std::vector<std::string> names = ShootingLayout(model).unknown_names();
-  if (std::find(names.begin(), names.end(), name) == names.end() || name == "xi") {
+  const bool observable = model.FindObservable(name) >= 0;
+  if (!observable && (std::find(names.begin(), names.end(), name) == names.end() || name == "xi")) {
     std::string known;
     for (const std::string& n : names) known += n == "xi" ? "" : (known.empty() ? "" : ", ") + n;
-    throw std::invalid_argument("--fix '" + args.fix + "': '" + name + "' is not an unknown of model '" + model.name() +
-                                "' that can be held fixed (" + known + ")");
+    for (const Observable& o : model.observables()) known += ", " + o.name;
+    throw std::invalid_argument("--fix '" + args.fix + "': '" + name + "' is not an unknown or observable of model '" +
+                                model.name() + "' that can be held fixed (" + known + ")");
   }
-  setup->free = FreeParameters{{args.free}, {{name, value}}};
+  setup->free = FreeParameters{{args.free}, {{name, value}}, {}};
+  if (observable) setup->free.observables.push_back(name);
   ContinuationOptions& seed = setup->seed_exploration.continuation;
   for (ComponentBound& b : seed.bounds) {
     if (b.component == "H" && !(value >= b.lower && value <= b.upper)) {
@@ -191,6 +194,31 @@ void ApplyFreeParameter(const RunArguments& args, const HybridModel& model, RunS
   setup->scenario.bounds.push_back(DefaultParameterBound(model, args.free));
   setup->exploration.continuation.bounds.push_back(setup->scenario.bounds.back());
   setup->exploration.start_conditions.clear();  // the starts are regular points of the families
+}
+
+// Observables named by --until, --bound and --monitor join the map's unknowns (shooting_layout.h,
+// "Observables"), in the order named; --monitor names observables only.
+void ApplyObservables(const RunArguments& args, const HybridModel& model, RunSetup* setup) {
+  RefuseRepeats("--monitor", args.monitors);
+  const auto join = [&](const std::string& name) {
+    if (model.FindObservable(name) < 0) return;
+    std::vector<std::string>& joined = setup->free.observables;
+    if (std::find(joined.begin(), joined.end(), name) == joined.end()) joined.push_back(name);
+  };
+  for (const std::string& text : args.until) join(ParseAssignment("--until", text).first);
+  for (const std::string& text : args.bounds) join(ParseBound("--bound", text).name);
+  for (const std::string& text : args.monitors) {
+    const auto [name, value] = ParseAssignment("--monitor", text);
+    if (model.FindObservable(name) < 0) {
+      std::string known;
+      for (const Observable& o : model.observables()) known += (known.empty() ? "" : ", ") + o.name;
+      throw std::invalid_argument("--monitor '" + text + "': '" + name + "' is not an observable of model '" +
+                                  model.name() + "' (" + (known.empty() ? "it declares none" : "observables: " + known) +
+                                  ")");
+    }
+    join(name);
+    setup->monitors.push_back({name, value});
+  }
 }
 
 // --curves: the parameter and its bound (taken out of --bound, whose other names are the run's unknowns).
@@ -231,6 +259,7 @@ RunSetup MakeRunSetup(const RunArguments& given, const HybridModel& model) {
   ApplyCurveParameter(given, model, &args, &setup);
   ApplyExplorationLimits(args, &setup.exploration);
   ApplyFreeParameter(args, model, &setup);
+  ApplyObservables(args, model, &setup);
   ApplyTargetsAndBounds(args, model, &setup.exploration.continuation);
   WidenBoundsToTargets(args, &setup.exploration.continuation);
   return setup;

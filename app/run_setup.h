@@ -20,6 +20,8 @@ struct RunSetup {
   // --free/--fix: the parameter continued as an unknown and the unknown held fixed (empty: families in H).
   // exploration's bounds, targets and scales then include the parameter.
   FreeParameters free;
+  // --monitor: observables and the values at which their crossings are located (UZ points).
+  std::vector<std::pair<std::string, double>> monitors;
   // The options of the ordinary run in H that gives the starts of a run with free parameters (its
   // families' crossings of the fixed value): the scenario's, with --max-branches, --threads, --no-symmetry
   // and an H bound that contains the fixed value.

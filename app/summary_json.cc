@@ -18,6 +18,8 @@ std::string SpecialPointTypeCode(SpecialPointType type) {
     case SpecialPointType::kUserTestFunction: return "test";
     case SpecialPointType::kGrazing: return "GR";
     case SpecialPointType::kNeimarkSacker: return "NS";
+    case SpecialPointType::kObservableValue: return "UZ";
+    case SpecialPointType::kConstraintBoundary: return "CB";
   }
   return "?";
 }
@@ -100,6 +102,10 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
     if (sp.u.size() == layout.num_unknowns()) {
       for (int i = 0; i < layout.num_free_parameters(); ++i) {
         j[layout.unknown_names()[layout.parameter_index(i)]] = sp.u(layout.parameter_index(i));
+      }
+      // And each observable that joined the unknowns, e.g. "speed": 0.5.
+      for (int i = 0; i < layout.num_observables(); ++i) {
+        j[layout.unknown_names()[layout.observable_index(i)]] = sp.u(layout.observable_index(i));
       }
     }
     list.push_back(j);

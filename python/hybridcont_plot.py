@@ -1088,8 +1088,10 @@ def figure_curves(res, svg, written):
         with open(os.path.join(res.dir, c["file"]), newline="") as f:
             rows = list(csv.DictReader(f))
         xs, ys = [to_float(r.get(p)) for r in rows], [to_float(r.get("H")) for r in rows]
-        ax.plot(xs, ys, color=branch_colour(pos), lw=1.6,
-                label="%s from special point %s" % (c.get("type"), c.get("special_point")))
+        boundary = c.get("type") == "boundary"
+        ax.plot(xs, ys, color="0.25" if boundary else branch_colour(pos), lw=1.6, ls="--" if boundary else "-",
+                label="boundary %s" % c.get("name") if boundary
+                else "%s from special point %s" % (c.get("type"), c.get("special_point")))
         for q in c.get("codim_two") or []:
             ax.plot([to_float(q.get(p))], [to_float(q.get("H"))], "k*", ms=8)
     ax.set_xlabel(axis_label(p), fontsize=9)

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
@@ -49,6 +50,18 @@ std::map<std::string, std::vector<double>> ReadColumns(const fs::path& file) {
 nlohmann::json ReadSummary(const fs::path& dir) {
   std::ifstream f(dir / "summary.json");
   return nlohmann::json::parse(f);
+}
+
+// |r| of the built-in SLIP's map at stiffness k at the orbit of a branch file's row (infinite if it does not
+// evaluate): an independent check of a model file's or a free-parameter run's points.
+double BuiltinSlipResidual(const std::map<std::string, std::vector<double>>& columns, std::size_t row, double k) {
+  HybridModel at_k = MakeBuiltinModel("slip");
+  at_k.SetParameter("k", k);
+  TimeBasedShooting map(at_k, IntegratorOptions{});
+  const ShootingLayout& layout = map.layout();
+  Vector u(layout.num_unknowns()), res;
+  for (int j = 0; j < layout.num_unknowns(); ++j) u(j) = columns.at(layout.unknown_names()[j])[row];
+  return map.Evaluate(u, &res, nullptr).ok ? res.norm() : std::numeric_limits<double>::infinity();
 }
 
 // Hopping in place at H̄ = 1.5 continued in k over [15, 100]: the branches whose orbits all have zero
@@ -113,8 +126,6 @@ TEST(CliParameters, SlipAtFixedFlightSpeedInStiffness) {
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json summary = ReadSummary(dir);
   EXPECT_EQ(summary["options"]["fixed"]["x2_dx"], 0.8);
-  const ShootingLayout layout(MakeBuiltinModel("slip"));
-  const std::vector<std::string> names = layout.unknown_names();
   int points = 0;
   double worst_speed = 0, worst_residual = 0, k_min = 1e300, k_max = -1e300, H_min = 1e300, H_max = -1e300;
   for (const nlohmann::json& b : summary["branches"]) {
@@ -122,13 +133,7 @@ TEST(CliParameters, SlipAtFixedFlightSpeedInStiffness) {
     for (std::size_t row = 0; row < columns.at("k").size(); ++row) {
       const double k = columns.at("k")[row], H = columns.at("H")[row];
       worst_speed = std::max(worst_speed, std::abs(columns.at("x2_dx")[row] - 0.8));
-      HybridModel at_k = MakeBuiltinModel("slip");
-      at_k.SetParameter("k", k);
-      TimeBasedShooting map(at_k, IntegratorOptions{});
-      Vector u(layout.num_unknowns()), res;
-      for (int j = 0; j < layout.num_unknowns(); ++j) u(j) = columns.at(names[j])[row];
-      ASSERT_TRUE(map.Evaluate(u, &res, nullptr).ok);
-      worst_residual = std::max(worst_residual, res.norm());
+      worst_residual = std::max(worst_residual, BuiltinSlipResidual(columns, row, k));
       k_min = std::min(k_min, k), k_max = std::max(k_max, k), H_min = std::min(H_min, H), H_max = std::max(H_max, H);
       ++points;
     }
@@ -175,6 +180,81 @@ TEST(CliParameters, SlipFirstSbCurveInSwingFrequencyMatchesTheClosedForm) {
   RecordProperty("worst_deviation_from_closed_form", text);
   RecordProperty("points", static_cast<int>(w2.size()));
   EXPECT_TRUE(fs::exists(dir / "curves.png") || !r.err.empty());  // drawn where Python and matplotlib exist
+}
+
+// The SLIP's mean forward speed from the unknowns of an orbit alone: the body moves by −l sin α relative to
+// the foot in stance (lift-off at l = l0 with the flight's α, touch-down state x̄_3, the nadir terms cancel)
+// and by dx·t2 in flight; independent of the tool's quadrature.
+double SlipSpeedFromUnknowns(const std::map<std::string, std::vector<double>>& c, std::size_t row) {
+  const double stride = -std::sin(c.at("x2_alpha")[row]) + c.at("x3_l")[row] * std::sin(c.at("x3_alpha")[row]) +
+                        c.at("x2_dx")[row] * c.at("t2")[row];
+  return stride / c.at("T")[row];
+}
+
+// models/slip.toml's observable `speed` (mean forward speed) as a target: every branch that reaches it ends
+// on it, and the speed computed from that orbit's unknowns agrees; `--monitor apex=1.2` locates UZ points.
+TEST(CliParameters, SlipModelFileRunsUntilAMeanSpeed) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_cli_until_speed";
+  const std::string file = std::string(HYBRIDCONT_SOURCE_DIR) + "/models/slip.toml";
+  const CliResult r = RunTool({"run", file, "--until", "speed=0.5", "--monitor", "apex=1.2", "--out", dir.string(),
+                               "--quiet", "--no-plots", "--threads", "1", "--overwrite"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json summary = ReadSummary(dir);
+  int reached = 0;
+  double worst_target = 0, worst_independent = 0;
+  for (const nlohmann::json& b : summary["branches"]) {
+    const auto columns = ReadColumns(dir / b["file"].get<std::string>());
+    ASSERT_TRUE(columns.count("speed") && columns.count("apex") && columns.count("stride")) << b["file"];
+    if (b["termination"] != "target-reached") continue;
+    const std::size_t last = columns.at("speed").size() - 1;
+    worst_target = std::max(worst_target, std::abs(columns.at("speed")[last] - 0.5));
+    worst_independent = std::max(worst_independent, std::abs(SlipSpeedFromUnknowns(columns, last) - 0.5));
+    ++reached;
+  }
+  EXPECT_GE(reached, 2);  // forward hopping, and its mirror image traced too
+  EXPECT_LT(worst_target, 1e-10);
+  EXPECT_LT(worst_independent, 1e-9);
+  int uz = 0;
+  double worst_apex = 0;
+  for (const nlohmann::json& sp : summary["special_points"]) {
+    if (sp["type"] != "UZ") continue;
+    ++uz;
+    worst_apex = std::max(worst_apex, std::abs(sp["apex"].get<double>() - 1.2));
+  }
+  EXPECT_GE(uz, 1);
+  EXPECT_LT(worst_apex, 1e-9);
+  std::printf("until speed = 0.5: %d branches reached it, |speed - 0.5| <= %.1e (from the unknowns %.1e); %d UZ "
+              "points at apex 1.2 (%.1e)\n", reached, worst_target, worst_independent, uz, worst_apex);
+}
+
+// A family held at a fixed mean forward speed while the leg stiffness varies: `--free k --fix speed=0.5`.
+TEST(CliParameters, SlipModelFileAtFixedMeanSpeedInStiffness) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_cli_fix_mean_speed";
+  const std::string file = std::string(HYBRIDCONT_SOURCE_DIR) + "/models/slip.toml";
+  const CliResult r = RunTool({"run", file, "--free", "k", "--fix", "speed=0.5", "--bound", "k=15:100", "--out",
+                               dir.string(), "--quiet", "--no-plots", "--threads", "1", "--overwrite"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json summary = ReadSummary(dir);
+  int points = 0;
+  double worst_speed = 0, worst_independent = 0, worst_residual = 0, k_min = 1e300, k_max = -1e300;
+  for (const nlohmann::json& b : summary["branches"]) {
+    const auto columns = ReadColumns(dir / b["file"].get<std::string>());
+    for (std::size_t row = 0; row < columns.at("k").size(); ++row) {
+      const double k = columns.at("k")[row];
+      worst_speed = std::max(worst_speed, std::abs(columns.at("speed")[row] - 0.5));
+      worst_independent = std::max(worst_independent, std::abs(SlipSpeedFromUnknowns(columns, row) - 0.5));
+      worst_residual = std::max(worst_residual, BuiltinSlipResidual(columns, row, k));
+      k_min = std::min(k_min, k), k_max = std::max(k_max, k);
+      ++points;
+    }
+  }
+  EXPECT_GE(points, 20);
+  EXPECT_LT(worst_speed, 1e-12);
+  EXPECT_LT(worst_independent, 1e-9);
+  EXPECT_LT(worst_residual, 1e-9);
+  EXPECT_GT(k_max - k_min, 10.0);
+  std::printf("SLIP at mean speed 0.5: %d points, k in [%.3f, %.3f]; speed off by %.1e (from the unknowns %.1e), "
+              "residual %.1e\n", points, k_min, k_max, worst_speed, worst_independent, worst_residual);
 }
 
 }  // namespace

@@ -34,6 +34,7 @@ enum class OrbitClass {
   kMissedAnchor,     // the anchor was crossed earlier in the return segment
   kIntegrationFailed,
   kReplayFailed,     // passed every check on u, but event-driven re-simulation from x̄_1 does not return
+  kConstraintViolated,  // an admissibility constraint of the model (observable.h) is negative
 };
 // Short hyphenated words used in the CSV files ("physical", "reversed-time", ...).
 std::string ToString(OrbitClass c);
@@ -45,6 +46,10 @@ struct ClassificationOptions {
   double duration_tolerance = 1e-7;
   // Normalized crossing speed (de·f) / (|de| |f|) above -this counts as grazing.
   double grazing_tolerance = 1e-6;
+  // An admissibility constraint below -this is violated: its minimum is computed to the integrator's
+  // tolerance (1e-10), and a constraint that is 0 at the ends of its phase (a foot clearance) must not
+  // flip with the noise there.
+  double constraint_tolerance = 1e-8;
   // Least interpolant evaluations per integrator step when searching earlier crossings (more where the
   // state moves fast: no component moves by more than 0.02 between samples).
   int samples_per_step = 8;

@@ -6,9 +6,11 @@
 //
 // Checked, at num_points random (seeded) points per phase: df/dx, de/dx, dDelta/dx, dH/dx (against FD
 // of H), d2H/dx2 (against FD of dH), the anchor's da/dx, the flow sensitivities Phi = dphi/dx0 and
-// Psi = dphi/dxi (durations drawn from [-max_duration, max_duration], xi != 0) and the Jacobian dr of
+// Psi = dphi/dxi (durations drawn from [-max_duration, max_duration], xi != 0), the Jacobian dr of
 // the time-based shooting map at random u, and every declared symmetry S of the model at the same u:
-// |r(S u)| = |r(u)| and |dr(S u) S| = |dr(u)| componentwise (model.h, ModelSymmetry). States are drawn around each phase's typical state.
+// |r(S u)| = |r(u)| and |dr(S u) S| = |dr(u)| componentwise (model.h, ModelSymmetry), and the gradient of
+// every observable and constraint (observable.h) at random u. States are drawn around each phase's
+// typical state.
 //
 // Error measure per derivative and point: max_ij |J_ij - FD_ij| / max(max_ij |J_ij|, 1e-8), i.e.
 // relative to the largest entry, so that structurally small entries (r^2 terms of the rod) still count

@@ -48,6 +48,7 @@ struct ExpressionModelSpec {
   std::vector<ExpressionPhaseSpec> phases;
   ExpressionProgram anchor;  // over the first phase's states
   std::vector<ModelSymmetry> symmetries;
+  std::vector<Observable> observables;  // and admissibility constraints (observable.h)
   ModelSetup setup;
 };
 

@@ -26,6 +26,7 @@
 
 #include "hybridcont/invariant.h"
 #include "hybridcont/model_setup.h"
+#include "hybridcont/observable.h"
 #include "hybridcont/types.h"
 
 namespace hybridcont {
@@ -250,6 +251,15 @@ class HybridModel {
   // not match the phases (count, dimension, entries ±1) or the name is empty or taken.
   void AddSymmetry(ModelSymmetry symmetry);
 
+  // Declared observables and admissibility constraints (observable.h), in declaration order.
+  const std::vector<Observable>& observables() const { return observables_; }
+  // Index of the named observable, or -1.
+  int FindObservable(const std::string& name) const;
+  // Adds one; throws std::invalid_argument naming it when the name is empty, taken (by an observable, a
+  // parameter or an unknown of the time-based layout), the function of its kind is missing, or a
+  // constraint is not a minimum.
+  void AddObservable(Observable observable);
+
  private:
   int ParameterIndex(const std::string& name) const;
 
@@ -259,6 +269,7 @@ class HybridModel {
   std::vector<std::unique_ptr<Phase>> phases_;
   std::unique_ptr<Anchor> anchor_;
   std::vector<ModelSymmetry> symmetries_;
+  std::vector<Observable> observables_;
   ModelSetup setup_;
 };
 

@@ -20,6 +20,14 @@
 // others. A parameter is named as in the model ("k"); any unknown may be fixed ("H", "t2", "x1_l", "xi").
 // Without free parameters the layout is the paper's.
 //
+// Observables (observable.h). A model's observables named in FreeParameters::observables join the problem as
+// COCO joins monitor functions: each adds an unknown o_j, after the free parameters, and an equation
+// o_j − g_j(v, p) = 0, after the fixing rows, so that it can be held fixed (a fixing row on o_j: `--fix
+// speed=1 --free k`), bounded or reached like any unknown; its Jacobian row is g_j's exact gradient
+// (orbit_observables.h). Unnamed observables cost nothing; they are evaluated at branch points for outputs.
+//
+//   u = [ ... | p_1..p_q | o_1..o_s ]      r = [ ... | fixing rows | o_1 − g_1 .. o_s − g_s ]
+//
 // Models without a first integral (k = 0: dissipative or forced systems, a passive walker) have no
 // unfolding and no level: u = [ segments | p_1..p_q ], r = [ blocks | fixing rows ], and the first free
 // parameter carries the family (q = number of fixed unknowns + 1). H_index() is then -1; level_index() is
@@ -27,7 +35,7 @@
 // square (an isolated orbit at fixed parameters) and has no level_index().
 //
 // Names (used as CSV column headers and to address components): "t1".."t<m+1>", "x<i>_<state>" (e.g.
-// "x2_dx"), "xi" (or "xi1".."xik"), "H", then the free parameters' names.
+// "x2_dx"), "xi" (or "xi1".."xik"), "H", then the free parameters' and the observables' names.
 //
 //   ShootingLayout layout(model);
 //   double H = u(layout.H_index());
@@ -48,6 +56,8 @@ namespace hybridcont {
 struct FreeParameters {
   std::vector<std::string> parameters;                  // model parameter names, appended to u in order
   std::vector<std::pair<std::string, double>> fixed;    // unknown name and the value it is held at
+  std::vector<std::string> observables;                 // model observables joining the unknowns, in order
+  // No parameter free and nothing fixed (observables may still join).
   bool empty() const { return parameters.empty() && fixed.empty(); }
 };
 
@@ -83,6 +93,14 @@ class ShootingLayout {
   int num_free_parameters() const { return static_cast<int>(parameter_model_index_.size()); }
   int parameter_index(int i = 0) const { return parameter_start_ + i; }
   int parameter_model_index(int i) const { return parameter_model_index_.at(i); }
+  // Observables joining the unknowns: their number s, the index in u of the j-th, its index among the model's
+  // observables and its equation's row.
+  int num_observables() const { return static_cast<int>(observable_model_index_.size()); }
+  int observable_index(int j) const { return observable_start_ + j; }
+  int observable_model_index(int j) const { return observable_model_index_.at(j); }
+  int observable_row(int j) const { return fixed_row(0) + num_fixed() + j; }
+  // Unknowns of the orbit without free parameters and observables: v of observable.h.
+  int num_orbit_unknowns() const { return parameter_start_; }
   // Fixing rows: the i-th holds unknown fixed_index(i) at fixed_value(i), in row fixed_row(i).
   int num_fixed() const { return static_cast<int>(fixed_index_.size()); }
   int fixed_index(int i) const { return fixed_index_.at(i); }
@@ -92,9 +110,11 @@ class ShootingLayout {
 
   // First row of block i of r (segment i's shooting/periodicity rows followed by its event/anchor row).
   int block_row(int i) const { return block_row_[CheckedSegment(i)]; }
-  int first_integral_row() const { return num_equations() - k_ - num_fixed(); }
+  int first_integral_row() const { return num_equations() - k_ - num_fixed() - num_observables(); }
 
   const std::vector<std::string>& unknown_names() const { return names_; }
+  // Index of the named unknown, or -1.
+  int UnknownIndex(const std::string& name) const;
 
   // Total period T = sum of the m+1 durations.
   double Period(const Vector& u) const;
@@ -115,6 +135,8 @@ class ShootingLayout {
   int parameter_start_;
   int num_unknowns_;
   std::vector<int> parameter_model_index_;
+  int observable_start_;
+  std::vector<int> observable_model_index_;
   std::vector<int> fixed_index_;
   std::vector<double> fixed_value_;
   std::vector<std::string> names_;

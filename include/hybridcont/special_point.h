@@ -47,6 +47,8 @@ enum class SpecialPointType {
   kUserTestFunction,    // a zero of a caller's test function
   kGrazing,             // an event met tangentially: its normalized crossing speed de·f/(|de||f|) is 0
   kNeimarkSacker,       // a complex pair of Floquet multipliers crosses the unit circle (NS; floquet.h)
+  kObservableValue,     // an observable reaches a value the user monitors (UZ, as AUTO's; observable.h)
+  kConstraintBoundary,  // an admissibility constraint's minimum reaches 0 (CB; observable.h)
 };
 std::string ToString(SpecialPointType type);
 

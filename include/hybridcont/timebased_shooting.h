@@ -8,6 +8,7 @@
 //   r_s,i = Delta_i(phi_i(t_i, x̄_i; xi)) - x̄_{i+1}        shooting, i = m..1
 //   r_e,i = e_i(phi_i(t_i, x̄_i; xi))                      event, i = m..1
 //   r_i  = H_1(x̄_1) - H̄                                   first integral
+// followed by the fixing rows and the observables' equations o_j − g_j(u) (shooting_layout.h).
 //
 // Jacobian (columns grouped as u, rows as r; f~ = f~(phi_i), Phi_i, Psi_i at the end of phase i):
 //
@@ -52,6 +53,7 @@ namespace hybridcont {
 namespace internal {
 class WorkerTeam;
 }
+class ObservableEvaluator;
 
 class TimeBasedShooting : public ShootingProblem {
  public:
@@ -80,6 +82,10 @@ class TimeBasedShooting : public ShootingProblem {
   // Fixed levels H̄_j of first integrals j = 2..k (size k-1); zero by default.
   void SetFixedLevels(const Vector& levels);
   const FreeParameters& free_parameters() const { return free_; }
+  // u without the observables' entries (num_unknowns() − layout().num_observables() values) completed with
+  // their values at u: a start point of a map whose observables joined the unknowns. NaN where one cannot
+  // be evaluated (a correction from there then fails with the evaluation's message).
+  Vector CompleteUnknowns(const Vector& u);
   // The value the i-th fixed unknown is held at (FreeParameters::fixed).
   void SetFixedValue(int i, double value);
 
@@ -112,7 +118,8 @@ class TimeBasedShooting : public ShootingProblem {
 
   // Same model, integrator options and fixed levels; one thread (zero_problem.h).
   // The model's symmetries (ModelSymmetry) and their products, on u: states by the phases' signs;
-  // durations and ξ change sign under time reversal; H̄ is invariant.
+  // durations and ξ change sign under time reversal; H̄ is invariant. None when observables joined the
+  // unknowns (how an observable transforms is not declared).
   std::vector<Symmetry> symmetries() const override;
   // "H", or the first free parameter when there are any (its families are traced at fixed values).
   std::string family_parameter() const override {
@@ -145,6 +152,10 @@ class TimeBasedShooting : public ShootingProblem {
   Vector fixed_levels_;
   std::vector<PhaseFlow> integrators_;
   std::vector<PhaseFlowResult> flows_;
+  // observables joining the unknowns: their evaluator, values and gradients at the cached point
+  std::unique_ptr<ObservableEvaluator> observables_;
+  Vector observable_values_;
+  Matrix observable_gradients_;
   // cache of the last integrated point
   Vector cached_u_;
   bool cached_sensitivities_ = false;

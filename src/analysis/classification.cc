@@ -1,9 +1,11 @@
 #include "hybridcont/classification.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "hybridcont/internal/enum_names.h"
+#include "hybridcont/orbit_observables.h"
 
 namespace hybridcont {
 
@@ -22,6 +24,7 @@ constexpr internal::EnumName<OrbitClass> kOrbitClassNames[] = {
     {OrbitClass::kMissedAnchor, "missed-anchor"},
     {OrbitClass::kIntegrationFailed, "integration-failed"},
     {OrbitClass::kReplayFailed, "replay-failed"},
+    {OrbitClass::kConstraintViolated, "constraint-violated"},
 };
 
 }  // namespace
@@ -138,6 +141,21 @@ Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const Or
       os << (i < m ? "event" : "anchor") << " of segment " << i + 1 << " violated at t = " << t << " < "
          << trace.duration(i);
       return NonPhysical(i < m ? OrbitClass::kMissedEvent : OrbitClass::kMissedAnchor, os.str());
+    }
+  }
+  // Admissibility constraints (observable.h): each minimum >= 0, the first violated one named.
+  const std::vector<Observable>& observables = model.observables();
+  if (std::any_of(observables.begin(), observables.end(), [](const Observable& o) { return o.constraint; })) {
+    ObservableEvaluator evaluator(model, layout, IntegratorOptions{});
+    for (int j = 0; j < static_cast<int>(observables.size()); ++j) {
+      if (!observables[j].constraint) continue;
+      double value = 0.0;
+      const EvaluationStatus status = evaluator.Evaluate(j, u, &value, nullptr);
+      if (!status.ok) return NonPhysical(OrbitClass::kIntegrationFailed, status.message);
+      if (value < -options.constraint_tolerance) {
+        os << "constraint '" << observables[j].name << "': minimum " << value << " < 0";
+        return NonPhysical(OrbitClass::kConstraintViolated, os.str());
+      }
     }
   }
   return {true, OrbitClass::kPhysical, ""};

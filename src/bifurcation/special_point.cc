@@ -16,6 +16,8 @@ constexpr internal::EnumName<SpecialPointType> kSpecialPointTypeNames[] = {
     {SpecialPointType::kPeriodDoubling, "period-doubling"},
     {SpecialPointType::kGrazing, "grazing"},
     {SpecialPointType::kNeimarkSacker, "neimark-sacker"},
+    {SpecialPointType::kObservableValue, "observable-value"},
+    {SpecialPointType::kConstraintBoundary, "constraint-boundary"},
     {SpecialPointType::kUserTestFunction, "test-function-zero"},
 };
 

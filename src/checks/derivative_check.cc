@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "hybridcont/orbit_observables.h"
 #include "hybridcont/timebased_shooting.h"
 
 #include "hybridcont/internal/options_check.h"
@@ -86,6 +87,7 @@ class Checker {
     CheckAnchor();
     CheckShootingMap();
     CheckParameterColumns();
+    CheckObservables();
     return report_;
   }
 
@@ -236,8 +238,8 @@ class Checker {
       const std::string what = "shooting map: dr/d" + info.name;
       // The parameter free (and, with a first integral, held by a fixing row; without, it carries the family).
       const FreeParameters free = model_.num_first_integrals() > 0
-                                      ? FreeParameters{{info.name}, {{info.name, info.default_value}}}
-                                      : FreeParameters{{info.name}, {}};
+                                      ? FreeParameters{{info.name}, {{info.name, info.default_value}}, {}}
+                                      : FreeParameters{{info.name}, {}, {}};
       TimeBasedShooting shooting(model_, o_.integrator, free);
       const int col = shooting.layout().parameter_index(0);
       // Random points where the map cannot be integrated (a singular state reached) are drawn again: this
@@ -259,6 +261,37 @@ class Checker {
           continue;
         }
         Record(what, o_.flow_tolerance, dr.col(col), (r_plus - r_minus) / (2 * h), true);
+        ++checked;
+      }
+      if (checked == 0) Record(what, o_.flow_tolerance, Matrix(), Matrix(), false, failure);
+    }
+  }
+
+  // Each observable's gradient in u (orbit_observables.h) against central differences of its value, at
+  // random u where it evaluates (an integration that fails at a drawn point is drawn again).
+  void CheckObservables() {
+    const ShootingLayout layout(model_);
+    ObservableEvaluator evaluator(model_, layout, o_.integrator);
+    for (int j = 0; j < static_cast<int>(model_.observables().size()); ++j) {
+      const std::string what = "observable '" + model_.observables()[j].name + "': d/du";
+      int checked = 0;
+      std::string failure;
+      for (int attempt = 0; attempt < 4 * o_.num_points && checked < o_.num_points; ++attempt) {
+        const Vector u = SampleUnknowns(layout);
+        double value = 0.0;
+        RowVector du;
+        const EvaluationStatus s = evaluator.Evaluate(j, u, &value, &du);
+        if (!s.ok) {
+          failure = s.message;
+          continue;
+        }
+        bool ok = false;
+        const Matrix fd = FiniteDifferenceJacobian([&](const Vector& v, Vector* out) {
+          out->resize(1);
+          return evaluator.Evaluate(j, v, &(*out)(0), nullptr).ok;
+        }, u, o_.flow_step, &ok);
+        if (!ok) continue;
+        Record(what, o_.flow_tolerance, du, fd, true);
         ++checked;
       }
       if (checked == 0) Record(what, o_.flow_tolerance, Matrix(), Matrix(), false, failure);

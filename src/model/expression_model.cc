@@ -144,6 +144,7 @@ HybridModel BuildExpressionModel(ExpressionModelSpec spec, std::shared_ptr<const
   auto anchor_fn = std::make_unique<ExpressionAnchor>(block.get(), m);
   HybridModel model(spec.name, spec.description, std::move(block), std::move(phases), std::move(anchor_fn));
   for (ModelSymmetry& s : spec.symmetries) model.AddSymmetry(std::move(s));
+  for (Observable& o : spec.observables) model.AddObservable(std::move(o));
   model.SetSetup(std::move(spec.setup));
   return model;
 }

@@ -1,5 +1,7 @@
 #include "hybridcont/model.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <charconv>
 #include <stdexcept>
@@ -89,6 +91,69 @@ void HybridModel::AddSymmetry(ModelSymmetry symmetry) {
   symmetries_.push_back(std::move(symmetry));
 }
 
+int HybridModel::FindObservable(const std::string& name) const {
+  for (int i = 0; i < static_cast<int>(observables_.size()); ++i) {
+    if (observables_[i].name == name) return i;
+  }
+  return -1;
+}
+
+namespace {
+// Whether `name` is, or could be, an unknown of the time-based layout (shooting_layout.h): t<digits>,
+// x<digits>_<state>, xi, xi<digits>, H; or T, the period every observable expression knows.
+bool IsLayoutName(const std::string& name) {
+  const auto digits_from = [&](std::size_t i) {
+    std::size_t j = i;
+    while (j < name.size() && std::isdigit(static_cast<unsigned char>(name[j]))) ++j;
+    return j;
+  };
+  if (name == "H" || name == "T" || name == "xi") return true;
+  if (name.rfind("xi", 0) == 0) return digits_from(2) == name.size() && name.size() > 2;
+  if (name[0] == 't') return name.size() > 1 && digits_from(1) == name.size();
+  if (name[0] == 'x') {
+    const std::size_t j = digits_from(1);
+    return j > 1 && j < name.size() && name[j] == '_';
+  }
+  return false;
+}
+}  // namespace
+
+void HybridModel::AddObservable(Observable observable) {
+  const std::string where = "model '" + name_ + "', observable '" + observable.name + "'";
+  if (observable.name.empty()) throw std::invalid_argument("model '" + name_ + "': an observable needs a name");
+  if (FindObservable(observable.name) >= 0) throw std::invalid_argument(where + ": declared twice");
+  if (FindParameter(observable.name) >= 0) throw std::invalid_argument(where + ": is the name of a parameter");
+  if (IsLayoutName(observable.name)) {
+    throw std::invalid_argument(where + ": is the name of an unknown of the orbit (t<i>, x<i>_<state>, xi, H, T)");
+  }
+  if (observable.kind == ObservableKind::kValue) {
+    if (!observable.value) throw std::invalid_argument(where + ": a value observable needs its function");
+  } else {
+    if (observable.phases.size() != phases_.size()) {
+      throw std::invalid_argument(where + ": " + std::to_string(observable.phases.size()) + " phase functions for " +
+                                  std::to_string(phases_.size()) + " phases");
+    }
+    if (std::none_of(observable.phases.begin(), observable.phases.end(), [](const auto& g) { return g != nullptr; })) {
+      throw std::invalid_argument(where + ": names no phase");
+    }
+  }
+  if (observable.constraint && observable.kind != ObservableKind::kMinimum) {
+    throw std::invalid_argument(where + ": a constraint is a minimum that must stay >= 0");
+  }
+  observables_.push_back(std::move(observable));
+}
+
+std::string ToString(ObservableKind kind) {
+  switch (kind) {
+    case ObservableKind::kValue: return "value";
+    case ObservableKind::kIntegral: return "integral";
+    case ObservableKind::kMean: return "mean";
+    case ObservableKind::kMinimum: return "minimum";
+    case ObservableKind::kMaximum: return "maximum";
+  }
+  HYBRIDCONT_UNREACHABLE();
+}
+
 int HybridModel::ParameterIndex(const std::string& name) const {
   const auto& infos = parameters_->infos();
   for (int i = 0; i < static_cast<int>(infos.size()); ++i) {
@@ -155,6 +220,7 @@ HybridModel HybridModel::Clone() const {
   HYBRIDCONT_DEMAND(anchor != nullptr);
   HybridModel copy(name_, description_, std::move(block), std::move(phases), std::move(anchor));
   copy.symmetries_ = symmetries_;
+  copy.observables_ = observables_;
   copy.setup_ = setup_;
   return copy;
 }

@@ -11,7 +11,7 @@ namespace hybridcont::internal {
 ExpressionModelSpec Reader::Read() {
   CheckKeys(root_, "", {"hybridcont", "name", "description", "title", "parameters", "definitions", "phases",
                         "symmetries", "start", "run", "families", "quantities", "figures", "drawing",
-                        "conservative"});
+                        "conservative", "observables", "constraints"});
   ReadVersion();
   conservative_ = OptionalBool(root_, "conservative", "", true);
   if (!conservative_) num_integrals_ = 0;
@@ -31,6 +31,8 @@ ExpressionModelSpec Reader::Read() {
   ReadRun();
   ReadFamilies();
   ReadQuantities();
+  ReadObservables();
+  ReadConstraints();
   for (const FamilyRule& rule : spec_.setup.families) CheckSetupValue(rule.when, OrbitSymbols());
   ReadFigures();
   ReadDrawing();

@@ -4,6 +4,7 @@
 //   model_reader.cc        Read (the order of the tables), messages, typed access, symbols
 //   read_setup.cc          version, parameters, definitions, start, run, families, quantities
 //   read_phases.cc         phases (headers, then the functions of each) and symmetries
+//   read_observables.cc    observables and constraints
 //   read_presentation.cc   figures and drawing
 //   ExpressionModelSpec spec = Reader(root, "slip.toml").Read();
 #ifndef HYBRIDCONT_SRC_MODELFILE_MODEL_READER_H_
@@ -130,6 +131,19 @@ class Reader {
   // (mechanics.h), checks them and stores M for explanations.
   Mechanics ReadMechanics(int i);
   void ReadSymmetries();
+
+  // ---- sections (read_observables.cc)
+  void ReadObservables();
+  void ReadConstraints();
+  // The names of the time-based layout's unknowns in its order (t_{m+1}, x̄_{m+1}, ..., ξ, H̄).
+  std::vector<std::string> LayoutNames() const;
+  // A table of expressions by phase name (the key `skip` left out), one ExpressionFunction per named phase
+  // (null elsewhere).
+  std::vector<std::shared_ptr<const SmoothFunction>> ReadPhaseFunctions(const toml::node& node, const std::string& field,
+                                                                        const std::string& skip = "");
+  // An observable's or constraint's name: an identifier that no unknown, parameter, quantity or other
+  // observable has.
+  void CheckObservableName(const toml::node& node, const std::string& field, const std::string& name) const;
 
   // ---- sections (read_presentation.cc)
   void ReadFigures();

@@ -59,12 +59,28 @@ ShootingLayout::ShootingLayout(const HybridModel& model, const FreeParameters& f
     names_.push_back(name);
     ++num_unknowns_;
   }
+  observable_start_ = num_unknowns_;
+  for (const std::string& name : free.observables) {
+    const int index = model.FindObservable(name);
+    if (index < 0) {
+      std::string known;
+      for (const Observable& o : model.observables()) known += (known.empty() ? "" : ", ") + o.name;
+      throw std::invalid_argument("observable '" + name + "': model '" + model.name() + "' has no such observable" +
+                                  (known.empty() ? std::string(" (it declares none)") : " (observables: " + known + ")"));
+    }
+    if (std::find(names_.begin(), names_.end(), name) != names_.end()) {
+      throw std::invalid_argument("observable '" + name + "': named twice");
+    }
+    observable_model_index_.push_back(index);
+    names_.push_back(name);
+    ++num_unknowns_;
+  }
   for (const auto& [name, value] : free.fixed) {
     const auto it = std::find(names_.begin(), names_.end(), name);
     if (it == names_.end()) {
       throw std::invalid_argument("fixed unknown '" + name + "' is not an unknown of the problem (unknowns: " +
                                   std::string(k_ > 0 ? "H, xi, " : "") +
-                                  "t1..t" + std::to_string(m + 1) + ", x<i>_<state>, the free parameters)");
+                                  "t1..t" + std::to_string(m + 1) + ", x<i>_<state>, the free parameters, the observables)");
     }
     const int index = static_cast<int>(it - names_.begin());
     if (std::find(fixed_index_.begin(), fixed_index_.end(), index) != fixed_index_.end()) {
@@ -89,7 +105,13 @@ ShootingLayout::ShootingLayout(const HybridModel& model, const FreeParameters& f
 }
 
 int ShootingLayout::num_equations() const {
-  return segment_rows_ + k_ + num_fixed();  // the blocks, the first integrals, the fixing rows
+  // the blocks, the first integrals, the fixing rows, the observables' equations
+  return segment_rows_ + k_ + num_fixed() + num_observables();
+}
+
+int ShootingLayout::UnknownIndex(const std::string& name) const {
+  const auto it = std::find(names_.begin(), names_.end(), name);
+  return it == names_.end() ? -1 : static_cast<int>(it - names_.begin());
 }
 
 double ShootingLayout::Period(const Vector& u) const {

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <exception>
+#include <limits>
 #include <stdexcept>
 #include <thread>
 
+#include "hybridcont/orbit_observables.h"
 #include "shooting/worker_team.h"
 
 namespace hybridcont {
@@ -43,6 +45,7 @@ TimeBasedShooting::TimeBasedShooting(const HybridModel& model, IntegratorOptions
     integrators_.back().set_free_parameters(parameters);
   }
   flows_.resize(m + 1);
+  if (layout_.num_observables() > 0) observables_ = std::make_unique<ObservableEvaluator>(*model_, layout_, options);
 }
 
 void TimeBasedShooting::SetFixedValue(int i, double value) {
@@ -63,6 +66,22 @@ EvaluationStatus TimeBasedShooting::SetParameters(const Vector& u) {
     }
   }
   return {};
+}
+
+Vector TimeBasedShooting::CompleteUnknowns(const Vector& u) {
+  const int s = layout_.num_observables();
+  HYBRIDCONT_DEMAND(u.size() == layout_.num_unknowns() - s);
+  Vector v = Vector::Zero(layout_.num_unknowns());
+  v.head(u.size()) = u;
+  const bool parameters_ok = SetParameters(v).ok;
+  for (int j = 0; j < s; ++j) {
+    double value = std::numeric_limits<double>::quiet_NaN();
+    if (parameters_ok && !observables_->Evaluate(layout_.observable_model_index(j), v, &value, nullptr).ok) {
+      value = std::numeric_limits<double>::quiet_NaN();
+    }
+    v(layout_.observable_index(j)) = value;
+  }
+  return v;
 }
 
 TimeBasedShooting::~TimeBasedShooting() = default;
@@ -88,6 +107,9 @@ void TimeBasedShooting::set_threads(int threads) {
 }
 
 std::vector<Symmetry> TimeBasedShooting::symmetries() const {
+  // An observable's value under a symmetry is not declared (a mean speed flips with the mirror, an apex
+  // height does not): with observables among the unknowns, the images are traced, not mapped.
+  if (layout_.num_observables() > 0) return {};
   std::vector<Symmetry> generators;
   for (const ModelSymmetry& s : model_->symmetries()) {
     const double time = s.reverses_time ? -1.0 : 1.0;
@@ -169,6 +191,18 @@ EvaluationStatus TimeBasedShooting::Integrate(const Vector& u, bool sensitivitie
       status = EvaluationStatus::Failure("segment " + std::to_string(i + 1) + ": " + flows_[i].message);
       break;
     }
+  }
+  // The observables joining the unknowns, from their own integrations (orbit_observables.h).
+  const int num_observables = layout_.num_observables();
+  observable_values_.resize(num_observables);
+  observable_gradients_.resize(num_observables, u.size());
+  for (int j = 0; j < num_observables && status.ok; ++j) {
+    RowVector gradient;
+    status = observables_->Evaluate(layout_.observable_model_index(j), u, &observable_values_(j),
+                                    sensitivities ? &gradient : nullptr);
+    if (sensitivities) observable_gradients_.row(j) = gradient;
+    CountWork(observables_->counters());
+    observables_->ResetCounters();
   }
   cached_u_ = u;
   cached_sensitivities_ = sensitivities;
@@ -322,6 +356,15 @@ EvaluationStatus TimeBasedShooting::Assemble(const Vector& u, Vector* r, Sink* d
   for (int i = 0; i < layout_.num_fixed(); ++i) {
     if (r) (*r)(layout_.fixed_row(i)) = u(layout_.fixed_index(i)) - layout_.fixed_value(i);
     if (dr) dr->Add(layout_.fixed_row(i), layout_.fixed_index(i), 1.0);
+  }
+  // Observables: o_j − g_j(u), gradient row −∇g_j (zero in the observables' own columns) plus e_{o_j}.
+  for (int j = 0; j < layout_.num_observables(); ++j) {
+    const int row = layout_.observable_row(j);
+    if (r) (*r)(row) = u(layout_.observable_index(j)) - observable_values_(j);
+    if (dr) {
+      dr->Add(row, 0, -observable_gradients_.row(j));
+      dr->Add(row, layout_.observable_index(j), 1.0);
+    }
   }
   return r == nullptr || r->allFinite() ? EvaluationStatus{}
                                         : EvaluationStatus::Failure("first integral returned a non-finite value");

@@ -1,0 +1,384 @@
+#include "hybridcont/orbit_observables.h"
+
+#include <boost/math/tools/toms748_solve.hpp>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "hybridcont/invariant.h"
+
+namespace hybridcont {
+
+namespace {
+
+// The phase with the quadrature state q' = g(x) appended: x_aug = [x; q]. Its first integrals, event and
+// reset are the phase's, blind to q, so that the unfolded field is [f + ξ∇H; g] and the flow's
+// sensitivities carry dq/d(x0, ξ, p).
+class QuadraturePhase : public Phase {
+ public:
+  QuadraturePhase(const Phase& base, const SmoothFunction& g, const HybridModel& model)
+      : Phase(base.name(), Names(base), base.next_dim(), base.num_first_integrals(), Typical(base)),
+        base_(&base),
+        g_(&g),
+        model_(&model) {}
+
+  void VectorField(const Eigen::Ref<const Vector>& x, Vector* f, Matrix* df) const override {
+    const int n = base_->dim();
+    thread_local Vector fb;
+    thread_local Matrix dfb;
+    thread_local RowVector dg;
+    base_->VectorField(x.head(n), &fb, df ? &dfb : nullptr);
+    Assemble(x, fb, df ? &dfb : nullptr, f, df);
+  }
+  void FirstIntegrals(const Eigen::Ref<const Vector>& x, Vector* H, Matrix* dH, std::vector<Matrix>* d2H) const override {
+    const int n = base_->dim();
+    Matrix dHb;
+    std::vector<Matrix> d2Hb;
+    base_->FirstIntegrals(x.head(n), H, dH ? &dHb : nullptr, d2H ? &d2Hb : nullptr);
+    if (dH) {
+      dH->setZero(dHb.rows(), n + 1);
+      dH->leftCols(n) = dHb;
+    }
+    if (d2H) {
+      d2H->resize(d2Hb.size());
+      for (std::size_t j = 0; j < d2Hb.size(); ++j) {
+        (*d2H)[j].setZero(n + 1, n + 1);
+        (*d2H)[j].topLeftCorner(n, n) = d2Hb[j];
+      }
+    }
+  }
+  double Event(const Eigen::Ref<const Vector>& x, RowVector* de) const override {
+    const int n = base_->dim();
+    RowVector deb;
+    const double e = base_->Event(x.head(n), de ? &deb : nullptr);
+    if (de) {
+      de->setZero(n + 1);
+      de->head(n) = deb;
+    }
+    return e;
+  }
+  void Reset(const Eigen::Ref<const Vector>& x, Vector* x_next, Matrix* D) const override {
+    const int n = base_->dim();
+    Matrix Db;
+    base_->Reset(x.head(n), x_next, D ? &Db : nullptr);
+    if (D) {
+      D->setZero(Db.rows(), n + 1);
+      D->leftCols(n) = Db;
+    }
+  }
+  bool has_parameter_derivatives() const override { return base_->has_parameter_derivatives(); }
+  void ParameterDerivatives(const Eigen::Ref<const Vector>& x, int parameter, Vector* field, Vector* integrals,
+                            double* event, Vector* reset) const override {
+    const int n = base_->dim();
+    Vector fb;
+    base_->ParameterDerivatives(x.head(n), parameter, field ? &fb : nullptr, integrals, event, reset);
+    if (field) {
+      field->resize(n + 1);
+      field->head(n) = fb;
+      (*field)(n) = ParameterDerivativeOfG(x.head(n), parameter);
+    }
+  }
+  void UnfoldedFieldParameterDerivative(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
+                                        int parameter, Vector* dfdp, bool include_mixed_term) const override {
+    const int n = base_->dim();
+    thread_local Vector fb;
+    base_->UnfoldedFieldParameterDerivative(x.head(n), xi, parameter, &fb, include_mixed_term);
+    dfdp->resize(n + 1);
+    dfdp->head(n) = fb;
+    (*dfdp)(n) = ParameterDerivativeOfG(x.head(n), parameter);
+  }
+
+ protected:
+  void ComputeUnfoldedVectorField(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& xi,
+                                  Vector* f_tilde, Matrix* A, Matrix* B, bool include_hessian_term) const override {
+    const int n = base_->dim();
+    thread_local Vector fb;
+    thread_local Matrix Ab, Bb;
+    base_->UnfoldedVectorField(x.head(n), xi, &fb, A ? &Ab : nullptr, B ? &Bb : nullptr, include_hessian_term);
+    Assemble(x, fb, A ? &Ab : nullptr, f_tilde, A);
+    if (B) {
+      B->setZero(n + 1, Bb.cols());
+      B->topRows(n) = Bb;
+    }
+  }
+
+ private:
+  static std::vector<std::string> Names(const Phase& base) {
+    std::vector<std::string> names = base.state_names();
+    names.push_back("quadrature");
+    return names;
+  }
+  static Vector Typical(const Phase& base) {
+    Vector x = Vector::Zero(base.dim() + 1);
+    x.head(base.dim()) = base.typical_state();
+    return x;
+  }
+  Vector Parameters() const {
+    Vector p(model_->parameters().size());
+    for (int i = 0; i < p.size(); ++i) p(i) = model_->parameter_value(i);
+    return p;
+  }
+  double ParameterDerivativeOfG(const Eigen::Ref<const Vector>& x, int parameter) const {
+    RowVector dp;
+    g_->Evaluate(x, Parameters(), nullptr, &dp);
+    return dp(parameter);
+  }
+  // [fb; g(x)] and, with dfb, [[dfb, 0]; [∇g, 0]].
+  void Assemble(const Eigen::Ref<const Vector>& x, const Vector& fb, const Matrix* dfb, Vector* f, Matrix* df) const {
+    const int n = base_->dim();
+    thread_local RowVector dg;
+    const double g = g_->Evaluate(x.head(n), Parameters(), dfb ? &dg : nullptr, nullptr);
+    f->resize(n + 1);
+    f->head(n) = fb;
+    (*f)(n) = g;
+    if (dfb && df) {
+      df->setZero(n + 1, n + 1);
+      df->topLeftCorner(n, n) = *dfb;
+      df->row(n).head(n) = dg;
+    }
+  }
+
+  const Phase* base_;
+  const SmoothFunction* g_;
+  const HybridModel* model_;
+};
+
+}  // namespace
+
+struct ObservableEvaluator::Quadrature {
+  std::unique_ptr<QuadraturePhase> phase;
+  std::unique_ptr<PhaseFlow> flow;
+};
+
+ObservableEvaluator::ObservableEvaluator(const HybridModel& model, const ShootingLayout& layout,
+                                         IntegratorOptions options)
+    : model_(&model), layout_(layout), options_(options) {
+  for (int i = 0; i < layout.num_free_parameters(); ++i) free_parameters_.push_back(layout.parameter_model_index(i));
+  for (int i = 0; i < model.num_phases(); ++i) {
+    flows_.emplace_back(model.phase(i), options);
+    flows_.back().set_free_parameters(free_parameters_);
+  }
+}
+
+ObservableEvaluator::~ObservableEvaluator() = default;
+ObservableEvaluator::ObservableEvaluator(ObservableEvaluator&&) noexcept = default;
+ObservableEvaluator& ObservableEvaluator::operator=(ObservableEvaluator&&) noexcept = default;
+
+Vector ObservableEvaluator::Parameters() const {
+  Vector p(model_->parameters().size());
+  for (int i = 0; i < p.size(); ++i) p(i) = model_->parameter_value(i);
+  return p;
+}
+
+void ObservableEvaluator::AddParameterGradient(const RowVector& dp, RowVector* du) const {
+  for (int j = 0; j < layout_.num_free_parameters(); ++j) {
+    (*du)(layout_.parameter_index(j)) += dp(layout_.parameter_model_index(j));
+  }
+}
+
+EvaluationStatus ObservableEvaluator::Evaluate(int observable, const Vector& u, double* value, RowVector* du) {
+  HYBRIDCONT_DEMAND(observable >= 0 && observable < static_cast<int>(model_->observables().size()));
+  HYBRIDCONT_DEMAND(u.size() >= layout_.num_orbit_unknowns() + layout_.num_free_parameters());
+  const Observable& o = model_->observables()[observable];
+  if (du) du->setZero(u.size());
+  EvaluationStatus status;
+  if (o.kind == ObservableKind::kValue) {
+    const int nv = layout_.num_orbit_unknowns();
+    RowVector dv, dp;
+    *value = o.value->Evaluate(u.head(nv), Parameters(), du ? &dv : nullptr, du ? &dp : nullptr);
+    if (du) {
+      du->head(nv) = dv;
+      AddParameterGradient(dp, du);
+    }
+  } else if (o.kind == ObservableKind::kIntegral || o.kind == ObservableKind::kMean) {
+    status = Integral(o, observable, u, value, du);
+  } else {
+    status = Extremum(o, u, value, du);
+  }
+  if (status.ok && !std::isfinite(*value)) {
+    status = EvaluationStatus::Failure("observable '" + o.name + "' is not finite");
+  }
+  if (!status.ok) status.message = "observable '" + o.name + "': " + status.message;
+  return status;
+}
+
+Vector ObservableEvaluator::EvaluateAll(const Vector& u) {
+  const int s = static_cast<int>(model_->observables().size());
+  Vector values(s);
+  for (int j = 0; j < s; ++j) {
+    double v = 0.0;
+    values(j) = Evaluate(j, u, &v, nullptr).ok ? v : std::numeric_limits<double>::quiet_NaN();
+  }
+  return values;
+}
+
+EvaluationStatus ObservableEvaluator::Integral(const Observable& o, int observable, const Vector& u, double* value,
+                                               RowVector* du) {
+  const int m = model_->num_phases();
+  const int k = layout_.num_first_integrals();
+  const auto xi = u.segment(layout_.xi_index(), k);
+  const Vector p = Parameters();
+  double integral = 0.0, duration = 0.0;
+  RowVector d_duration;
+  if (du) d_duration.setZero(u.size());
+  PhaseFlowResult res;
+  for (int s = 0; s < layout_.num_segments(); ++s) {
+    const int i = s % m;
+    const SmoothFunction* g = o.phases[i].get();
+    if (g == nullptr) continue;
+    auto& q = quadratures_[{observable, i}];
+    if (!q) {
+      q = std::make_unique<Quadrature>();
+      q->phase = std::make_unique<QuadraturePhase>(model_->phase(i), *g, *model_);
+      q->flow = std::make_unique<PhaseFlow>(*q->phase, options_);
+      q->flow->set_free_parameters(free_parameters_);
+    }
+    const int n = layout_.dim(s);
+    const double t = u(layout_.time_index(s));
+    Vector z0 = Vector::Zero(n + 1);
+    z0.head(n) = u.segment(layout_.state_offset(s), n);
+    q->flow->Integrate(z0, xi, t, du != nullptr, &res);
+    counters_ += res.counters;
+    if (!res.ok()) return EvaluationStatus::Failure(res.message);
+    integral += res.x(n);
+    duration += t;
+    if (du) {
+      du->segment(layout_.state_offset(s), n) += res.Phi.row(n).head(n);
+      (*du)(layout_.time_index(s)) += g->Evaluate(res.x.head(n), p, nullptr, nullptr);
+      if (k > 0) du->segment(layout_.xi_index(), k) += res.Psi.row(n).head(k);
+      for (int j = 0; j < layout_.num_free_parameters(); ++j) {
+        (*du)(layout_.parameter_index(j)) += res.Psi(n, k + j);
+      }
+      d_duration(layout_.time_index(s)) = 1.0;
+    }
+  }
+  if (o.kind == ObservableKind::kIntegral) {
+    *value = integral;
+    return {};
+  }
+  if (duration == 0.0) return EvaluationStatus::Failure("a mean over phases whose durations sum to 0");
+  *value = integral / duration;
+  if (du) *du = (*du - *value * d_duration) / duration;
+  return {};
+}
+
+EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector& u, double* value, RowVector* du) {
+  const int m = model_->num_phases();
+  const int k = layout_.num_first_integrals();
+  const auto xi = u.segment(layout_.xi_index(), k);
+  const Vector p = Parameters();
+  const double sign = o.kind == ObservableKind::kMaximum ? -1.0 : 1.0;  // extremum of sign·g is a minimum
+  struct Sample {
+    double t;
+    Vector x;
+  };
+  // The best candidate so far: value of sign·g, segment, time (signed), interior or an end.
+  double best = std::numeric_limits<double>::infinity();
+  int best_segment = -1;
+  double best_t = 0.0;
+  bool best_interior = false;
+  double best_end = std::numeric_limits<double>::infinity();  // constraints: the smaller end value
+  int end_segment = -1;
+  double end_t = 0.0;
+  PhaseFlowResult res;
+  std::vector<Sample> samples;
+  Vector f;
+  RowVector dg;
+  for (int s = 0; s < layout_.num_segments(); ++s) {
+    const int i = s % m;
+    const SmoothFunction* g = o.phases[i].get();
+    if (g == nullptr) continue;
+    const Phase& phase = model_->phase(i);
+    PhaseFlow& flow = flows_[i];
+    const double t_s = u(layout_.time_index(s));
+    const double dir = t_s < 0 ? -1.0 : 1.0;
+    samples.clear();
+    const Vector x0 = u.segment(layout_.state_offset(s), layout_.dim(s));
+    flow.Integrate(x0, xi, t_s, false, &res, [&](double t, const Eigen::Ref<const Vector>& x) {
+      samples.push_back({t, x});
+    });
+    counters_ += res.counters;
+    if (!res.ok()) return EvaluationStatus::Failure(res.message);
+    if (samples.empty()) samples.push_back({0.0, x0});  // a zero duration: the start alone
+    // h = sign·g along the samples and its derivative along the sequence, dh = sign·ġ·dir.
+    const auto h_and_slope = [&](const Eigen::Ref<const Vector>& x, double* slope) {
+      const double gx = g->Evaluate(x, p, &dg, nullptr);
+      phase.UnfoldedVectorField(x, xi, &f, nullptr, nullptr);
+      *slope = sign * dir * dg.dot(f);
+      return sign * gx;
+    };
+    const int ns = static_cast<int>(samples.size());
+    std::vector<double> h(ns), dh(ns);
+    for (int j = 0; j < ns; ++j) h[j] = h_and_slope(samples[j].x, &dh[j]);
+    // The zero of dh between samples a and a+1 (dh[a] < 0 < dh[a+1]): a local minimum of h.
+    const auto refine = [&](int a, double* t_star) {
+      const Sample& start = samples[a];
+      double slope = 0.0;
+      Vector x;
+      const auto slope_at = [&](double t) {
+        flow.Integrate(start.x, xi, t - start.t, false, &res);
+        counters_ += res.counters;
+        if (!res.ok()) return std::numeric_limits<double>::quiet_NaN();
+        h_and_slope(res.x, &slope);
+        return slope;
+      };
+      std::uintmax_t max_iter = 100;
+      const auto tol = [](double lo, double hi) {
+        return std::abs(hi - lo) <= 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(lo), std::abs(hi));
+      };
+      double lo = samples[a].t, hi = samples[a + 1].t;
+      double flo = dh[a], fhi = dh[a + 1];
+      if (lo > hi) {
+        std::swap(lo, hi);
+        std::swap(flo, fhi);
+      }
+      const auto bracket = boost::math::tools::toms748_solve(slope_at, lo, hi, flo, fhi, tol, max_iter);
+      *t_star = 0.5 * (bracket.first + bracket.second);
+      flow.Integrate(start.x, xi, *t_star - start.t, false, &res);
+      counters_ += res.counters;
+      double unused;
+      return res.ok() ? h_and_slope(res.x, &unused) : std::numeric_limits<double>::infinity();
+    };
+    // Interior local minima of h.
+    for (int a = 0; a + 1 < ns; ++a) {
+      if (!(dh[a] < 0.0 && dh[a + 1] > 0.0)) continue;
+      double t_star = 0.0;
+      const double v = refine(a, &t_star);
+      if (v < best) best = v, best_segment = s, best_t = t_star, best_interior = true;
+    }
+    // The ends.
+    for (const int j : {0, ns - 1}) {
+      if (h[j] < best_end) best_end = h[j], end_segment = s, end_t = samples[j].t;
+    }
+  }
+  // Minimum and maximum: the smallest of all; a constraint: the smallest interior minimum, else the ends.
+  const bool use_end = o.constraint ? !best_interior : best_end < best;
+  const int segment = use_end ? end_segment : best_segment;
+  const double t_star = use_end ? end_t : best_t;
+  HYBRIDCONT_DEMAND(segment >= 0);
+  *value = sign * (use_end ? best_end : best);
+  last_interior_ = !use_end;
+  if (du == nullptr) return {};
+  // Gradient: ∇g(x(t*)) dx(t*)/d(x̄_s, ξ, p) + ∂g/∂p, and ġ(t_s) when t* is the segment's end.
+  const int i = segment % m;
+  const SmoothFunction& g = *o.phases[i];
+  const int n = layout_.dim(segment);
+  const double t_s = u(layout_.time_index(segment));
+  const Vector x0 = u.segment(layout_.state_offset(segment), n);
+  flows_[i].Integrate(x0, xi, t_star, true, &res);
+  counters_ += res.counters;
+  if (!res.ok()) return EvaluationStatus::Failure(res.message);
+  RowVector dp;
+  g.Evaluate(res.x, p, &dg, &dp);
+  du->segment(layout_.state_offset(segment), n) += dg * res.Phi;
+  if (k > 0) du->segment(layout_.xi_index(), k) += dg * res.Psi.leftCols(k);
+  for (int j = 0; j < layout_.num_free_parameters(); ++j) (*du)(layout_.parameter_index(j)) += dg.dot(res.Psi.col(k + j));
+  AddParameterGradient(dp, du);
+  if (use_end && t_star == t_s && t_s != 0.0) {
+    model_->phase(i).UnfoldedVectorField(res.x, xi, &f, nullptr, nullptr);
+    (*du)(layout_.time_index(segment)) += dg.dot(f);
+  }
+  return {};
+}
+
+}  // namespace hybridcont
