@@ -237,7 +237,8 @@ nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& se
     for (int j = 0; j < static_cast<int>(model.observables().size()); ++j) {
       double v = 0;
       if (!model.observables()[j].constraint || !evaluator.Evaluate(j, u, &v, nullptr).ok) continue;
-      if (evaluator.last_extremum_interior() && std::abs(v) < smallest) best = j, smallest = std::abs(v);
+      const bool defined = model.observables()[j].kind == ObservableKind::kFinal || evaluator.last_extremum_interior();
+      if (defined && std::abs(v) < smallest) best = j, smallest = std::abs(v);
     }
     if (best < 0) continue;
     const std::string& name = model.observables()[best].name;

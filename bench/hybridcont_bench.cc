@@ -279,5 +279,54 @@ void BM_ScalingNewtonStep(benchmark::State& state) {
 }
 BENCHMARK(BM_ScalingNewtonStep)->Arg(1)->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// A chain of `masses` masses on springs with an elastic stop (models/mass-chain.toml has 12): one phase of
+// 2·masses states, on the fixed-capacity jets up to 16 states and on the dynamic-size path above.
+std::string MassChainText(int masses) {
+  std::string states, ode, kinetic, potential = "x1^2", reset, flip;
+  for (int i = 1; i <= masses; ++i) {
+    const std::string x = "x" + std::to_string(i), v = "v" + std::to_string(i);
+    const std::string left = i > 1 ? "x" + std::to_string(i - 1) : "0";
+    const std::string acc = i < masses ? "k/m*(" + left + " - 2*" + x + " + x" + std::to_string(i + 1) + ")"
+                                       : "k/m*(" + left + " - " + x + ")";
+    states += (i > 1 ? ", \"" : "\"") + x + "\"";
+    ode += (i > 1 ? ", " : "") + x + " = \"" + v + "\", " + v + " = \"" + acc + "\"";
+    kinetic += (i > 1 ? " + " : "") + v + "^2";
+    if (i > 1) potential += " + (" + x + " - x" + std::to_string(i - 1) + ")^2";
+    reset += (i > 1 ? ", " : "") + x + " = \"" + x + "\", " + v + " = \"" + (i < masses ? v : "-" + v) + "\"";
+  }
+  for (int i = 1; i <= masses; ++i) states += ", \"v" + std::to_string(i) + "\"";
+  const std::string last = std::to_string(masses);
+  return "hybridcont = 1\nname = \"mass-chain\"\n[parameters]\nm = { value = 1.0 }\nk = { value = 1.0 }\n"
+         "[[phases]]\nname = \"free\"\nstates = [" + states + "]\node = { " + ode + " }\nenergy = \"0.5*m*(" +
+         kinetic + ") + 0.5*k*(" + potential + ")\"\nevent = \"-x" + last + "\"\nanchor = \"-v" + last +
+         "\"\nreset = { " + reset + " }\n[start]\nkind = \"singular\"\n";
+}
+
+// One r + dr evaluation of the time-based map of the mass chain against its state dimension (interpreted,
+// both paths): the cost of a continuation point is 3–4 of them.
+void BM_LargeModelEvaluate(benchmark::State& state) {
+  const int masses = static_cast<int>(state.range(0));
+  const HybridModel model = BuildExpressionModel(ParseModelText(MassChainText(masses), "mass-chain.toml"), nullptr);
+  TimeBasedShooting shooting(model, IntegratorOptions{});
+  shooting.set_threads(1);
+  const ShootingLayout& layout = shooting.layout();
+  Vector u = Vector::Zero(layout.num_unknowns()), r;
+  for (int s = 0; s < layout.num_segments(); ++s) {
+    u(layout.time_index(s)) = 0.8;
+    for (int j = 0; j < layout.dim(s); ++j) u(layout.state_offset(s) + j) = 0.05 * std::sin(1.0 + j + 3 * s);
+  }
+  u(layout.H_index()) = 0.01;
+  Matrix dr;
+  for (auto _ : state) {
+    u(0) += 1e-15;  // a new point each time
+    if (!shooting.Evaluate(u, &r, &dr).ok) state.SkipWithError("evaluation failed");
+    benchmark::DoNotOptimize(r.data());
+  }
+  state.counters["states"] = 2 * masses;
+  state.counters["rhs_per_eval"] =
+      static_cast<double>(shooting.counters().rhs_evaluations) / static_cast<double>(shooting.num_evaluations());
+}
+BENCHMARK(BM_LargeModelEvaluate)->Arg(2)->Arg(4)->Arg(6)->Arg(8)->Arg(9)->Arg(12)->Arg(16)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 }  // namespace hybridcont::app

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
+#include "csv_columns.h"
 #include "hybridcont/models.h"
 #include "hybridcont/timebased_shooting.h"
 #include "known_orbits.h"
@@ -24,28 +25,6 @@ namespace hybridcont::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-// The numeric columns of a CSV file by header name (empty cells: NaN).
-std::map<std::string, std::vector<double>> ReadColumns(const fs::path& file) {
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> header;
-  std::stringstream hs(line);
-  for (std::string cell; std::getline(hs, cell, ',');) header.push_back(cell);
-  std::map<std::string, std::vector<double>> columns;
-  while (std::getline(in, line)) {
-    std::stringstream ss(line);
-    std::size_t i = 0;
-    for (std::string cell; i < header.size(); ++i) {
-      if (!std::getline(ss, cell, ',')) cell.clear();
-      char* end = nullptr;
-      const double v = std::strtod(cell.c_str(), &end);
-      columns[header[i]].push_back(end != cell.c_str() ? v : std::nan(""));
-    }
-  }
-  return columns;
-}
 
 nlohmann::json ReadSummary(const fs::path& dir) {
   std::ifstream f(dir / "summary.json");

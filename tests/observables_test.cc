@@ -84,6 +84,15 @@ TEST(Observables, IntegralMeanAndExtremaMatchIndependentValues) {
   const double y0 = u0(layout.state_offset(1)), dy0 = u0(layout.state_offset(1) + 3);
   EXPECT_NEAR(apex, y0 + dy0 * dy0 / 2.0, 1e-12);
   EXPECT_TRUE(evaluator.last_extremum_interior());
+  // The foot's height rate at touch-down, −(ẏ + l0 sin α α̇) at the end of flight: ballistic body, harmonic leg
+  // (α'' = −w2 α).
+  double touchdown = 0;
+  ASSERT_TRUE(evaluator.Evaluate(Index(slip, "touchdown"), u0, &touchdown, nullptr).ok);
+  const double t2 = u0(layout.time_index(1)), w = std::sqrt(5.0);
+  const double a0 = u0(layout.state_offset(1) + 1), da0 = u0(layout.state_offset(1) + 4);
+  const double a = a0 * std::cos(w * t2) + da0 / w * std::sin(w * t2);
+  const double da = -a0 * w * std::sin(w * t2) + da0 * std::cos(w * t2);
+  EXPECT_NEAR(touchdown, -((dy0 - t2) + std::sin(a) * da), 1e-10);
   // The leg force k (l0 − l) is largest at the nadir, the start of segment 1 (an end value).
   ASSERT_TRUE(evaluator.Evaluate(Index(slip, "peak_force"), u0, &force, nullptr).ok);
   EXPECT_NEAR(force, 40.0 * (1.0 - u0(layout.state_offset(0) + 1)), 1e-12);

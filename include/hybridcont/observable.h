@@ -9,10 +9,13 @@
 //              (segment m+1 is phase 1 again): a stride length, an impulse, a cost of transport's work;
 //   mean       the integral divided by the summed durations of those segments: a mean forward speed;
 //   minimum,   the extreme value of g_i(x_s(t)) over t in [0, t_s] and the same segments: a peak force, a
-//   maximum    lowest foot height.
+//   maximum    lowest foot height;
+//   final      g_i at the end of the segment that phase i's event ends (segment i, before its reset), for
+//              the one phase it names: a touch-down velocity, an impact angle.
 // An admissibility constraint is a minimum that a physical orbit keeps >= 0 (ground force, foot clearance,
-// a friction cone written as μ F_n − |F_t|): the classification names the constraint an orbit violates,
-// and a family crossing its boundary has a located special point there.
+// a friction cone written as μ F_n − |F_t|), or a final value that it keeps >= 0 (the foot moving toward
+// the ground at touch-down): the classification names the constraint an orbit violates, and a family
+// crossing its boundary has a located special point there.
 //
 // A constraint's value is its smallest *interior* local minimum over the segments, or, where g has none,
 // the smaller end value: a clearance that is 0 at both ends of the phase (the foot leaves and reaches the
@@ -47,7 +50,7 @@ class SmoothFunction {
                           RowVector* dp) const = 0;
 };
 
-enum class ObservableKind { kValue, kIntegral, kMean, kMinimum, kMaximum };
+enum class ObservableKind { kValue, kIntegral, kMean, kMinimum, kMaximum, kFinal };
 std::string ToString(ObservableKind kind);
 
 struct Observable {
@@ -58,7 +61,7 @@ struct Observable {
   std::shared_ptr<const SmoothFunction> value;
   // Other kinds: g_i(x, p) per phase i of the model (num_phases entries); nullptr leaves phase i out.
   std::vector<std::shared_ptr<const SmoothFunction>> phases;
-  // An admissibility constraint (kind kMinimum): a physical orbit keeps the minimum >= 0.
+  // An admissibility constraint (kind kMinimum or kFinal): a physical orbit keeps the value >= 0.
   bool constraint = false;
 };
 

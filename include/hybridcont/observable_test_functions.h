@@ -2,8 +2,8 @@
 // value (kObservableValue, AUTO's UZ points: `--monitor speed=1`), and each admissibility constraint of the
 // model reaching 0 (kConstraintBoundary), located on the branch like any special point.
 //
-// A constraint's test function is its interior minimum (observable.h), NaN where the minimum lies at an end
-// of its segments: a foot clearance that is 0 where the phase starts and ends has no sign there, and its
+// A constraint's test function is its value: for a minimum its interior minimum (observable.h), NaN where
+// the minimum lies at an end of its segments: a foot clearance that is 0 where the phase starts and ends has no sign there, and its
 // boundary is where an interior dip touches 0. It is NaN too where some phase duration is <= 0 (a
 // reversed-time or degenerate orbit, which no constraint makes physical or not).
 //

@@ -8,6 +8,7 @@
 //              system (QuadraturePhase), so that dq(t_s)/d(x̄_s, ξ, p) are rows of the flow's own
 //              sensitivities Φ, Ψ (eqs. `diffState`, `diffParam`) and dq/dt_s = g_i(x_s(t_s));
 //   mean       integral / Σ t_s, by the quotient rule;
+//   final      g_i(x_i(t_i)) at the end of segment i: ∇g times the sensitivities there, ∇g·f~ for t_i;
 //   extremum   the accepted steps of the phase's flow sample g along the segment; the extreme sample's
 //              neighbouring step holds the zero of ġ = ∇g·f~, found by TOMS 748 on short integrations from
 //              the sample, to a few ulps in time. By the envelope theorem the gradient is ∇g(x(t*)) times the
@@ -58,6 +59,7 @@ class ObservableEvaluator {
  private:
   EvaluationStatus Integral(const Observable& o, int observable, const Vector& u, double* value, RowVector* du);
   EvaluationStatus Extremum(const Observable& o, const Vector& u, double* value, RowVector* du);
+  EvaluationStatus Final(const Observable& o, const Vector& u, double* value, RowVector* du);
   Vector Parameters() const;
   void AddParameterGradient(const RowVector& dp, RowVector* du) const;
 

@@ -62,7 +62,9 @@ void ObservableTestFunctions::Evaluate(const Vector& u, bool branch_point, Vecto
     } else if (!evaluator_->Evaluate(f.observable, u, &value, nullptr).ok) {
       continue;
     }
-    if (f.constraint && !evaluator_->last_extremum_interior()) continue;  // no sign at an end value
+    // A minimum's sign at an end value means nothing (a clearance is 0 there); a final value always has one.
+    const bool minimum = model_->observables()[f.observable].kind == ObservableKind::kMinimum;
+    if (f.constraint && minimum && !evaluator_->last_extremum_interior()) continue;
     (*values)(i) = value - f.value;
   }
 }

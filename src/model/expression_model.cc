@@ -1,5 +1,7 @@
 #include "hybridcont/expression_model.h"
 
+#include "large_expression_phase.h"
+
 #include <stdexcept>
 
 #include "hybridcont/mechanics.h"
@@ -133,15 +135,24 @@ HybridModel BuildExpressionModel(ExpressionModelSpec spec, std::shared_ptr<const
   for (int i = 0; i < m; ++i) {
     const ExpressionPhaseSpec& p = view->phases[i];
     const int n = static_cast<int>(p.state_names.size());
-    if (n < 1 || n > kMaxPhaseDim) {
-      throw std::invalid_argument("model '" + spec.name + "', phase '" + p.name + "': " + std::to_string(n) +
-                                  " states, outside [1, " + std::to_string(kMaxPhaseDim) + "]");
-    }
+    if (n < 1) throw std::invalid_argument("model '" + spec.name + "', phase '" + p.name + "': no states");
     const int next_dim = static_cast<int>(view->phases[(i + 1) % m].state_names.size());
-    phases.push_back(std::make_unique<ExpressionPhase>(p.name, p.state_names, next_dim, p.typical_state, block.get(), i));
+    // Above the fixed-capacity jets' kMaxPhaseDim: the dynamic-size path (large_expression_phase.h).
+    if (n > kMaxPhaseDim) {
+      phases.push_back(std::make_unique<internal::LargeExpressionPhase>(p.name, p.state_names, next_dim,
+                                                                        p.integrals.num_outputs(), p.typical_state,
+                                                                        block.get(), i));
+    } else {
+      phases.push_back(std::make_unique<ExpressionPhase>(p.name, p.state_names, next_dim, p.typical_state, block.get(), i));
+    }
   }
   internal::ValidatePhaseSizes(spec.name, phases);
-  auto anchor_fn = std::make_unique<ExpressionAnchor>(block.get(), m);
+  std::unique_ptr<Anchor> anchor_fn;
+  if (static_cast<int>(view->phases[0].state_names.size()) > kMaxPhaseDim) {
+    anchor_fn = std::make_unique<internal::LargeExpressionAnchor>(block.get(), m);
+  } else {
+    anchor_fn = std::make_unique<ExpressionAnchor>(block.get(), m);
+  }
   HybridModel model(spec.name, spec.description, std::move(block), std::move(phases), std::move(anchor_fn));
   for (ModelSymmetry& s : spec.symmetries) model.AddSymmetry(std::move(s));
   for (Observable& o : spec.observables) model.AddObservable(std::move(o));

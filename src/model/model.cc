@@ -137,8 +137,12 @@ void HybridModel::AddObservable(Observable observable) {
       throw std::invalid_argument(where + ": names no phase");
     }
   }
-  if (observable.constraint && observable.kind != ObservableKind::kMinimum) {
-    throw std::invalid_argument(where + ": a constraint is a minimum that must stay >= 0");
+  if (observable.constraint && observable.kind != ObservableKind::kMinimum && observable.kind != ObservableKind::kFinal) {
+    throw std::invalid_argument(where + ": a constraint is a minimum or a final value that must stay >= 0");
+  }
+  if (observable.kind == ObservableKind::kFinal &&
+      std::count_if(observable.phases.begin(), observable.phases.end(), [](const auto& g) { return g != nullptr; }) != 1) {
+    throw std::invalid_argument(where + ": a final value names exactly one phase");
   }
   observables_.push_back(std::move(observable));
 }
@@ -150,6 +154,7 @@ std::string ToString(ObservableKind kind) {
     case ObservableKind::kMean: return "mean";
     case ObservableKind::kMinimum: return "minimum";
     case ObservableKind::kMaximum: return "maximum";
+    case ObservableKind::kFinal: return "final";
   }
   HYBRIDCONT_UNREACHABLE();
 }

@@ -143,6 +143,8 @@ class Reader {
                                                                         const std::string& skip = "");
   // An observable's or constraint's name: an identifier that no unknown, parameter, quantity or other
   // observable has.
+  // A `final` table names exactly one phase.
+  void CheckOnePhase(const toml::node& node, const std::string& field) const;
   void CheckObservableName(const toml::node& node, const std::string& field, const std::string& name) const;
 
   // ---- sections (read_presentation.cc)

@@ -5,8 +5,10 @@
 //   speed = { mean = { stance = "-dl*sin(alpha) - l*cos(alpha)*dalpha", flight = "dx" } }
 //   flight_speed = { value = "x2_dx" }          # the orbit's unknowns, T, parameters, definitions
 //   apex = { maximum = { flight = "y" }, description = "highest point of the body" }
+//   touchdown_rate = { final = { flight = "dy + l0*sin(alpha)*dalpha" } }   # at the end of the phase
 //   [constraints]
 //   clearance = { flight = "y - l0*cos(alpha)", description = "the swing foot stays above the ground" }
+//   touchdown = { final = { flight = "-(dy + l0*sin(alpha)*dalpha)" } }      # >= 0 at the end of flight
 #include <memory>
 
 #include "hybridcont/expression_derivative.h"
@@ -69,6 +71,10 @@ void Reader::CheckObservableName(const toml::node& node, const std::string& fiel
   }
 }
 
+void Reader::CheckOnePhase(const toml::node& node, const std::string& field) const {
+  if (node.as_table()->size() != 1) Fail(&node, field, "a final value names exactly one phase");
+}
+
 void Reader::ReadObservables() {
   const toml::table* t = OptionalTable(root_, "observables", "");
   if (t == nullptr) return;
@@ -82,7 +88,7 @@ void Reader::ReadObservables() {
       Fail(&node, field, "expected a table with one of value, integral, mean, minimum, maximum, got " + TypeName(node));
     }
     const toml::table& ot = *node.as_table();
-    CheckKeys(ot, field, {"value", "integral", "mean", "minimum", "maximum", "description"});
+    CheckKeys(ot, field, {"value", "integral", "mean", "minimum", "maximum", "final", "description"});
     Observable o;
     o.name = name;
     o.description = OptionalString(ot, "description", field, "");
@@ -90,7 +96,7 @@ void Reader::ReadObservables() {
     const std::pair<const char*, ObservableKind> kinds_by_key[] = {
         {"value", ObservableKind::kValue},     {"integral", ObservableKind::kIntegral},
         {"mean", ObservableKind::kMean},       {"minimum", ObservableKind::kMinimum},
-        {"maximum", ObservableKind::kMaximum}};
+        {"maximum", ObservableKind::kMaximum}, {"final", ObservableKind::kFinal}};
     for (const auto& [k, kind] : kinds_by_key) {
       const toml::node* v = ot.get(k);
       if (v == nullptr) continue;
@@ -99,6 +105,7 @@ void Reader::ReadObservables() {
       const std::string f = field + "." + k;
       if (kind != ObservableKind::kValue) {
         o.phases = ReadPhaseFunctions(*v, f);
+        if (kind == ObservableKind::kFinal) CheckOnePhase(*v, f);
         continue;
       }
       // The orbit's unknowns by their layout index, T their durations' sum, then parameters and definitions.
@@ -120,7 +127,8 @@ void Reader::ReadObservables() {
       o.value = std::make_shared<ExpressionFunction>(e, static_cast<int>(layout.size()), num_parameters, At(v, f));
     }
     if (kinds != 1) {
-      Fail(&node, field, "give exactly one of value, integral, mean, minimum, maximum (got " + std::to_string(kinds) + ")");
+      Fail(&node, field,
+           "give exactly one of value, integral, mean, minimum, maximum, final (got " + std::to_string(kinds) + ")");
     }
     spec_.observables.push_back(std::move(o));
   }
@@ -138,14 +146,22 @@ void Reader::ReadConstraints() {
     }
     Observable o;
     o.name = name;
-    o.kind = ObservableKind::kMinimum;
     o.constraint = true;
     const toml::table& phases = *node.as_table();
     if (const toml::node* d = phases.get("description")) o.description = AsString(*d, field + ".description");
-    if (phases.size() == (phases.get("description") ? 1u : 0u)) {
-      Fail(&node, field, "names no phase (e.g. { flight = \"y - l0*cos(alpha)\" })");
+    if (const toml::node* final_value = phases.get("final")) {
+      // { final = { phase = "..." } }: the value at the end of that phase, >= 0.
+      CheckKeys(phases, field, {"final", "description"});
+      o.kind = ObservableKind::kFinal;
+      o.phases = ReadPhaseFunctions(*final_value, field + ".final");
+      CheckOnePhase(*final_value, field + ".final");
+    } else {
+      if (phases.size() == (phases.get("description") ? 1u : 0u)) {
+        Fail(&node, field, "names no phase (e.g. { flight = \"y - l0*cos(alpha)\" })");
+      }
+      o.kind = ObservableKind::kMinimum;
+      o.phases = ReadPhaseFunctions(node, field, "description");
     }
-    o.phases = ReadPhaseFunctions(node, field, "description");
     spec_.observables.push_back(std::move(o));
   }
 }

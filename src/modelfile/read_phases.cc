@@ -49,10 +49,14 @@ void Reader::ReadPhaseHeaders() {
         }
       }
     }
+    // Phases given by `ode` have any number of states (above kMaxPhaseDim they take the dynamic-size path,
+    // large_expression_phase.h); a mechanical phase's mass matrix is fixed-capacity storage.
+    const bool mechanical = !mech.coordinates.empty();
     mechanical_names_.push_back(std::move(mech));
-    if (p.state_names.empty() || static_cast<int>(p.state_names.size()) > kMaxPhaseDim) {
-      Fail(states, pf + ".states", std::to_string(p.state_names.size()) + " states, expected 1 to " +
-                                       std::to_string(kMaxPhaseDim));
+    if (p.state_names.empty()) Fail(states, pf + ".states", "0 states, expected at least 1");
+    if (mechanical && static_cast<int>(p.state_names.size()) > kMaxPhaseDim) {
+      Fail(states, pf + ".states", std::to_string(p.state_names.size()) + " states: a phase given by its mechanics has "
+                                   "at most " + std::to_string(kMaxPhaseDim) + " (write a larger one with `ode`)");
     }
     std::set<std::string> seen;
     for (const std::string& s : p.state_names) {

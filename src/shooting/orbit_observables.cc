@@ -192,6 +192,8 @@ EvaluationStatus ObservableEvaluator::Evaluate(int observable, const Vector& u, 
     }
   } else if (o.kind == ObservableKind::kIntegral || o.kind == ObservableKind::kMean) {
     status = Integral(o, observable, u, value, du);
+  } else if (o.kind == ObservableKind::kFinal) {
+    status = Final(o, u, value, du);
   } else {
     status = Extremum(o, u, value, du);
   }
@@ -259,6 +261,33 @@ EvaluationStatus ObservableEvaluator::Integral(const Observable& o, int observab
   if (duration == 0.0) return EvaluationStatus::Failure("a mean over phases whose durations sum to 0");
   *value = integral / duration;
   if (du) *du = (*du - *value * d_duration) / duration;
+  return {};
+}
+
+EvaluationStatus ObservableEvaluator::Final(const Observable& o, const Vector& u, double* value, RowVector* du) {
+  const int m = model_->num_phases();
+  const int k = layout_.num_first_integrals();
+  const auto xi = u.segment(layout_.xi_index(), k);
+  int i = 0;
+  while (o.phases[i] == nullptr) ++i;
+  // Segment i ends with phase i's event (segment m, phase 1 again, ends at the section).
+  const int n = layout_.dim(i);
+  const double t = u(layout_.time_index(i));
+  PhaseFlowResult res;
+  flows_[i].Integrate(u.segment(layout_.state_offset(i), n), xi, t, du != nullptr, &res);
+  counters_ += res.counters;
+  if (!res.ok()) return EvaluationStatus::Failure(res.message);
+  RowVector dg, dp;
+  *value = o.phases[i]->Evaluate(res.x, Parameters(), du ? &dg : nullptr, du ? &dp : nullptr);
+  last_interior_ = false;
+  if (du == nullptr) return {};
+  du->segment(layout_.state_offset(i), n) += dg * res.Phi;
+  if (k > 0) du->segment(layout_.xi_index(), k) += dg * res.Psi.leftCols(k);
+  for (int j = 0; j < layout_.num_free_parameters(); ++j) (*du)(layout_.parameter_index(j)) += dg.dot(res.Psi.col(k + j));
+  AddParameterGradient(dp, du);
+  Vector f;
+  model_->phase(i % m).UnfoldedVectorField(res.x, xi, &f, nullptr, nullptr);
+  (*du)(layout_.time_index(i)) += dg.dot(f);
   return {};
 }
 
