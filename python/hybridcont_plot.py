@@ -1084,12 +1084,16 @@ def figure_curves(res, svg, written):
     if not entries or not isinstance(p, str):
         return
     fig, ax = plt.subplots(figsize=(7.0, 4.8))
+    boundary_styles = ["--", ":", "-.", (0, (5, 1, 1, 1))]
+    boundaries = 0
     for pos, c in enumerate(entries):
         with open(os.path.join(res.dir, c["file"]), newline="") as f:
             rows = list(csv.DictReader(f))
         xs, ys = [to_float(r.get(p)) for r in rows], [to_float(r.get("H")) for r in rows]
         boundary = c.get("type") == "boundary"
-        ax.plot(xs, ys, color="0.25" if boundary else branch_colour(pos), lw=1.6, ls="--" if boundary else "-",
+        style = boundary_styles[boundaries % len(boundary_styles)] if boundary else "-"
+        boundaries += 1 if boundary else 0
+        ax.plot(xs, ys, color="0.25" if boundary else branch_colour(pos), lw=1.6, ls=style,
                 label="boundary %s" % c.get("name") if boundary
                 else "%s from special point %s" % (c.get("type"), c.get("special_point")))
         for q in c.get("codim_two") or []:

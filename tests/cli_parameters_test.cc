@@ -31,11 +31,13 @@ nlohmann::json ReadSummary(const fs::path& dir) {
   return nlohmann::json::parse(f);
 }
 
-// |r| of the built-in SLIP's map at stiffness k at the orbit of a branch file's row (infinite if it does not
-// evaluate): an independent check of a model file's or a free-parameter run's points.
-double BuiltinSlipResidual(const std::map<std::string, std::vector<double>>& columns, std::size_t row, double k) {
+// |r| of the built-in SLIP's map with `parameter` at `value` (default: the stiffness k) at the orbit of a
+// results file's row (infinite if it does not evaluate): an independent check of a model file's or a
+// free-parameter run's points.
+double BuiltinSlipResidual(const std::map<std::string, std::vector<double>>& columns, std::size_t row, double value,
+                           const std::string& parameter = "k") {
   HybridModel at_k = MakeBuiltinModel("slip");
-  at_k.SetParameter("k", k);
+  at_k.SetParameter(parameter, value);
   TimeBasedShooting map(at_k, IntegratorOptions{});
   const ShootingLayout& layout = map.layout();
   Vector u(layout.num_unknowns()), res;
@@ -234,6 +236,61 @@ TEST(CliParameters, SlipModelFileAtFixedMeanSpeedInStiffness) {
   EXPECT_GT(k_max - k_min, 10.0);
   std::printf("SLIP at mean speed 0.5: %d points, k in [%.3f, %.3f]; speed off by %.1e (from the unknowns %.1e), "
               "residual %.1e\n", points, k_min, k_max, worst_speed, worst_independent, worst_residual);
+}
+
+// The boundaries of the SLIP's physical hopping in (w2, H̄) at w2 around 25 (`--curves w2`): where the swing
+// foot's dip in flight touches the ground (clearance = 0) and where the foot lands moving tangentially
+// (touchdown = 0). Every curve point is an orbit of the built-in SLIP at its w2, and the closed-form flight
+// (ballistic body, harmonic leg) has its lowest foot height 0, resp. a zero foot speed at touch-down.
+TEST(CliParameters, SlipBoundariesOfPhysicalHoppingInSwingFrequency) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_cli_boundaries_w2";
+  const std::string file = std::string(HYBRIDCONT_SOURCE_DIR) + "/models/slip.toml";
+  const CliResult r = RunTool({"run", file, "--set", "w2=25", "--curves", "w2", "--bound", "w2=20:30", "--out",
+                               dir.string(), "--quiet", "--no-plots", "--threads", "1", "--overwrite"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json summary = ReadSummary(dir);
+  std::map<std::string, int> found;
+  double worst_clearance = 0, worst_touchdown = 0, worst_residual = 0, w2_min = 1e300, w2_max = -1e300;
+  for (const nlohmann::json& c : summary["curves"]) {
+    if (c["type"] != "boundary") continue;
+    const std::string name = c["name"];
+    const auto columns = ReadColumns(dir / c["file"].get<std::string>());
+    for (std::size_t row = 0; row < columns.at("H").size(); ++row) {
+      const double w2 = columns.at("w2")[row], w = std::sqrt(w2), t2 = columns.at("t2")[row];
+      const double y0 = columns.at("x2_y")[row], dy0 = columns.at("x2_dy")[row];
+      const double a0 = columns.at("x2_alpha")[row], da0 = columns.at("x2_dalpha")[row];
+      const auto alpha = [&](double t) { return a0 * std::cos(w * t) + da0 / w * std::sin(w * t); };
+      const auto height = [&](double t) { return y0 + dy0 * t - 0.5 * t * t - std::cos(alpha(t)); };
+      if (name == "clearance = 0") {
+        // The lowest interior foot height: dense samples, then golden-section search around the lowest.
+        const int n = 4000;
+        int best = 1;
+        for (int i = 1; i < n; ++i) best = height(t2 * i / n) < height(t2 * best / n) ? i : best;
+        double a = t2 * (best - 1) / n, b = t2 * (best + 1) / n;
+        for (int it = 0; it < 200; ++it) {
+          const double c1 = b - 0.618033988749895 * (b - a), c2 = a + 0.618033988749895 * (b - a);
+          (height(c1) < height(c2) ? b : a) = height(c1) < height(c2) ? c2 : c1;
+        }
+        worst_clearance = std::max(worst_clearance, std::abs(height(0.5 * (a + b))));
+      } else if (name == "touchdown = 0") {
+        const double da = -a0 * w * std::sin(w * t2) + da0 * std::cos(w * t2);
+        worst_touchdown = std::max(worst_touchdown, std::abs((dy0 - t2) + std::sin(alpha(t2)) * da));
+      }
+      worst_residual = std::max(worst_residual, BuiltinSlipResidual(columns, row, w2, "w2"));
+      w2_min = std::min(w2_min, w2), w2_max = std::max(w2_max, w2);
+      ++found[name];
+    }
+  }
+  EXPECT_GE(found["clearance = 0"], 5);
+  EXPECT_GE(found["touchdown = 0"], 5);
+  EXPECT_LT(worst_clearance, 1e-8);
+  EXPECT_LT(worst_touchdown, 1e-8);
+  EXPECT_LT(worst_residual, 1e-9);
+  EXPECT_NEAR(w2_min, 20.0, 1e-9);
+  EXPECT_NEAR(w2_max, 30.0, 1e-9);
+  std::printf("boundaries in w2: %d points on clearance = 0 (closed-form minimum %.1e), %d on touchdown = 0 "
+              "(closed-form foot speed %.1e), residual %.1e\n", found["clearance = 0"], worst_clearance,
+              found["touchdown = 0"], worst_touchdown, worst_residual);
 }
 
 }  // namespace
