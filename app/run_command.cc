@@ -223,12 +223,17 @@ void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log,
 // The Floquet crossings among the diagram's special points (located by the exploration as test functions,
 // floquet_test_functions.h), one line each, BP before PD.
 std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayout& layout) {
-  std::string report = "Floquet special points (multiplier crossings on physical orbits; grazing events):\n";
+  std::string report =
+      "Floquet and observable special points (multiplier crossings on physical orbits; grazing events; constraint "
+      "boundaries; monitored values):\n";
   int count = 0;
   for (const auto& [type, code] : {std::pair{SpecialPointType::kFloquetBranchPoint, "BP"},
                                    std::pair{SpecialPointType::kPeriodDoubling, "PD"},
                                    std::pair{SpecialPointType::kGrazing, "GR"},
-                                   std::pair{SpecialPointType::kNeimarkSacker, "NS"}}) {
+                                   std::pair{SpecialPointType::kNeimarkSacker, "NS"},
+                                   std::pair{SpecialPointType::kKreinCollision, "KC"},
+                                   std::pair{SpecialPointType::kConstraintBoundary, "CB"},
+                                   std::pair{SpecialPointType::kObservableValue, "UZ"}}) {
     for (const SpecialPoint& sp : diagram.special_points) {
       if (sp.type != type || sp.u.size() == 0) continue;
       const double precision = sp.interval_width.size() ? sp.interval_width.norm() : sp.precision();
@@ -310,7 +315,7 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   }
   if (formulation == Formulation::kStateBased) ConvertToTimeBased(exploration, layout, &diagram);
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
-  nlohmann::json special_points = SpecialPointsJson(diagram, layout);
+  nlohmann::json special_points = SpecialPointsJson(diagram, layout, &model, setup.integrator);
   const std::string floquet_report = FloquetReport(diagram, layout);
   std::string period_doubled;
   const std::unique_ptr<HybridModel> doubled =

@@ -1,7 +1,10 @@
 #include "summary_json.h"
 
 #include <cmath>
+#include <memory>
+#include <stdexcept>
 
+#include "hybridcont/orbit_observables.h"
 #include "model_exploration.h"
 
 namespace hybridcont::app {
@@ -20,6 +23,7 @@ std::string SpecialPointTypeCode(SpecialPointType type) {
     case SpecialPointType::kNeimarkSacker: return "NS";
     case SpecialPointType::kObservableValue: return "UZ";
     case SpecialPointType::kConstraintBoundary: return "CB";
+    case SpecialPointType::kKreinCollision: return "KC";
   }
   return "?";
 }
@@ -71,8 +75,12 @@ nlohmann::json OptionsJson(const RunArguments& args, const RunSetup& setup) {
   return j;
 }
 
-nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayout& layout) {
+nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayout& layout, const HybridModel* model,
+                                 const IntegratorOptions& integrator) {
   nlohmann::json list = nlohmann::json::array();
+  // The model at a point's parameter values (free parameters are unknowns), for its observables.
+  std::unique_ptr<HybridModel> at_point;
+  if (model != nullptr && !model->observables().empty()) at_point = std::make_unique<HybridModel>(model->Clone());
   for (const SpecialPoint& sp : d.special_points) {
     const bool level = layout.has_level();  // no H̄ without a first integral
     const double H = sp.u.size() && level ? sp.u(layout.H_index()) : std::nan("");
@@ -106,6 +114,25 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
       // And each observable that joined the unknowns, e.g. "speed": 0.5.
       for (int i = 0; i < layout.num_observables(); ++i) {
         j[layout.unknown_names()[layout.observable_index(i)]] = sp.u(layout.observable_index(i));
+      }
+      if (at_point) {
+        nlohmann::json values = nlohmann::json::object();
+        bool in_range = true;
+        for (int i = 0; i < layout.num_free_parameters() && in_range; ++i) {
+          try {
+            at_point->SetParameterValue(layout.parameter_model_index(i), sp.u(layout.parameter_index(i)));
+          } catch (const std::invalid_argument&) {
+            in_range = false;
+          }
+        }
+        ObservableEvaluator evaluator(*at_point, layout, integrator);
+        for (int k = 0; k < static_cast<int>(at_point->observables().size()); ++k) {
+          double v = 0.0;
+          const std::string& name = at_point->observables()[k].name;
+          if (in_range && evaluator.Evaluate(k, sp.u, &v, nullptr).ok) values[name] = v;
+          else values[name] = nullptr;
+        }
+        j["observables"] = values;
       }
     }
     list.push_back(j);

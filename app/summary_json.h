@@ -20,8 +20,11 @@ namespace hybridcont::app {
 // exploration limits, start conditions and the scenario's unknown scales.
 nlohmann::json OptionsJson(const RunArguments& args, const RunSetup& setup);
 
-// The continuation's special points of `d` (u in the time-based layout described by `layout`).
-nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayout& layout);
+// The continuation's special points of `d` (u in the time-based layout described by `layout`). With a
+// model, each point also gets "observables": the model's observables and constraints at it (evaluated at
+// its parameter values; null where one is undefined).
+nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayout& layout,
+                                 const HybridModel* model = nullptr, const IntegratorOptions& integrator = {});
 
 }  // namespace hybridcont::app
 

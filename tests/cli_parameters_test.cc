@@ -198,7 +198,10 @@ TEST(CliParameters, SlipModelFileRunsUntilAMeanSpeed) {
   int uz = 0;
   double worst_apex = 0;
   for (const nlohmann::json& sp : summary["special_points"]) {
+    // Every special point lists the model's observables at it.
+    EXPECT_TRUE(sp.contains("observables") && sp["observables"].contains("clearance")) << sp.dump();
     if (sp["type"] != "UZ") continue;
+    EXPECT_NEAR(sp["observables"]["apex"].get<double>(), 1.2, 1e-9);
     ++uz;
     worst_apex = std::max(worst_apex, std::abs(sp["apex"].get<double>() - 1.2));
   }

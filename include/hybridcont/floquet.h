@@ -64,6 +64,21 @@
 //                                                    where two real multipliers have product 1 (a neutral
 //                                                    saddle, no bifurcation); on a symplectic map, whose
 //                                                    multipliers come in pairs mu, 1/mu, it is 0 everywhere.
+//   krein_test = sign of prod over pairs a < b of (rho_a - rho_b)^2 / (1 + |rho_a|^2 + |rho_b|^2) times the
+//                                                    smallest factor's modulus (the product of many factors
+//                                                    would underflow), rho = mu + 1/mu
+//                                                    per reciprocal pair (mu, 1/mu) of a symplectic map: real
+//                                                    for real rho (pairs on the unit circle, rho = 2 cos θ, or
+//                                                    real pairs off it) and negative for a conjugate pair of
+//                                                    rho (a quadruplet mu, 1/mu, mu-bar, 1/mu-bar off the
+//                                                    circle). It changes sign where two pairs collide and
+//                                                    leave as a quadruplet: a Krein collision when they
+//                                                    collide on the unit circle (|rho| < 2). Two pairs of the
+//                                                    same Krein signature pass through each other instead: a
+//                                                    double zero, no sign change. NaN where the multipliers
+//                                                    do not pair up to pair_tolerance (the map is not
+//                                                    symplectic: the SLIP with its massless leg) or fewer
+//                                                    than two pairs exist.
 //
 //   TimeBasedShooting shooting(model, IntegratorOptions{});
 //   FloquetResult fl = ComputeFloquet(shooting, u);
@@ -72,6 +87,7 @@
 #define HYBRIDCONT_FLOQUET_H_
 
 #include <complex>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -82,6 +98,9 @@ namespace hybridcont {
 struct FloquetOptions {
   double unit_tolerance = 1e-6;      // |mu - 1| for a further unit multiplier (see the header comment)
   double circle_tolerance = 1e-6;    // |mu| <= 1 + this for linear stability
+  // |mu_i mu_j - 1| below this pairs two multipliers as reciprocal (krein_test): the inverse product keeps
+  // the pairs of symplectic maps at 1e-11 (the rod), a non-symplectic map misses by O(1) (the SLIP: 0.97).
+  double pair_tolerance = 1e-6;
   double min_transversality = 1e-8;  // saltation refused below this crossing sine
   // The multipliers inside the unit circle from the inverse product where every factor is invertible.
   bool product_inverse = true;
@@ -139,8 +158,15 @@ struct FloquetResult {
   double bp_test = 0;      // prod (mu - 1) over the nontrivial multipliers
   double pd_test = 0;      // 2^num_trivial * prod (mu + 1) over the nontrivial multipliers
   double ns_test = 1;      // prod (mu_i mu_j - 1) over pairs of nontrivial multipliers (1 with fewer than 2)
+  double krein_test = std::numeric_limits<double>::quiet_NaN();  // see the header comment; NaN: not symplectic
+  // rho = mu + 1/mu of each reciprocal pair (empty where the multipliers do not pair up): a Krein collision
+  // is where two of them meet inside (-2, 2).
+  std::vector<std::complex<double>> krein_rho;
   // A complex pair of modulus 1 within `tolerance`: what makes a zero of ns_test a Neimark–Sacker point.
   bool HasUnitComplexPair(double tolerance = 1e-6) const;
+  // Two rho of krein_rho within `tolerance` of each other at |Re rho| < 2: what makes a zero of krein_test a
+  // Krein collision (two pairs meeting on the unit circle), not a meeting of two real pairs off it.
+  bool HasKreinCollision(double tolerance) const;
   // Residuals of the theory on this orbit (|Phi_T f - f| / |f|, |dH Phi_T - dH| / |dH|): ~integration
   // error on a periodic orbit; large values mean u is not a periodic orbit at xi = 0.
   double flow_residual = 0;

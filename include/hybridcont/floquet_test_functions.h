@@ -51,8 +51,11 @@ double PeriodDoublingTest(const Matrix& dr, const ShootingLayout& layout);
 // event-driven replay does not return (replay.h) has NaN values: the multipliers of a non-physical orbit
 // mean nothing for the mechanical system. Trial points between two branch points are not classified.
 //
-// Last, a kNeimarkSacker function: FloquetResult::ns_test (floquet.h), NaN at a branch point where it is
+// Then a kNeimarkSacker function: FloquetResult::ns_test (floquet.h), NaN at a branch point where it is
 // below kNeimarkSackerUndefined (on a symplectic map it is 0 everywhere but for the multipliers' errors).
+// Last, for a model with a first integral, a kKreinCollision function: FloquetResult::krein_test, NaN where
+// the multipliers do not come in reciprocal pairs (the map is not symplectic); its zeros are kept where two
+// pairs meet on the unit circle (two real pairs meeting off it are no Krein collision).
 //
 // A model without first integral adds one kGrazing function per event, the normalized crossing speed
 // de_i·f_i / (|de_i| |f_i|) at the end of segment i (negative on a physical orbit, zero where the event is
@@ -73,6 +76,9 @@ class FloquetTestFunctions : public TestFunctions {
   // |ns_test| below this at a branch point: undefined there (the map is symplectic, see Evaluate).
   static constexpr double kNeimarkSackerUndefined = 1e-8;
   static constexpr double kUnitPairTolerance = 1e-6;
+  // At a located Krein collision the two rho = mu + 1/mu meet to the square root of the location's accuracy
+  // (krein_test is quadratic in their distance): within 1e-4 of each other.
+  static constexpr double kKreinMeetTolerance = 1e-4;
   std::unique_ptr<TestFunctions> Clone() const override;
   // The integrator tolerances times factor.
   std::unique_ptr<TestFunctions> Refined(double factor) const override;

@@ -49,6 +49,7 @@ enum class SpecialPointType {
   kNeimarkSacker,       // a complex pair of Floquet multipliers crosses the unit circle (NS; floquet.h)
   kObservableValue,     // an observable reaches a value the user monitors (UZ, as AUTO's; observable.h)
   kConstraintBoundary,  // an admissibility constraint's minimum reaches 0 (CB; observable.h)
+  kKreinCollision,      // two pairs of multipliers of a symplectic map collide on the unit circle (KC; floquet.h)
 };
 std::string ToString(SpecialPointType type);
 

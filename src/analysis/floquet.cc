@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -46,6 +47,58 @@ std::string FloquetResult::BriefReport() const {
      << max_modulus << ", nontrivial multipliers";
   for (const auto& mu : nontrivial) os << " " << mu.real() << (mu.imag() >= 0 ? "+" : "") << mu.imag() << "i";
   return os.str();
+}
+
+namespace {
+// krein_test and krein_rho (floquet.h): the nontrivial multipliers paired greedily with their reciprocals,
+// rho per pair the mean of the two members' mu + 1/mu.
+void KreinTest(double pair_tolerance, FloquetResult* res) {
+  const std::vector<std::complex<double>>& mu = res->nontrivial;
+  const int n = static_cast<int>(mu.size());
+  if (n < 4 || n % 2 != 0) return;
+  std::vector<bool> paired(n, false);
+  std::vector<std::complex<double>> rho;
+  for (int i = 0; i < n; ++i) {
+    if (paired[i]) continue;
+    int best = -1;
+    for (int j = i + 1; j < n; ++j) {
+      if (!paired[j] && (best < 0 || std::abs(mu[i] * mu[j] - 1.0) < std::abs(mu[i] * mu[best] - 1.0))) best = j;
+    }
+    if (best < 0 || !(std::abs(mu[i] * mu[best] - 1.0) <= pair_tolerance)) return;  // not symplectic
+    paired[i] = paired[best] = true;
+    rho.push_back(0.5 * (mu[i] + 1.0 / mu[i] + mu[best] + 1.0 / mu[best]));
+  }
+  // The product's sign (from its factors' phases: many factors would underflow) times its smallest factor's
+  // modulus: continuous, zero exactly where two rho meet, of the size of the closest approach.
+  std::complex<double> phase = 1.0;
+  double smallest = std::numeric_limits<double>::infinity();
+  for (std::size_t a = 0; a < rho.size(); ++a) {
+    for (std::size_t b = a + 1; b < rho.size(); ++b) {
+      const std::complex<double> factor =
+          (rho[a] - rho[b]) * (rho[a] - rho[b]) / (1.0 + std::norm(rho[a]) + std::norm(rho[b]));
+      const double modulus = std::abs(factor);
+      if (modulus == 0.0) {
+        smallest = 0.0;
+        continue;
+      }
+      phase *= factor / modulus;
+      smallest = std::min(smallest, modulus);
+    }
+  }
+  res->krein_test = (phase.real() < 0 ? -1.0 : 1.0) * smallest;  // conjugate rho make the phase ±1
+  res->krein_rho = std::move(rho);
+}
+}  // namespace
+
+bool FloquetResult::HasKreinCollision(double tolerance) const {
+  // The closest two rho, and whether they meet on the unit circle (|Re rho| < 2).
+  for (std::size_t a = 0; a < krein_rho.size(); ++a) {
+    for (std::size_t b = a + 1; b < krein_rho.size(); ++b) {
+      const std::complex<double> mid = 0.5 * (krein_rho[a] + krein_rho[b]);
+      if (std::abs(krein_rho[a] - krein_rho[b]) <= tolerance && std::abs(mid.real()) < 2.0) return true;
+    }
+  }
+  return false;
 }
 
 bool FloquetResult::HasUnitComplexPair(double tolerance) const {
@@ -174,6 +227,7 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
     for (std::size_t j = i + 1; j < res.nontrivial.size(); ++j) ns *= res.nontrivial[i] * res.nontrivial[j] - 1.0;
   }
   res.ns_test = ns.real();
+  KreinTest(options.pair_tolerance, &res);
   res.bp_test = bp.real();  // conjugate pairs make the products real up to round-off
   res.pd_test = pd.real();
   res.normal = res.num_unit == res.num_trivial;

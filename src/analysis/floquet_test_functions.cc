@@ -59,6 +59,7 @@ std::vector<SpecialPointType> FloquetTestFunctions::types() const {
   std::vector<SpecialPointType> types = {SpecialPointType::kFloquetBranchPoint, SpecialPointType::kPeriodDoubling};
   if (model_->num_first_integrals() == 0) types.insert(types.end(), model_->num_phases(), SpecialPointType::kGrazing);
   types.push_back(SpecialPointType::kNeimarkSacker);
+  if (model_->num_first_integrals() > 0) types.push_back(SpecialPointType::kKreinCollision);
   return types;
 }
 
@@ -91,8 +92,9 @@ bool FloquetTestFunctions::Physical(const Vector& u_free) const {
 void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* values) {
   const int m = model_->num_phases();
   const bool grazing = model_->num_first_integrals() == 0;
-  const int ns = 2 + (grazing ? m : 0);  // the Neimark–Sacker function, last
-  *values = Vector::Constant(ns + 1, std::numeric_limits<double>::quiet_NaN());
+  const int ns = 2 + (grazing ? m : 0);  // the Neimark–Sacker function, then (conservative) the Krein one
+  const bool krein = !grazing;
+  *values = Vector::Constant(ns + 1 + (krein ? 1 : 0), std::numeric_limits<double>::quiet_NaN());
   const bool evaluated = shooting_.Evaluate(u, nullptr, &dr_).ok;
   if (grazing && evaluated) {  // every orbit, physical or not: the crossing speed changes sign at grazing
     const HybridModel& model = shooting_.model();  // at u's parameter values
@@ -114,13 +116,18 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
   // branch points, so that noise marks no point; a crossing elsewhere has |ns_test| of order 1 at the
   // branch points around it and keeps its values in between.
   (*values)(ns) = branch_point && std::abs(floquet.ns_test) < kNeimarkSackerUndefined ? std::nan("") : floquet.ns_test;
+  if (krein) (*values)(ns + 1) = floquet.krein_test;  // NaN where the map is not symplectic
 }
 
 bool FloquetTestFunctions::Keep(int function, const Vector& u, std::string* note) {
-  if (types()[function] != SpecialPointType::kNeimarkSacker) return true;
+  const SpecialPointType type = types()[function];
+  if (type != SpecialPointType::kNeimarkSacker && type != SpecialPointType::kKreinCollision) return true;
   const FloquetResult floquet = ComputeFloquet(shooting_, u);
   if (!floquet.ok()) return true;
   (void)note;
+  if (type == SpecialPointType::kKreinCollision) {
+    return floquet.HasKreinCollision(kKreinMeetTolerance);  // else two real pairs met off the unit circle
+  }
   return floquet.HasUnitComplexPair(kUnitPairTolerance);  // else a neutral saddle: no bifurcation
 }
 

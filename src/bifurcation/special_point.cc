@@ -18,6 +18,7 @@ constexpr internal::EnumName<SpecialPointType> kSpecialPointTypeNames[] = {
     {SpecialPointType::kNeimarkSacker, "neimark-sacker"},
     {SpecialPointType::kObservableValue, "observable-value"},
     {SpecialPointType::kConstraintBoundary, "constraint-boundary"},
+    {SpecialPointType::kKreinCollision, "krein-collision"},
     {SpecialPointType::kUserTestFunction, "test-function-zero"},
 };
 

@@ -535,6 +535,10 @@ void SpecialPointDetector::DetectTestFunctions(size_t index, bool from_singular,
       if (!(defined(k - 1) && defined(k) && defined(k + 1))) continue;
       const bool one_sign = std::signbit(g(k - 1)) == std::signbit(g(k)) && std::signbit(g(k)) == std::signbit(g(k + 1));
       if (!one_sign || !(std::abs(g(k)) < std::abs(g(k - 1)) && std::abs(g(k)) <= std::abs(g(k + 1)))) continue;
+      // A dip at the noise level of g is no bowl: a function constant along the branch (a homogeneous
+      // model's multipliers) has such "minima" at a third of its samples.
+      const double rim = std::min(std::abs(g(k - 1)), std::abs(g(k + 1)));
+      if (rim - std::abs(g(k)) <= kNoiseDip * std::abs(g(k))) continue;
       CurveMinimum minimum = MinimizeOnCurve(j, std::signbit(g(k)) ? -1.0 : 1.0, samples[k - 1], samples[k], samples[k + 1]);
       const CurveSample& lo = minimum.left ? samples[k - 1] : samples[k];
       const CurveSample& hi = minimum.left ? samples[k] : samples[k + 1];

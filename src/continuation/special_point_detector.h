@@ -66,6 +66,11 @@ class SpecialPointDetector {
   // sqrt(c/κ) below 1e-5 of the samples' spread, where the test's own rounding and integration error
   // (relative 1e-13 to 1e-9 on the maps of this library) can no longer tell c from zero.
   static constexpr double kTouchingZero = 1e-10;
+  // A local minimum of |g| over the samples whose dip below the lower of its neighbours is at most this
+  // fraction of |g| is integration noise, not a bowl that could hold two zeros or touch zero: not refined
+  // on the curve. The test functions' relative error is 1e-13 to 1e-9 (above); a real bowl between two
+  // steps of the controller dips by far more.
+  static constexpr double kNoiseDip = 1e-6;
   // Relative agreement of a branch point's test values with the mapped ones at which a symmetry counts as
   // leaving the test functions invariant (integration noise of the mapped and the image's evaluation).
   static constexpr double kInvariantTolerance = 1e-6;
