@@ -23,7 +23,11 @@ void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator,
     const OrbitTrace trace(model, u, integrator);
     record->classification = ClassifyOrbit(model, u, trace, ClassificationOptions{});
   }
-  // Observables: those that joined the unknowns from u, the others evaluated at the point.
+  // Floquet data first: its r + dr evaluation leaves r in the map's cache, so the residual below costs no
+  // second integration on physical points.
+  AnalyzePhysicalOrbit(model, floquet_map, replay_options, record->u, record);
+  // Observables: those that joined the unknowns from u, the others evaluated at a physical point (empty
+  // elsewhere, like the Floquet columns: a reversed-time orbit's mean speed means nothing for the mechanism).
   const std::vector<Observable>& observables = model.observables();
   if (!observables.empty()) {
     const ShootingLayout& layout = floquet_map.layout();
@@ -33,15 +37,12 @@ void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator,
       double value = std::nan("");
       if (k >= 0) {
         value = record->u(k);
-      } else if (!evaluator.Evaluate(j, record->u, &value, nullptr).ok) {
+      } else if (!record->classification.physical || !evaluator.Evaluate(j, record->u, &value, nullptr).ok) {
         value = std::nan("");
       }
       record->observables.push_back({observables[j].name, value});
     }
   }
-  // Floquet data first: its r + dr evaluation leaves r in the map's cache, so the residual below costs no
-  // second integration on physical points.
-  AnalyzePhysicalOrbit(model, floquet_map, replay_options, record->u, record);
   Vector r;
   const EvaluationStatus status = floquet_map.Evaluate(record->u, &r, nullptr);
   record->residual = status.ok ? r.norm() : std::nan("");

@@ -57,7 +57,8 @@ struct PointRecord {
   // Extra named columns appended after the fixed ones (e.g. Floquet data); same names for every row.
   std::vector<std::pair<std::string, double>> extra;
   // The model's observables and constraints at the point (observable.h), written after the quantities; NaN
-  // where one is undefined (a mean over zero durations, a failed integration).
+  // where one is undefined (a mean over zero durations, a failed integration) and, unless it is an unknown of
+  // the run, at a non-physical point.
   std::vector<std::pair<std::string, double>> observables;
 };
 
