@@ -144,7 +144,7 @@ TEST(FloquetAccuracy, StabilityClassNamesTheKindOfInstability) {
   EXPECT_EQ(classify(Eigen::Vector3d(-1.5, -2.0, 0.1).asDiagonal()), "unstable (2 flip)");
   Matrix rotation = Matrix::Zero(3, 3);  // a complex pair of modulus 1.2 and a saddle multiplier 3
   rotation << 0, -1.2, 0, 1.2, 0, 0, 0, 0, 3;
-  EXPECT_EQ(classify(rotation), "unstable (saddle, oscillatory)");
+  EXPECT_EQ(classify(rotation), "unstable (saddle and oscillatory)");
   rotation(0, 1) = -1, rotation(1, 0) = 1, rotation(2, 2) = 0.3;  // a pair on the unit circle
   EXPECT_EQ(classify(rotation), "neutrally stable");
 }

@@ -6,6 +6,7 @@
 
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -69,6 +70,13 @@ TEST(LargeModel, RunsEndToEndAndItsOrbitsAreThoseOfTheLinearChain) {
   int physical = 0, families = 0;
   double worst_flow = 0, worst_period = 0;
   for (const nlohmann::json& b : summary["branches"]) {
+    // Every row has the header's number of cells (a multiplier list of 22 entries, a two-kind stability).
+    std::ifstream rows(dir / b["file"].get<std::string>());
+    std::string header, line;
+    std::getline(rows, header);
+    while (std::getline(rows, line)) {
+      ASSERT_EQ(std::count(line.begin(), line.end(), ','), std::count(header.begin(), header.end(), ',')) << line;
+    }
     const auto c = ReadColumns(dir / b["file"].get<std::string>());
     double period = std::nan("");
     bool family = false;

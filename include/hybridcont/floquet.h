@@ -129,7 +129,8 @@ struct StabilityClass {
   int flip = 0;                   // real multipliers < −1 − tolerance
   int oscillatory = 0;            // complex pairs outside the unit circle
   bool unstable() const { return saddle + flip + oscillatory > 0; }
-  // "asymptotically stable", "neutrally stable", "unstable (saddle)", "unstable (flip, 2 oscillatory)", ...
+  // "asymptotically stable", "neutrally stable", "unstable (saddle)", "unstable (flip and 2 oscillatory)",
+  // ...: no comma, the text is a cell of the branch files' CSV.
   std::string ToString() const;
 };
 

@@ -113,7 +113,7 @@ std::string StabilityClass::ToString() const {
   std::string kinds;
   const auto add = [&](int count, const char* name) {
     if (count == 0) return;
-    kinds += (kinds.empty() ? "" : ", ") + (count > 1 ? std::to_string(count) + " " : std::string()) + name;
+    kinds += (kinds.empty() ? "" : " and ") + (count > 1 ? std::to_string(count) + " " : std::string()) + name;
   };
   add(saddle, "saddle");
   add(flip, "flip");
