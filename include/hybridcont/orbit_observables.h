@@ -60,6 +60,10 @@ class ObservableEvaluator {
   EvaluationStatus Integral(const Observable& o, int observable, const Vector& u, double* value, RowVector* du);
   EvaluationStatus Extremum(const Observable& o, const Vector& u, double* value, RowVector* du);
   EvaluationStatus Final(const Observable& o, const Vector& u, double* value, RowVector* du);
+  // g(x_s(t)) on segment s and, with du, its gradient: ∇g times the sensitivities at t plus ∂g/∂p, and, where
+  // t is the segment's end (is_end), ∇g·f~ for t_s.
+  EvaluationStatus ValueAt(const SmoothFunction& g, int segment, double t, bool is_end, const Vector& u,
+                           double* value, RowVector* du);
   Vector Parameters() const;
   void AddParameterGradient(const RowVector& dp, RowVector* du) const;
 

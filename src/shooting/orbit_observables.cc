@@ -26,7 +26,6 @@ class QuadraturePhase : public Phase {
     const int n = base_->dim();
     thread_local Vector fb;
     thread_local Matrix dfb;
-    thread_local RowVector dg;
     base_->VectorField(x.head(n), &fb, df ? &dfb : nullptr);
     Assemble(x, fb, df ? &dfb : nullptr, f, df);
   }
@@ -264,31 +263,37 @@ EvaluationStatus ObservableEvaluator::Integral(const Observable& o, int observab
   return {};
 }
 
-EvaluationStatus ObservableEvaluator::Final(const Observable& o, const Vector& u, double* value, RowVector* du) {
-  const int m = model_->num_phases();
+EvaluationStatus ObservableEvaluator::ValueAt(const SmoothFunction& g, int segment, double t, bool is_end,
+                                              const Vector& u, double* value, RowVector* du) {
   const int k = layout_.num_first_integrals();
   const auto xi = u.segment(layout_.xi_index(), k);
-  int i = 0;
-  while (o.phases[i] == nullptr) ++i;
-  // Segment i ends with phase i's event (segment m, phase 1 again, ends at the section).
-  const int n = layout_.dim(i);
-  const double t = u(layout_.time_index(i));
+  const int i = segment % model_->num_phases();
+  const int n = layout_.dim(segment);
   PhaseFlowResult res;
-  flows_[i].Integrate(u.segment(layout_.state_offset(i), n), xi, t, du != nullptr, &res);
+  flows_[i].Integrate(u.segment(layout_.state_offset(segment), n), xi, t, du != nullptr, &res);
   counters_ += res.counters;
   if (!res.ok()) return EvaluationStatus::Failure(res.message);
   RowVector dg, dp;
-  *value = o.phases[i]->Evaluate(res.x, Parameters(), du ? &dg : nullptr, du ? &dp : nullptr);
-  last_interior_ = false;
+  *value = g.Evaluate(res.x, Parameters(), du ? &dg : nullptr, du ? &dp : nullptr);
   if (du == nullptr) return {};
-  du->segment(layout_.state_offset(i), n) += dg * res.Phi;
+  du->segment(layout_.state_offset(segment), n) += dg * res.Phi;
   if (k > 0) du->segment(layout_.xi_index(), k) += dg * res.Psi.leftCols(k);
   for (int j = 0; j < layout_.num_free_parameters(); ++j) (*du)(layout_.parameter_index(j)) += dg.dot(res.Psi.col(k + j));
   AddParameterGradient(dp, du);
-  Vector f;
-  model_->phase(i % m).UnfoldedVectorField(res.x, xi, &f, nullptr, nullptr);
-  (*du)(layout_.time_index(i)) += dg.dot(f);
+  if (is_end && t != 0.0) {  // x(t_s) moves with t_s
+    Vector f;
+    model_->phase(i).UnfoldedVectorField(res.x, xi, &f, nullptr, nullptr);
+    (*du)(layout_.time_index(segment)) += dg.dot(f);
+  }
   return {};
+}
+
+EvaluationStatus ObservableEvaluator::Final(const Observable& o, const Vector& u, double* value, RowVector* du) {
+  int i = 0;
+  while (o.phases[i] == nullptr) ++i;
+  // Segment i ends with phase i's event (segment m, phase 1 again, ends at the section).
+  last_interior_ = false;
+  return ValueAt(*o.phases[i], i, u(layout_.time_index(i)), true, u, value, du);
 }
 
 EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector& u, double* value, RowVector* du) {
@@ -388,26 +393,11 @@ EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector
   *value = sign * (use_end ? best_end : best);
   last_interior_ = !use_end;
   if (du == nullptr) return {};
-  // Gradient: ∇g(x(t*)) dx(t*)/d(x̄_s, ξ, p) + ∂g/∂p, and ġ(t_s) when t* is the segment's end.
-  const int i = segment % m;
-  const SmoothFunction& g = *o.phases[i];
-  const int n = layout_.dim(segment);
-  const double t_s = u(layout_.time_index(segment));
-  const Vector x0 = u.segment(layout_.state_offset(segment), n);
-  flows_[i].Integrate(x0, xi, t_star, true, &res);
-  counters_ += res.counters;
-  if (!res.ok()) return EvaluationStatus::Failure(res.message);
-  RowVector dp;
-  g.Evaluate(res.x, p, &dg, &dp);
-  du->segment(layout_.state_offset(segment), n) += dg * res.Phi;
-  if (k > 0) du->segment(layout_.xi_index(), k) += dg * res.Psi.leftCols(k);
-  for (int j = 0; j < layout_.num_free_parameters(); ++j) (*du)(layout_.parameter_index(j)) += dg.dot(res.Psi.col(k + j));
-  AddParameterGradient(dp, du);
-  if (use_end && t_star == t_s && t_s != 0.0) {
-    model_->phase(i).UnfoldedVectorField(res.x, xi, &f, nullptr, nullptr);
-    (*du)(layout_.time_index(segment)) += dg.dot(f);
-  }
-  return {};
+  // Gradient: ∇g(x(t*)) dx(t*)/d(x̄_s, ξ, p) + ∂g/∂p (envelope theorem), and ġ(t_s) when t* is the segment's
+  // end.
+  const bool at_end = use_end && t_star == u(layout_.time_index(segment));
+  double unused;
+  return ValueAt(*o.phases[segment % m], segment, t_star, at_end, u, &unused, du);
 }
 
 }  // namespace hybridcont
