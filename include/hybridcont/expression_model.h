@@ -41,6 +41,19 @@ struct ExpressionPhaseSpec {
   std::vector<int> coordinates;
 };
 
+// A model file's hybrid automaton ([[modes]] and [[transitions]], hybrid_automaton.h): transition k is
+// catalogue phase k, its source mode's programs with its guard as the event and its reset.
+struct ExpressionAutomatonSpec {
+  std::vector<AutomatonMode> modes;
+  std::vector<AutomatonTransition> transitions;  // guards: the event programs as functions
+  int anchor_mode = 0;
+  Word word;                                     // the file's word: the run's start is an orbit of it
+  std::vector<ExpressionPhaseSpec> phases;       // the catalogue, one per transition
+  std::vector<ModelSymmetry> symmetries;         // signs per catalogue phase
+  std::vector<Observable> observables;           // functions per catalogue phase
+  ModelSetup setup;                              // the file's, for its word
+};
+
 struct ExpressionModelSpec {
   std::string name;
   std::string description;
@@ -50,7 +63,16 @@ struct ExpressionModelSpec {
   std::vector<ModelSymmetry> symmetries;
   std::vector<Observable> observables;  // and admissibility constraints (observable.h)
   ModelSetup setup;
+  // Set for an automaton: the fields above are those of its word (ExpressionWordSpec).
+  std::shared_ptr<const ExpressionAutomatonSpec> automaton;
 };
+
+// The cyclic model spec of one word of spec.automaton: phase i is catalogue phase word[i], symmetries and
+// observables mapped along. Words other than the file's keep the run's bounds and drawing but not what names
+// the file word's unknowns (starts, families, quantities, figures, value observables).
+ExpressionModelSpec ExpressionWordSpec(const ExpressionModelSpec& spec, const Word& word);
+// The catalogue as one spec (phases per transition, the anchor after them), what a model file compiles.
+ExpressionModelSpec ExpressionCatalogueSpec(const ExpressionModelSpec& spec);
 
 // The programs of a model, in the order phase 0 (vector field, integrals, event, reset), phase 1, ...,
 // then the anchor.
@@ -177,7 +199,8 @@ struct ParametersAs<ExpressionPhaseData, S> {
 
 }  // namespace internal
 
-// Builds the model; compiled (may be null) supplies compiled entry points for the spec's programs.
+// Builds the model; compiled (may be null) supplies compiled entry points for the spec's programs (for an
+// automaton: for ExpressionCatalogueSpec(spec)'s, and the model is the automaton's model of its word).
 // Throws std::invalid_argument for inconsistent sizes (ValidatePhaseSizes' messages).
 HybridModel BuildExpressionModel(ExpressionModelSpec spec, std::shared_ptr<const CompiledPrograms> compiled = nullptr);
 

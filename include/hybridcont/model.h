@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "hybridcont/hybrid_automaton.h"
 #include "hybridcont/invariant.h"
 #include "hybridcont/model_setup.h"
 #include "hybridcont/observable.h"
@@ -260,6 +261,17 @@ class HybridModel {
   // constraint is not a minimum.
   void AddObservable(Observable observable);
 
+  // The hybrid automaton this model is the word `word()` of (hybrid_automaton.h), or null: a cyclic model is
+  // the automaton of its one cycle. Set by HybridAutomaton::ModelForWord; kept by Clone.
+  const std::shared_ptr<const HybridAutomaton>& automaton() const { return automaton_; }
+  const Word& word() const { return word_; }
+  void SetAutomaton(std::shared_ptr<const HybridAutomaton> automaton, Word word) {
+    automaton_ = std::move(automaton);
+    word_ = std::move(word);
+  }
+  // The modes of the phases: the automaton's mode names along word(), else the phases' names.
+  std::vector<std::string> WordModeNames() const;
+
  private:
   int ParameterIndex(const std::string& name) const;
 
@@ -271,6 +283,8 @@ class HybridModel {
   std::vector<ModelSymmetry> symmetries_;
   std::vector<Observable> observables_;
   ModelSetup setup_;
+  std::shared_ptr<const HybridAutomaton> automaton_;
+  Word word_;
 };
 
 }  // namespace hybridcont

@@ -63,6 +63,9 @@ struct Observable {
   std::vector<std::shared_ptr<const SmoothFunction>> phases;
   // An admissibility constraint (kind kMinimum or kFinal): a physical orbit keeps the value >= 0.
   bool constraint = false;
+  // A competing transition's guard (hybrid_automaton.h): a segment's start value does not count, since a
+  // phase may begin where the guard is 0 (right after that very transition, or a simultaneous one).
+  bool guard = false;
 };
 
 }  // namespace hybridcont

@@ -51,6 +51,9 @@ class ObservableEvaluator {
   // Whether the last extremum evaluated lies inside its segment (not at an end): a constraint's boundary
   // is a zero of its interior minimum (observable.h).
   bool last_extremum_interior() const { return last_interior_; }
+  // Where it was attained: the shooting segment and the time in it (0 <= |t| <= |t_s|).
+  int last_extremum_segment() const { return last_segment_; }
+  double last_extremum_time() const { return last_time_; }
 
   // Work of the integrations since the last ResetCounters().
   const FlowCounters& counters() const { return counters_; }
@@ -77,6 +80,8 @@ class ObservableEvaluator {
   std::map<std::pair<int, int>, std::unique_ptr<Quadrature>> quadratures_;
   FlowCounters counters_;
   bool last_interior_ = false;
+  int last_segment_ = -1;
+  double last_time_ = 0.0;
 };
 
 }  // namespace hybridcont

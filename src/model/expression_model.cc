@@ -1,5 +1,7 @@
 #include "hybridcont/expression_model.h"
 
+#include <algorithm>
+
 #include "large_expression_phase.h"
 
 #include <stdexcept>
@@ -112,7 +114,104 @@ std::string internal::ExpressionFunctions::ExplainNonFinite(const Vector& x, con
   return ExplainMassMatrix(entries, names, q);
 }
 
+ExpressionModelSpec ExpressionWordSpec(const ExpressionModelSpec& spec, const Word& word) {
+  HYBRIDCONT_DEMAND(spec.automaton != nullptr);
+  const ExpressionAutomatonSpec& a = *spec.automaton;
+  ExpressionModelSpec w;
+  w.name = spec.name;
+  w.description = spec.description;
+  w.parameters = spec.parameters;
+  w.anchor = spec.anchor;
+  for (int k : word) w.phases.push_back(a.phases[k]);
+  for (const ModelSymmetry& s : a.symmetries) {
+    ModelSymmetry mapped = s;
+    mapped.state_signs.clear();
+    for (int k : word) mapped.state_signs.push_back(s.state_signs[k]);
+    w.symmetries.push_back(std::move(mapped));
+  }
+  const bool file_word = word == a.word;
+  for (const Observable& o : a.observables) {
+    if (o.kind == ObservableKind::kValue) {
+      if (file_word) w.observables.push_back(o);  // a function of the file word's unknowns
+      continue;
+    }
+    Observable mapped = o;
+    mapped.phases.clear();
+    for (int k : word) mapped.phases.push_back(o.phases[k]);
+    const bool any = std::any_of(mapped.phases.begin(), mapped.phases.end(), [](const auto& g) { return g != nullptr; });
+    const int named = static_cast<int>(std::count_if(mapped.phases.begin(), mapped.phases.end(),
+                                                     [](const auto& g) { return g != nullptr; }));
+    // A final value names one phase: in a word that visits its mode twice it is the first visit's.
+    if (o.kind == ObservableKind::kFinal && named > 1) {
+      bool first = true;
+      for (auto& g : mapped.phases) {
+        if (g && !first) g = nullptr;
+        if (g) first = false;
+      }
+    }
+    if (any) w.observables.push_back(std::move(mapped));
+  }
+  w.setup = a.setup;
+  if (!file_word) {
+    w.setup.start = StartSpec{};
+    w.setup.more_starts.clear();
+    w.setup.families.clear();
+    w.setup.quantities.clear();
+    w.setup.figures.clear();
+  }
+  return w;
+}
+
+ExpressionModelSpec ExpressionCatalogueSpec(const ExpressionModelSpec& spec) {
+  HYBRIDCONT_DEMAND(spec.automaton != nullptr);
+  ExpressionModelSpec c;
+  c.name = spec.name;
+  c.parameters = spec.parameters;
+  c.phases = spec.automaton->phases;
+  c.anchor = spec.anchor;
+  return c;
+}
+
+namespace {
+
+// The compiled entry points of a word, picked from the catalogue's (null stays null).
+std::shared_ptr<const CompiledPrograms> WordPrograms(const std::shared_ptr<const CompiledPrograms>& catalogue,
+                                                     int num_catalogue_phases, const Word& word) {
+  if (!catalogue) return nullptr;
+  auto w = std::make_shared<CompiledPrograms>();
+  const bool param_jets = !catalogue->param_jet_entries.empty();
+  for (int k : word) {
+    for (int kind = 0; kind < 5; ++kind) {
+      w->entries.push_back(catalogue->entries[5 * k + kind]);
+      if (param_jets) w->param_jet_entries.push_back(catalogue->param_jet_entries[5 * k + kind]);
+    }
+  }
+  for (int kind = 0; kind < 5; ++kind) {
+    w->entries.push_back(catalogue->entries[5 * num_catalogue_phases + kind]);
+    if (param_jets) w->param_jet_entries.push_back(catalogue->param_jet_entries[5 * num_catalogue_phases + kind]);
+  }
+  w->library = catalogue->library;
+  return w;
+}
+
+}  // namespace
+
 HybridModel BuildExpressionModel(ExpressionModelSpec spec, std::shared_ptr<const CompiledPrograms> compiled) {
+  if (spec.automaton) {
+    std::shared_ptr<const ExpressionAutomatonSpec> a = spec.automaton;
+    const int num_catalogue = static_cast<int>(a->phases.size());
+    if (compiled && static_cast<int>(compiled->entries.size()) != 5 * num_catalogue + 5) {
+      throw std::invalid_argument("model '" + spec.name + "': compiled code does not match the model");
+    }
+    // The factory keeps the spec (header, anchor, catalogue) and the compiled code alive.
+    auto base = std::make_shared<const ExpressionModelSpec>(spec);
+    auto automaton = HybridAutomaton::Create(
+        spec.name, a->modes, a->transitions, a->anchor_mode, [base, compiled, num_catalogue](const Word& word) {
+          ExpressionModelSpec w = ExpressionWordSpec(*base, word);
+          return BuildExpressionModel(std::move(w), WordPrograms(compiled, num_catalogue, word));
+        });
+    return automaton->ModelForWord(a->word);
+  }
   const int m = static_cast<int>(spec.phases.size());
   if (m == 0) throw std::invalid_argument("model '" + spec.name + "': no phases");
   auto data = std::make_unique<ExpressionModelData>();

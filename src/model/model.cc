@@ -147,6 +147,13 @@ void HybridModel::AddObservable(Observable observable) {
   observables_.push_back(std::move(observable));
 }
 
+std::vector<std::string> HybridModel::WordModeNames() const {
+  if (automaton_) return automaton_->ModeNames(word_);
+  std::vector<std::string> names;
+  for (const auto& phase : phases_) names.push_back(phase->name());
+  return names;
+}
+
 std::string ToString(ObservableKind kind) {
   switch (kind) {
     case ObservableKind::kValue: return "value";
@@ -227,6 +234,8 @@ HybridModel HybridModel::Clone() const {
   copy.symmetries_ = symmetries_;
   copy.observables_ = observables_;
   copy.setup_ = setup_;
+  copy.automaton_ = automaton_;
+  copy.word_ = word_;
   return copy;
 }
 

@@ -105,7 +105,7 @@ ExpressionModelSpec ReadModelFile(const std::filesystem::path& path) {
 HybridModel LoadModelFile(const std::filesystem::path& path, const ModelFileOptions& options) {
   ExpressionModelSpec spec = ReadModelFile(path);
   std::shared_ptr<const CompiledPrograms> compiled;
-  if (options.compile) compiled = internal::CompileModel(spec, options);
+  if (options.compile) compiled = internal::CompileModel(spec.automaton ? ExpressionCatalogueSpec(spec) : spec, options);
   try {
     return BuildExpressionModel(std::move(spec), std::move(compiled));
   } catch (const ModelInputError&) {

@@ -11,7 +11,7 @@ namespace hybridcont::internal {
 ExpressionModelSpec Reader::Read() {
   CheckKeys(root_, "", {"hybridcont", "name", "description", "title", "parameters", "definitions", "phases",
                         "symmetries", "start", "run", "families", "quantities", "figures", "drawing",
-                        "conservative", "observables", "constraints"});
+                        "conservative", "observables", "constraints", "modes", "transitions", "word"});
   ReadVersion();
   conservative_ = OptionalBool(root_, "conservative", "", true);
   if (!conservative_) num_integrals_ = 0;
@@ -36,6 +36,17 @@ ExpressionModelSpec Reader::Read() {
   for (const FamilyRule& rule : spec_.setup.families) CheckSetupValue(rule.when, OrbitSymbols());
   ReadFigures();
   ReadDrawing();
+  if (!transition_tables_.empty()) {  // an automaton: the catalogue kept, the spec that of the file's word
+    automaton_.phases = spec_.phases;
+    automaton_.symmetries = spec_.symmetries;
+    automaton_.observables = spec_.observables;
+    automaton_.setup = spec_.setup;
+    spec_.automaton = std::make_shared<const ExpressionAutomatonSpec>(std::move(automaton_));
+    ExpressionModelSpec word = ExpressionWordSpec(spec_, spec_.automaton->word);
+    word.automaton = spec_.automaton;
+    return word;
+  }
+  if (root_.get("word")) Fail(root_.get("word"), "word", "'word' belongs to an automaton ([[modes]] and [[transitions]])");
   return std::move(spec_);
 }
 
@@ -207,9 +218,12 @@ ExprPtr Reader::PhaseSymbol(int phase, const std::string& name) {
   // A quantity read with the pinned coordinates as symbols is cached apart: elsewhere it is unknown.
   const std::string key = std::to_string(phase) + (pinned_symbols_phase_ == phase ? "+pinned:" : ":") + name;
   if (auto it = lets_.find(key); it != lets_.end()) return it->second;
-  if (const toml::table* let = phase_lets_[phase]) {
+  const toml::table* transition_let = transition_lets_.empty() ? nullptr : transition_lets_[phase];
+  for (const toml::table* let : {transition_let, phase_lets_[phase]}) {
+    if (let == nullptr) continue;
     if (const toml::node* n = let->get(name)) {
-      const std::string field = "phases." + spec_.phases[phase].name + ".let." + name;
+      const std::string field = (let == transition_let ? TransitionField(phase) : "phases." + spec_.phases[phase].name) +
+                                ".let." + name;
       if (!resolving_.insert(field).second) Fail(n, field, "'" + name + "' is defined in terms of itself");
       const ExprPtr e = ParseExpression(ExpressionText(*n, field),
                                         [this, phase](const std::string& s) { return PhaseSymbol(phase, s); },
@@ -240,10 +254,11 @@ void Reader::CheckSetupValue(const SetupValue& v, const std::vector<std::string>
 
 std::vector<std::string> Reader::UnknownNames() const {
   std::vector<std::string> names;
-  const int m = static_cast<int>(spec_.phases.size());
+  const std::vector<int>& word = WordPhases();
+  const int m = static_cast<int>(word.size());
   for (int i = 0; i <= m; ++i) names.push_back("t" + std::to_string(i + 1));
   for (int i = 0; i <= m; ++i) {
-    for (const std::string& s : spec_.phases[i % m].state_names) names.push_back("x" + std::to_string(i + 1) + "_" + s);
+    for (const std::string& s : spec_.phases[word[i % m]].state_names) names.push_back("x" + std::to_string(i + 1) + "_" + s);
   }
   if (num_integrals_ == 0) {  // no unfolding, no level: the run's parameter carries the family
     if (!spec_.setup.run.parameter.empty()) names.push_back(spec_.setup.run.parameter);

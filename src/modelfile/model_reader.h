@@ -96,6 +96,20 @@ class Reader {
 
   // ---- sections (read_phases.cc)
   void ReadPhaseHeaders();
+  // One [[phases]] or [[modes]] table's name, states and typical state (mode: the keys of a mode).
+  ExpressionPhaseSpec ReadPhaseHeader(const toml::table& t, const std::string& field, std::set<std::string>* names,
+                                      bool mode);
+  // [[modes]] and [[transitions]]: the catalogue of phases, one per transition (hybrid_automaton.h), and `word`.
+  void ReadAutomatonHeaders();
+  void ReadWord();
+  // The phases of the file's word: catalogue indices (an automaton) or 0..m-1.
+  const std::vector<int>& WordPhases() const;
+  // The phase that phase i resets into.
+  int NextPhase(int i) const;
+  // The table holding phase i's event and reset: its transition's for an automaton.
+  const toml::table& EventTable(int i) const { return transition_tables_.empty() ? *phase_tables_[i] : *transition_tables_[i]; }
+  // "phases.<name>" or "transitions.<name>": the field of phase i's event and reset.
+  std::string TransitionField(int i) const;
   // The functions of phase i: its let quantities, ode, first integrals, event, reset and (first phase) anchor.
   void ReadPhaseFunctions(int i);
   // The let quantities of phase i, each parsed now: errors in unused quantities are errors too.
@@ -170,6 +184,12 @@ class Reader {
   std::set<std::string> resolving_;
   std::vector<const toml::table*> phase_tables_;
   std::vector<const toml::table*> phase_lets_;
+  // An automaton: per catalogue phase its transition's table and let, the phase it resets into.
+  std::vector<const toml::table*> transition_tables_;
+  std::vector<const toml::table*> transition_lets_;
+  std::vector<int> next_phase_;
+  ExpressionAutomatonSpec automaton_;
+  mutable std::vector<int> cycle_;
   int num_integrals_ = 1;
   std::vector<MechanicalNames> mechanical_names_;
   // The phase whose pinned coordinates are symbols (while its energies and contact are read), or -1.

@@ -234,7 +234,7 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
       after = RelabelVelocities(system, relabel, after, At(rl, field + ".relabel"));
     }
     // Into the next phase: a state named like one of this phase's takes its value after the impact.
-    const ExpressionPhaseSpec& next = spec_.phases[(i + 1) % spec_.phases.size()];
+    const ExpressionPhaseSpec& next = spec_.phases[NextPhase(i)];
     for (const std::string& s : next.state_names) {
       const auto v = std::find(names.velocities.begin(), names.velocities.end(), s);
       const auto q = std::find(names.coordinates.begin(), names.coordinates.end(), s);

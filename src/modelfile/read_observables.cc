@@ -20,10 +20,11 @@ namespace hybridcont::internal {
 std::vector<std::string> Reader::LayoutNames() const {
   // The time-based layout's order (shooting_layout.h): segments m+1 down to 1, then ξ and H̄.
   std::vector<std::string> names;
-  const int m = static_cast<int>(spec_.phases.size());
+  const std::vector<int>& word = WordPhases();
+  const int m = static_cast<int>(word.size());
   for (int i = m; i >= 0; --i) {
     names.push_back("t" + std::to_string(i + 1));
-    for (const std::string& s : spec_.phases[i % m].state_names) names.push_back("x" + std::to_string(i + 1) + "_" + s);
+    for (const std::string& s : spec_.phases[word[i % m]].state_names) names.push_back("x" + std::to_string(i + 1) + "_" + s);
   }
   for (int j = 0; j < num_integrals_; ++j) names.push_back(num_integrals_ == 1 ? "xi" : "xi" + std::to_string(j + 1));
   if (num_integrals_ > 0) names.push_back("H");
@@ -50,9 +51,13 @@ std::vector<std::shared_ptr<const SmoothFunction>> Reader::ReadPhaseFunctions(co
       for (const ExpressionPhaseSpec& p : spec_.phases) known += (known.empty() ? "" : ", ") + p.name;
       Fail(&value, f, "'" + phase + "' is not a phase (phases: " + known + ")");
     }
-    const ExprPtr e = ParsePhaseExpression(i, value, f);
-    functions[i] = std::make_shared<ExpressionFunction>(e, static_cast<int>(spec_.phases[i].state_names.size()),
-                                                        num_parameters, At(&value, f));
+    // Every phase of that name: an automaton's mode is a phase per transition out of it.
+    for (; i < m; ++i) {
+      if (spec_.phases[i].name != phase) continue;
+      const ExprPtr e = ParsePhaseExpression(i, value, f);
+      functions[i] = std::make_shared<ExpressionFunction>(e, static_cast<int>(spec_.phases[i].state_names.size()),
+                                                          num_parameters, At(&value, f));
+    }
   }
   return functions;
 }

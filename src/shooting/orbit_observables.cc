@@ -382,6 +382,7 @@ EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector
     }
     // The ends.
     for (const int j : {0, ns - 1}) {
+      if (o.guard && j == 0 && ns > 1) continue;  // a guard may be 0 where its phase begins (observable.h)
       if (h[j] < best_end) best_end = h[j], end_segment = s, end_t = samples[j].t;
     }
   }
@@ -392,6 +393,8 @@ EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector
   HYBRIDCONT_DEMAND(segment >= 0);
   *value = sign * (use_end ? best_end : best);
   last_interior_ = !use_end;
+  last_segment_ = segment;
+  last_time_ = t_star;
   if (du == nullptr) return {};
   // Gradient: ∇g(x(t*)) dx(t*)/d(x̄_s, ξ, p) + ∂g/∂p (envelope theorem), and ġ(t_s) when t* is the segment's
   // end.
