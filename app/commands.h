@@ -41,6 +41,7 @@ struct RunArguments {
   bool no_plots = false;
   bool no_symmetry = false;            // trace every half-branch instead of mapping images
   bool overwrite = false;              // replace another model's results in --out (refused otherwise)
+  bool one_word = false;               // an automaton: follow the start's word only (no phase-sequence changes)
   bool period_doubling = false;        // explore the period-doubled family of every located PD point
   std::string free;                    // a model parameter continued as an unknown (needs `fix`)
   std::string fix;                     // NAME=VALUE: the unknown held fixed while `free` varies, e.g. H=1.5

@@ -146,6 +146,18 @@ class EngineFloquetTests : public TestFunctions {
 
 }  // namespace
 
+void RenumberDiagram(int branch_offset, int point_offset, BifurcationDiagram* d) {
+  const auto branch = [&](int* id) { *id = *id >= 0 ? *id + branch_offset : *id; };
+  const auto point = [&](int* id) { *id = *id >= 0 ? *id + point_offset : *id; };
+  const auto special = [&](SpecialPoint* sp) { point(&sp->id), branch(&sp->branch_id), point(&sp->duplicate_of); };
+  for (Branch& b : d->branches) {
+    branch(&b.id), branch(&b.image_of), branch(&b.reflected_from), point(&b.parent_special_point);
+    for (SpecialPoint& sp : b.special_points) special(&sp);
+  }
+  for (SpecialPoint& sp : d->special_points) special(&sp);
+}
+
+
 std::string ToString(Formulation f) { return internal::EnumToString(kFormulationNames, f); }
 
 bool FromString(const std::string& text, Formulation* f) { return internal::EnumFromString(kFormulationNames, text, f); }
@@ -361,7 +373,7 @@ void Append(BifurcationDiagram&& d, BifurcationDiagram* all) {
 
 }  // namespace
 
-bool ModelExploration::OnBranch(const BifurcationDiagram& d, const Vector& u) const {
+int ModelExploration::BranchThrough(const BifurcationDiagram& d, const Vector& u) const {
   const Vector& s = scaled_->scales();
   const Vector x = u.cwiseQuotient(s);
   // The chord sag of a step is a small fraction of it (curvature · step² / 8); a distinct family crosses a
@@ -375,11 +387,11 @@ bool ModelExploration::OnBranch(const BifurcationDiagram& d, const Vector& u) co
       const double t = length2 > 0 ? std::clamp((x - a).dot(chord) / length2, 0.0, 1.0) : 0.0;
       const double distance = (x - a - t * chord).norm();
       if (distance <= options_.known_branch_tolerance * (1 + x.norm()) + kSagFraction * std::sqrt(length2)) {
-        return true;
+        return b.id;
       }
     }
   }
-  return false;
+  return -1;
 }
 
 BifurcationDiagram ModelExploration::RunFromStarts(const std::vector<Vector>& starts, const PointCallback& on_point,

@@ -38,6 +38,10 @@ struct TestFunctionWork {
   long curve_evaluations = 0;  // of which of the copies of the engine's problem
 };
 
+// Ids of a diagram explored on its own, moved after the run's: branches by branch_offset, special points by
+// point_offset (a period-doubled family's, another word's).
+void RenumberDiagram(int branch_offset, int point_offset, BifurcationDiagram* d);
+
 // Bounds, step sizes, depth and branch limits of the scenario.
 ExplorationOptions ScenarioExplorationOptions(const Scenario& scenario);
 
@@ -85,6 +89,11 @@ class ModelExploration {
   EvaluationStatus ToTimeBased(const Vector& u, Vector* u_time);
   const Vector& scales() const { return scaled_->scales(); }
   // Work of the formulation's map (RHS evaluations, map evaluations).
+  // The id of a branch of d that u (model units) lies on: within the chord sag of one of its segments
+  // (scaled); -1 for none.
+  int BranchThrough(const BifurcationDiagram& d, const Vector& u) const;
+  bool OnBranch(const BifurcationDiagram& d, const Vector& u) const { return BranchThrough(d, u) >= 0; }
+
   FlowCounters counters() const;
   long num_evaluations() const;
   // Work of the Floquet test functions so far (complete once Run has returned).
@@ -95,8 +104,6 @@ class ModelExploration {
  private:
   // The run's options in scaled units with the callbacks converting to model units.
   ExplorationOptions EngineOptions(const PointCallback& on_point, int branch_offset = 0);
-  // Whether u (model units) lies on a branch of d: within the chord sag of one of its segments (scaled).
-  bool OnBranch(const BifurcationDiagram& d, const Vector& u) const;
   // The diagram's points and special points from scaled to model units.
   void ToModelUnits(BifurcationDiagram* diagram) const;
   // The first physical point of the time-based scenario, or an empty vector (message in *why).

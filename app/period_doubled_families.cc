@@ -42,19 +42,6 @@ ExplorationOptions DoubledOptions(const ExplorationOptions& run, const ShootingL
   return o;
 }
 
-// Ids of a diagram explored on its own, moved after the run's: branches by branch_offset, special points
-// by point_offset.
-void Renumber(int branch_offset, int point_offset, BifurcationDiagram* d) {
-  const auto branch = [&](int* id) { *id = *id >= 0 ? *id + branch_offset : *id; };
-  const auto point = [&](int* id) { *id = *id >= 0 ? *id + point_offset : *id; };
-  const auto special = [&](SpecialPoint* sp) { point(&sp->id), branch(&sp->branch_id), point(&sp->duplicate_of); };
-  for (Branch& b : d->branches) {
-    branch(&b.id), branch(&b.image_of), branch(&b.reflected_from), point(&b.parent_special_point);
-    for (SpecialPoint& sp : b.special_points) special(&sp);
-  }
-  for (SpecialPoint& sp : d->special_points) special(&sp);
-}
-
 // What the family's accepted points said, per branch id of the run.
 struct FamilyLog {
   std::map<int, std::vector<double>> stable, H;
@@ -117,7 +104,7 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
       continue;
     }
     ++families;
-    Renumber(offset, static_cast<int>(special_points->size()), &d);
+    RenumberDiagram(offset, static_cast<int>(special_points->size()), &d);
     for (SpecialPoint& sp : d.special_points) sp.message += " [period-doubled family of PD #" + std::to_string(pd_id) + "]";
     for (nlohmann::json& j : SpecialPointsJson(d, layout)) {
       j["period_doubled_from"] = pd_id;

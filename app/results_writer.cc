@@ -150,7 +150,14 @@ bool ResultsWriter::WriteFailed(const fs::path& file) {
 
 void ResultsWriter::SetBranchModel(int branch_id, const HybridModel& model) {
   // The run's free parameters are the other model's too (a doubled model's columns: its unknowns and p).
-  branch_models_.insert_or_assign(branch_id, BranchModel{ShootingLayout(model, free_), OrbitPresentation(model)});
+  branch_models_.insert_or_assign(branch_id,
+                                  BranchModel{ShootingLayout(model, free_), OrbitPresentation(model), model.WordModeNames()});
+}
+
+int ResultsWriter::next_branch_id() const {
+  int next = 0;
+  for (const nlohmann::json& b : summary_["branches"]) next = std::max(next, b["id"].get<int>() + 1);
+  return next;
 }
 
 void ResultsWriter::AnnotateBranch(int branch_id, const nlohmann::json& fields) {
@@ -230,6 +237,9 @@ void ResultsWriter::EndBranch(const Branch& b) {
                                   {"message", b.message},
                                   {"newton_iterations", b.newton_iterations},
                                   {"rejected_steps", b.rejected_steps}});
+  // Its phase sequence: the modes of its word (a cyclic model's phases).
+  const auto other = branch_models_.find(b.id);
+  summary_["branches"].back()["word"] = other == branch_models_.end() ? model_.WordModeNames() : other->second.word;
   if (b.image_of >= 0) {  // mapped, not traced (exploration.h, "Symmetries")
     summary_["branches"].back()["image_of"] = b.image_of;
     summary_["branches"].back()["symmetry"] = b.symmetry;

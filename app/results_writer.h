@@ -116,6 +116,8 @@ class ResultsWriter {
 
   const std::filesystem::path& dir() const { return dir_; }
   static std::string BranchFileName(int id) { return "branch-" + std::to_string(id) + ".csv"; }
+  // One more than the largest branch id ended so far (0 for none).
+  int next_branch_id() const;
 
  private:
   std::filesystem::path dir_;
@@ -127,6 +129,7 @@ class ResultsWriter {
   struct BranchModel {
     ShootingLayout layout;
     OrbitPresentation presentation;
+    std::vector<std::string> word;  // its modes (HybridModel::WordModeNames)
   };
   std::map<int, BranchModel> branch_models_;  // branches of another model (SetBranchModel)
   std::map<int, std::ofstream> branch_files_;

@@ -32,6 +32,7 @@
 #include "orbit_start.h"
 #include "parameter_starts.h"
 #include "period_doubled_families.h"
+#include "word_families.h"
 #include "results_writer.h"
 #include "run_setup.h"
 #include "scenario.h"
@@ -84,6 +85,9 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
                 "replace the results of another model in --out (without it such a folder is refused)");
   run->add_flag("--period-doubling", args->period_doubling,
                 "explore the period-doubled family of every located PD point (the phase sequence traversed twice)");
+  run->add_flag("--one-word", args->one_word,
+                "a model given as an automaton: follow the start's phase sequence only, not the words its families "
+                "lead into where a phase vanishes or a competing guard is touched");
   run->add_flag("--quiet", args->quiet, "no progress lines");
   run->add_flag("--no-plots", args->no_plots, "do not draw figures");
 }
@@ -323,6 +327,7 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   if (doubled) {
     period_doubled = ExplorePeriodDoubledFamilies(model, *doubled, setup, diagram, &special_points, writer, out, args.quiet);
   }
+  const std::string words = args.one_word ? "" : ExploreWordChanges(model, setup, diagram, &special_points, writer, out, args.quiet);
   std::string curves_report;
   if (!setup.curve_parameter.empty()) {
     writer.Annotate("curves", TraceParameterCurves(model, setup, diagram, writer.dir(), &curves_report));
@@ -330,7 +335,7 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   writer.SetSpecialPoints(special_points);
   WriteKeyframeOrbits(diagram, stream.log(), model, setup, layout, writer);
   const std::string report =
-      RunReport(diagram, starts_report + floquet_report + period_doubled + curves_report, start_time, exploration,
+      RunReport(diagram, starts_report + floquet_report + period_doubled + words + curves_report, start_time, exploration,
                 stream.floquet_map());
   writer.SetReport(report);
   out << report;

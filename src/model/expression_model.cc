@@ -158,6 +158,15 @@ ExpressionModelSpec ExpressionWordSpec(const ExpressionModelSpec& spec, const Wo
     w.setup.families.clear();
     w.setup.quantities.clear();
     w.setup.figures.clear();
+    // Drawings of the modes the word visits; those for given segments of the file's word do not apply.
+    auto& drawings = w.setup.drawing.phases;
+    drawings.erase(std::remove_if(drawings.begin(), drawings.end(),
+                                  [&](const DrawingSpec::PhaseDrawing& d) {
+                                    return !d.segments.empty() ||
+                                           std::none_of(w.phases.begin(), w.phases.end(),
+                                                        [&](const ExpressionPhaseSpec& p) { return p.name == d.phase; });
+                                  }),
+                   drawings.end());
   }
   return w;
 }

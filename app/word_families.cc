@@ -1,0 +1,325 @@
+#include "word_families.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <algorithm>
+#include <deque>
+#include <memory>
+#include <vector>
+
+#include "hybridcont/corrector.h"
+#include "hybridcont/orbit_observables.h"
+#include "hybridcont/timebased_shooting.h"
+#include "hybridcont/word_change.h"
+#include "model_exploration.h"
+#include "orbit_analysis.h"
+#include "scenario.h"
+#include "summary_json.h"
+
+namespace hybridcont::app {
+namespace {
+
+// A duration at most this is 0 (a branch point on a zero-duration family, a start with zero durations).
+constexpr double kZeroDuration = 1e-12;
+
+// One explored word: its model, an exploration of it (for BranchThrough) and its diagrams' branches (run ids).
+struct WordEntry {
+  Word word;
+  std::unique_ptr<HybridModel> owned;  // null for the run's own word
+  const HybridModel* model = nullptr;
+  std::unique_ptr<ModelExploration> exploration;
+  BifurcationDiagram branches;  // every branch of this word traced so far, ids of the run
+};
+
+// Where a family of a word degenerates: a phase's zero duration or a competing guard touched.
+struct Degeneracy {
+  int branch = -1;
+  Vector u;
+  int segment = -1;
+  int transition = -1;  // a guard touched; -1: a zero duration
+  double t = 0;         // where in the segment (guards)
+  std::string where;
+};
+
+std::string Names(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& n : names) text += (text.empty() ? "" : " > ") + n;
+  return text;
+}
+
+// Zero durations of phases 2..m on the physical families of `d`, located with the duration held at 0.
+void ZeroDurations(const HybridModel& model, const BifurcationDiagram& d, const IntegratorOptions& integrator,
+                   std::vector<Degeneracy>* out) {
+  const ShootingLayout layout(model);
+  const int m = model.num_phases();
+  TimeBasedShooting map(model, integrator);
+  Corrector corrector(&map);
+  for (const Branch& b : d.branches) {
+    if (b.image_of >= 0) continue;  // an image's ends are the images of its source's
+    for (std::size_t i = 0; i + 1 < b.points.size(); ++i) {
+      const Vector ua = b.points[i].u.head(layout.num_unknowns()), ub = b.points[i + 1].u.head(layout.num_unknowns());
+      for (int s = 1; s < m; ++s) {
+        const double ta = ua(layout.time_index(s)), tb = ub(layout.time_index(s));
+        const bool za = std::abs(ta) <= kZeroDuration, zb = std::abs(tb) <= kZeroDuration;
+        if (za && zb) continue;  // a family with that duration 0 throughout: its crossings are branch points
+        if (!(ta * tb < 0 || za || zb)) continue;
+        if (!IsPhysical(model, ua, integrator) && !IsPhysical(model, ub, integrator)) continue;
+        Degeneracy g;
+        g.branch = b.id;
+        g.segment = s;
+        g.where = fmt::format("branch {} between points {} and {}", b.id, i, i + 1);
+        if (za || zb) {
+          g.u = za ? ua : ub;
+        } else {
+          const Vector guess = ua + (ta / (ta - tb)) * (ub - ua);
+          if (corrector.CorrectFixedComponent(guess, layout.time_index(s), 0.0, &g.u).status !=
+              CorrectorStatus::kConverged) {
+            continue;
+          }
+        }
+        out->push_back(std::move(g));
+      }
+    }
+  }
+}
+
+// Located CB points of the competing guards' constraints (hybrid_automaton.h).
+void TouchedGuards(const HybridModel& model, const BifurcationDiagram& d, const IntegratorOptions& integrator,
+                   std::vector<Degeneracy>* out) {
+  const HybridAutomaton& a = *model.automaton();
+  const ShootingLayout layout(model);
+  ObservableEvaluator evaluator(model, layout, integrator);
+  for (const SpecialPoint& sp : d.special_points) {
+    if (sp.type != SpecialPointType::kConstraintBoundary || sp.duplicate_of >= 0 || sp.u.size() == 0) continue;
+    const Vector u = sp.u.head(layout.num_unknowns());
+    int best = -1, segment = -1;
+    double smallest = 1e-6, t = 0;
+    for (int j = 0; j < static_cast<int>(model.observables().size()); ++j) {
+      const Observable& o = model.observables()[j];
+      double v = 0;
+      if (!o.guard || !evaluator.Evaluate(j, u, &v, nullptr).ok || !(std::abs(v) < smallest)) continue;
+      best = j, smallest = std::abs(v), segment = evaluator.last_extremum_segment(), t = evaluator.last_extremum_time();
+    }
+    if (best < 0) continue;
+    Degeneracy g;
+    g.branch = sp.branch_id;
+    g.u = u;
+    g.segment = segment;
+    g.t = t;
+    g.transition = a.GuardConstraintTransition(model.observables()[best].name);
+    g.where = fmt::format("special point {} (CB of {})", sp.id, model.observables()[best].name);
+    out->push_back(std::move(g));
+  }
+}
+
+// The run's options on another word's layout: bounds and targets on unknowns it has, the period's bound (a sum
+// of every duration) on its own durations.
+ExplorationOptions WordOptions(const ExplorationOptions& run, const ShootingLayout& from, const ShootingLayout& to) {
+  ExplorationOptions o = run;
+  o.start_conditions.clear();
+  const auto has = [&](const std::string& name) { return to.UnknownIndex(name) >= 0; };
+  ContinuationOptions& c = o.continuation;
+  c.bounds.clear();
+  for (const ComponentBound& b : run.continuation.bounds) {
+    if (has(b.component)) c.bounds.push_back(b);
+  }
+  c.targets.clear();
+  for (const ComponentTarget& t : run.continuation.targets) {
+    if (has(t.component)) c.targets.push_back(t);
+  }
+  std::vector<std::string> from_durations, to_durations;
+  for (int s = 0; s < from.num_segments(); ++s) from_durations.push_back(from.unknown_names()[from.time_index(s)]);
+  for (int s = 0; s < to.num_segments(); ++s) to_durations.push_back(to.unknown_names()[to.time_index(s)]);
+  c.sum_bounds.clear();
+  for (const SumBound& b : run.continuation.sum_bounds) {
+    if (b.components == from_durations) {
+      c.sum_bounds.push_back({to_durations, b.lower, b.upper});
+    } else if (std::all_of(b.components.begin(), b.components.end(), has)) {
+      c.sum_bounds.push_back(b);
+    }
+  }
+  return o;
+}
+
+}  // namespace
+
+std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
+                               nlohmann::json* special_points, ResultsWriter& writer, std::ostream& out, bool quiet) {
+  if (!model.automaton()) return "";
+  const HybridAutomaton& automaton = *model.automaton();
+  std::string report = "Phase-sequence changes (words of the automaton):\n";
+  if (!setup.free.empty()) return report + "  not followed in a run with free parameters\n";
+  const IntegratorOptions& integrator = setup.integrator;
+  const ReplayOptions replay = ReplayOptionsFor(integrator);
+
+  std::deque<WordEntry> words;
+  words.push_back({model.word(), nullptr, &model, nullptr, diagram});
+  words.back().exploration =
+      std::make_unique<ModelExploration>(model, setup.scenario, integrator, setup.exploration);
+  nlohmann::json changes = nlohmann::json::array();
+  std::vector<std::pair<int, Vector>> handled;  // (word entry, orbit) of the degeneracies seen
+  const auto seen = [&](int entry, const Vector& u) {
+    for (const auto& [e, v] : handled) {
+      if (e == entry && v.size() == u.size() && (v - u).norm() <= 1e-6 * (1 + u.norm())) return true;
+    }
+    handled.emplace_back(entry, u);
+    return false;
+  };
+  std::deque<std::pair<int, BifurcationDiagram>> to_scan = {{0, diagram}};
+  while (!to_scan.empty()) {
+    const int entry = to_scan.front().first;
+    const BifurcationDiagram scan = std::move(to_scan.front().second);
+    to_scan.pop_front();
+    const HybridModel& word_model = *words[entry].model;
+    std::vector<Degeneracy> found;
+    ZeroDurations(word_model, scan, integrator, &found);
+    TouchedGuards(word_model, scan, integrator, &found);
+    for (const Degeneracy& g : found) {
+      if (seen(entry, g.u)) continue;
+      const ShootingLayout layout(word_model);
+      const double H = layout.has_level() ? g.u(layout.H_index()) : std::nan("");
+      std::string why;
+      const std::vector<WordChange> candidates =
+          g.transition < 0 ? WordsWithoutPhase(word_model, g.u, g.segment, integrator, &why)
+                           : WordsWithTransition(word_model, g.u, g.transition, g.segment, g.t, integrator, &why);
+      const std::string kind = g.transition < 0 ? fmt::format("t{} = 0", g.segment + 1)
+                                                : fmt::format("guard of {} touched", automaton.transitions()[g.transition].name);
+      report += fmt::format("  word {}: {} at H = {:.10f} ({}):\n", automaton.WordName(words[entry].word), kind, H, g.where);
+      if (candidates.empty()) {
+        report += "    refused: " + why + "\n";
+        changes.push_back({{"from_word", word_model.WordModeNames()}, {"from_branch", g.branch}, {"at", kind},
+                           {"H", H}, {"accepted", false}, {"reason", why}});
+        continue;
+      }
+      for (const WordChange& c : candidates) {
+        nlohmann::json j = {{"from_word", word_model.WordModeNames()},
+                            {"from_branch", g.branch},
+                            {"at", kind},
+                            {"H", H},
+                            {"rule", c.rule},
+                            {"to_word", automaton.ModeNames(c.word)},
+                            {"residual", c.residual},
+                            {"accepted", c.accepted}};
+        if (!c.accepted) {
+          j["reason"] = c.reason;
+          report += fmt::format("    {}: refused, {}\n", c.rule, c.reason);
+          changes.push_back(j);
+          continue;
+        }
+        j["state_difference"] = c.state_difference;
+        j["period_difference"] = c.period_difference;
+        const int id = static_cast<int>(changes.size());
+        // The word's entry, or a new one.
+        int target = -1;
+        for (std::size_t e = 0; e < words.size(); ++e) {
+          if (words[e].word == c.word) target = static_cast<int>(e);
+        }
+        if (target >= 0) {
+          const int through = words[target].exploration->BranchThrough(words[target].branches, c.u);
+          if (through >= 0) {
+            j["to_branches"] = {through};
+            report += fmt::format("    {}: the orbit continues on branch {} of word {} (already traced); same orbit to "
+                                  "{:.1e} (state at the section), {:.1e} (period)\n",
+                                  c.rule, through, automaton.WordName(c.word), c.state_difference, c.period_difference);
+            changes.push_back(j);
+            continue;
+          }
+        }
+        if (c.singular) {
+          j["accepted"] = false;
+          j["reason"] = "the orbit is a singular point (a branch point) of the new word's map, on no branch of it traced "
+                        "so far: not followed from there";
+          report += fmt::format("    {}: {}\n", c.rule, j["reason"].get<std::string>());
+          changes.push_back(j);
+          continue;
+        }
+        if (target >= 0) {
+        } else if (static_cast<int>(words.size()) >= kMaxWords) {
+          j["reason"] = fmt::format("not explored: {} words explored already", kMaxWords);
+          report += fmt::format("    {}: {}\n", c.rule, j["reason"].get<std::string>());
+          changes.push_back(j);
+          continue;
+        } else {
+          WordEntry w;
+          w.word = c.word;
+          w.owned = std::make_unique<HybridModel>(automaton.ModelForWord(c.word));
+          for (int p = 0; p < static_cast<int>(model.parameters().size()); ++p) {
+            w.owned->SetParameterValue(p, model.parameter_value(p));
+          }
+          w.model = w.owned.get();
+          try {
+            w.exploration = std::make_unique<ModelExploration>(
+                *w.model, DefaultScenario(*w.model), integrator,
+                WordOptions(setup.exploration, ShootingLayout(model), ShootingLayout(*w.model)));
+          } catch (const std::invalid_argument& e) {
+            j["reason"] = std::string("not explored: ") + e.what();
+            report += fmt::format("    {}: {}\n", c.rule, j["reason"].get<std::string>());
+            changes.push_back(j);
+            continue;
+          }
+          words.push_back(std::move(w));
+          target = static_cast<int>(words.size()) - 1;
+        }
+        // Explore the new word's family from the orbit, both directions.
+        WordEntry& w = words[target];
+        const int offset = writer.next_branch_id();
+        TimeBasedShooting floquet_map(*w.model, integrator);
+        const ShootingLayout word_layout(*w.model);
+        if (!quiet) out << fmt::format("word {} from {}:\n", automaton.WordName(c.word), c.rule);
+        int skipped = 0;
+        BifurcationDiagram d = w.exploration->RunFromStarts({c.u}, [&](const ProgressInfo& info, const Vector& u) {
+          const int branch = info.branch_id + offset;
+          if (info.point_index == 0) writer.SetBranchModel(branch, *w.model);
+          PointRecord record = RecordOf(info, u);
+          AnalyzePoint(*w.model, integrator, floquet_map, replay, &record);
+          writer.AddPoint(branch, record);
+          if (!quiet) {
+            out << fmt::format("  b{:<3} #{:<4} H = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {} ({})\n", branch,
+                               info.point_index, u(word_layout.H_index()), word_layout.Period(u), info.step,
+                               info.newton_iterations, ToString(record.classification.reason),
+                               automaton.WordName(c.word));
+          }
+        }, &skipped);
+        if (d.status == ExplorationStatus::kStartFailed) {
+          j["reason"] = "not explored: " + d.message;
+          report += fmt::format("    {}: {}\n", c.rule, j["reason"].get<std::string>());
+          changes.push_back(j);
+          continue;
+        }
+        RenumberDiagram(offset, static_cast<int>(special_points->size()), &d);
+        for (nlohmann::json& sp : SpecialPointsJson(d, word_layout, w.model, integrator)) {
+          sp["word"] = w.model->WordModeNames();
+          special_points->push_back(sp);
+        }
+        nlohmann::json ids = nlohmann::json::array();
+        for (const Branch& b : d.branches) {
+          writer.EndBranch(b);
+          writer.AnnotateBranch(b.id, {{"handed_over_from", id}});
+          ids.push_back(b.id);
+          w.branches.branches.push_back(b);
+        }
+        j["to_branches"] = ids;
+        report += fmt::format("    {}: accepted, same orbit to {:.1e} (state at the section), {:.1e} (period); word {}: "
+                              "{} branches ({} to {}), {} special points\n",
+                              c.rule, c.state_difference, c.period_difference, automaton.WordName(c.word),
+                              d.branches.size(), offset, offset + static_cast<int>(d.branches.size()) - 1,
+                              d.special_points.size());
+        changes.push_back(j);
+        to_scan.emplace_back(target, std::move(d));
+      }
+    }
+  }
+  nlohmann::json words_json = nlohmann::json::array();
+  for (const WordEntry& w : words) {
+    nlohmann::json ids = nlohmann::json::array();
+    for (const Branch& b : w.branches.branches) ids.push_back(b.id);
+    words_json.push_back({{"word", w.model->WordModeNames()}, {"name", automaton.WordName(w.word)}, {"branches", ids}});
+  }
+  writer.Annotate("words", words_json);
+  writer.Annotate("word_changes", changes);
+  if (changes.empty()) report += "  none (no physical family reaches a zero duration or a competing guard)\n";
+  return report;
+}
+
+}  // namespace hybridcont::app

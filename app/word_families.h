@@ -1,0 +1,40 @@
+// `hybridcont run` on a hybrid automaton (hybrid_automaton.h): after the run's own word, the families of the
+// neighbouring words its physical families lead into (word_change.h), followed like the run's own.
+//
+// Where a physical family of a word has a phase duration through 0 (between two accepted points, located by
+// the corrector with that duration held at 0) or a located CB point of a competing transition's guard, the
+// neighbouring words are built and checked; an accepted change is explored in its word from the orbit (both
+// directions: RunFromStarts), unless the orbit lies on a branch already traced in that word, which is then
+// recorded as the connection and not traced again. The new word's families are scanned in turn, up to
+// kMaxWords words. Branch and special-point ids continue the run's; each branch's summary entry says its
+// "word" (ResultsWriter), each explored family "handed_over_from" (the change's index), and summary.json's
+// "word_changes" lists every change considered: where, the rule, accepted or refused with the reason, the
+// new word's orbit compared with the old (state at the section and period), and the branches it leads to.
+//   std::string report = ExploreWordChanges(model, setup, diagram, &special_points, writer, out, quiet);
+#ifndef HYBRIDCONT_APP_WORD_FAMILIES_H_
+#define HYBRIDCONT_APP_WORD_FAMILIES_H_
+
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <string>
+
+#include "hybridcont/exploration.h"
+#include "hybridcont/model.h"
+#include "results_writer.h"
+#include "run_setup.h"
+
+namespace hybridcont::app {
+
+// Most words one run explores (the run's own included): an automaton's words are unbounded in number, a
+// diagram's hand-overs are few.
+inline constexpr int kMaxWords = 8;
+
+// `diagram` and `special_points` are the run's (time-based layout of `model`, a word of an automaton).
+// Appends the new families' special points to special_points, writes their branches through `writer` and
+// annotates summary.json; returns the report section ("" for a model without an automaton).
+std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
+                               nlohmann::json* special_points, ResultsWriter& writer, std::ostream& out, bool quiet);
+
+}  // namespace hybridcont::app
+
+#endif  // HYBRIDCONT_APP_WORD_FAMILIES_H_
