@@ -118,7 +118,10 @@ void TouchedGuards(const HybridModel& model, const BifurcationDiagram& d, const 
 ExplorationOptions WordOptions(const ExplorationOptions& run, const ShootingLayout& from, const ShootingLayout& to) {
   ExplorationOptions o = run;
   o.start_conditions.clear();
-  const auto has = [&](const std::string& name) { return to.UnknownIndex(name) >= 0; };
+  const auto has = [&](const std::string& name) {
+    const int index = to.UnknownIndex(name);
+    return index >= 0 && index < to.num_unknowns();
+  };
   ContinuationOptions& c = o.continuation;
   c.bounds.clear();
   for (const ComponentBound& b : run.continuation.bounds) {
@@ -150,6 +153,10 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
   const HybridAutomaton& automaton = *model.automaton();
   std::string report = "Phase-sequence changes (words of the automaton):\n";
   if (!setup.free.empty()) return report + "  not followed in a run with free parameters\n";
+  if (!setup.free.observables.empty()) {
+    return report + "  not followed in a run with observables among the unknowns (--until, --bound or --fix on an "
+                    "observable)\n";
+  }
   const IntegratorOptions& integrator = setup.integrator;
   const ReplayOptions replay = ReplayOptionsFor(integrator);
 
