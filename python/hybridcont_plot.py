@@ -50,6 +50,8 @@ H_T.png          H-bar over T for every branch (paper Fig. HoverT).  Physical po
                  boundary point, so the line stays continuous.  One colour per branch.  Special points:
                  SB filled dot, TP open circle, BP square, PD diamond, start star; points only bracketed
                  (not located) have a grey edge.  With a "stable" column, stable physical parts are thicker.
+                 A run across the words of an automaton ("words" in summary.json) names each branch's
+                 word (its modes) in the legend.
                  A branch whose projection collapses to one point is drawn as a marker.
 H_T_xi.png       (only when some xi != 0) the same in three dimensions T, xi, H-bar, showing the
                  branches that differ only in xi (e.g. an equilibrium family).
@@ -358,6 +360,20 @@ def load_branches(results_dir, summary):
             raise PlotError("%s has no H or T column" % path)
         check_rows(table, path)
         out.append({"id": bid, "entry": entry, "table": table})
+    # A run across the words of an automaton (summary "words"): every label names its branch's word.
+    words = summary.get("words")
+    if isinstance(words, list) and len(words) > 1:
+        names = {}  # branch id -> its word's name (modes, with the transition where two modes share several)
+        for w in words:
+            if isinstance(w, dict) and isinstance(w.get("name"), str) and isinstance(w.get("branches"), list):
+                for i in w["branches"]:
+                    names[i] = w["name"]
+        for b in out:
+            word = b["entry"].get("word")
+            if b["id"] in names:
+                b["word"] = names[b["id"]]
+            elif isinstance(word, list) and all(isinstance(w, str) for w in word):
+                b["word"] = " > ".join(word)
     return out
 
 
@@ -459,6 +475,8 @@ def branch_label(branch, special_points):
                 label += ", " + max(counts, key=counts.get)
     elif table is not None:
         label += ", no points"
+    if branch.get("word"):
+        label += " [%s]" % branch["word"]
     return label
 
 
