@@ -161,6 +161,38 @@ values = { t1 = "sqrt(0.5)", t2 = "sqrt(0.5)", x1_y = "0.25", x2_dy = "sqrt(0.5)
 bounds = { xi = [-1, 1], H = [0.05, 3], period = [-20, 20] }
 )toml";
 
+
+// A hybrid automaton (docs/model-files.md, "Automata"): one mode, two transitions.
+const char* const kBall = R"toml(hybridcont = 1
+name = "ball"
+word = ["floor"]
+
+[parameters]
+g = { value = 1.0, range = "(0, inf)" }
+h = { value = 1.0, range = "(0, inf)" }
+
+[[modes]]
+name = "fly"
+states = ["y", "v"]
+ode = { y = "v", v = "-g" }
+energy = "0.5*v^2 + g*y"
+anchor = "y - 0.25"
+
+[[transitions]]
+name = "floor"
+from = "fly"
+to = "fly"
+event = "y"
+reset.v = "-v"
+
+[[transitions]]
+name = "ceiling"
+from = "fly"
+to = "fly"
+event = "h - y"
+reset.v = "-v"
+)toml";
+
 struct BadFile {
   std::string name;     // the test's name
   std::string find;     // text of `model` to replace (it occurs exactly once); empty: append `replace`
@@ -301,6 +333,17 @@ const BadFile kBadFiles[] = {
      "observables.H: 'H' is also an unknown, T or a parameter"},
     {"ConstraintNotDifferentiable", "", "\n[constraints]\nclearance = { flight = \"min(y, 1)\" }\n", 103,
      "constraints.clearance.flight: comparisons, logic, min and max have no derivative and cannot be used here"},
+    // ---- automata
+    {"WordOfAmbiguousModes", "word = [\"floor\"]", "word = [\"fly\"]", 3,
+     "word: modes 'fly' and 'fly' are joined by several transitions (floor, ceiling)", kBall},
+    {"WordOfUnknownMode", "word = [\"floor\"]", "word = [\"swim\"]", 3, "word: 'swim' is neither a mode nor a transition",
+     kBall},
+    {"TransitionIntoUnknownMode", "to = \"fly\"\nevent = \"y\"", "to = \"air\"\nevent = \"y\"", 19,
+     "transitions.floor.to: 'air' is not a mode (modes: fly)", kBall},
+    {"NoModeCarriesTheAnchor", "anchor = \"y - 0.25\"\n", "", 9, "modes: no mode carries the anchor", kBall},
+    {"TransitionResetOfUnknownState", "reset.v = \"-v\"\n\n", "reset.w = \"-v\"\n\n", 21,
+     "transitions.floor.reset.w: 'w' is not a state of the next mode 'fly'", kBall},
+    {"TransitionWithoutGuard", "event = \"h - y\"\n", "", 23, "transitions.ceiling.event: missing field 'event'", kBall},
     {"FigureFileWithSlash", "file = \"slip_speed.png\"", "file = \"plots/slip_speed.png\"", 84,
      "figures[1].file: 'plots/slip_speed.png': a plain file name ending in .png"},
     {"FigureColumnUnknown", "x = \"t2\"", "x = \"t9\"", 80, "figures[0].x: 't9' is not a column"},
