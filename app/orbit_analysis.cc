@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hybridcont/automaton_replay.h"
 #include "hybridcont/classification.h"
 #include "hybridcont/floquet.h"
 #include "hybridcont/orbit_observables.h"
@@ -73,12 +74,26 @@ void AnalyzePhysicalOrbit(const HybridModel& model, TimeBasedShooting& floquet_m
     record->extra.push_back({"mu" + std::to_string(j + 1) + "_re", nan});
     record->extra.push_back({"mu" + std::to_string(j + 1) + "_im", nan});
   }
+  // A word of an automaton: also the automaton's own event-driven simulation (automaton_replay.h).
+  const int automaton_column = static_cast<int>(record->extra.size());
+  if (model.automaton()) record->extra.push_back({"automaton_replay_error", nan});
   if (!record->classification.physical) return;
   const ReplayResult replay = ReplayOrbit(model, OrbitPart(floquet_map.layout(), u), replay_options);
   record->extra[0].second = replay.error;
   if (!replay.physical()) {
     record->classification = {false, OrbitClass::kReplayFailed, replay.message};
     return;
+  }
+  if (model.automaton()) {
+    const AutomatonReplayResult automaton =
+        ReplayAutomaton(model, OrbitPart(floquet_map.layout(), u), floquet_map.integrator_options());
+    if (automaton.ok && automaton.same_word) {
+      record->extra[automaton_column].second = automaton.return_error;
+    } else {
+      record->classification = {false, OrbitClass::kReplayFailed,
+                                "simulating the automaton: " + (automaton.message.empty() ? "another word" : automaton.message)};
+      return;
+    }
   }
   const FloquetResult floquet = ComputeFloquet(floquet_map, u);
   if (!floquet.ok()) return;

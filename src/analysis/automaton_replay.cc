@@ -1,0 +1,117 @@
+#include "hybridcont/automaton_replay.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "hybridcont/shooting_layout.h"
+
+namespace hybridcont {
+namespace {
+
+// Bisection steps refining a crossing time between two accepted steps: 2^-60 of a step, below the
+// integrator's accuracy.
+constexpr int kBisections = 60;
+
+}  // namespace
+
+AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u, const IntegratorOptions& integrator) {
+  HYBRIDCONT_DEMAND(model.automaton() != nullptr);
+  AutomatonReplayResult result;
+  const HybridAutomaton& a = *model.automaton();
+  const Word& word = model.word();
+  const int m = static_cast<int>(word.size());
+  const ShootingLayout layout(model);
+  const int k = layout.num_first_integrals();
+  const Vector xi = k > 0 ? Vector(u.segment(layout.xi_index(), k)) : Vector();
+  Vector p(model.parameters().size());
+  for (int j = 0; j < p.size(); ++j) p(j) = model.parameter_value(j);
+  // A phase of the word per mode (its flow) and per transition (its reset); -1: not in the word.
+  std::vector<int> phase_of_mode(a.modes().size(), -1), phase_of_transition(a.transitions().size(), -1);
+  for (int i = m - 1; i >= 0; --i) {
+    phase_of_mode[a.transitions()[word[i]].from] = i;
+    phase_of_transition[word[i]] = i;
+  }
+  const Vector x1 = u.segment(layout.state_offset(0), layout.dim(0));
+  const double horizon = 2 * std::abs(layout.Period(u)) + 1.0;
+  Vector x = x1;
+  int mode = a.anchor_mode();
+  double elapsed = 0;
+  for (int leg = 0; leg <= m; ++leg) {
+    const int phase = phase_of_mode[mode];
+    HYBRIDCONT_DEMAND(phase >= 0);  // modes are entered by transitions of the word only
+    const std::vector<int> out = a.TransitionsFrom(mode);
+    // The functions watched: the guards out of the mode, and on the last leg the anchor (index out.size()).
+    const bool last = leg == m;
+    const auto values = [&](const Eigen::Ref<const Vector>& y) {
+      std::vector<double> v;
+      for (int t : out) v.push_back(a.transitions()[t].guard->Evaluate(y, p, nullptr, nullptr));
+      if (last) v.push_back(model.anchor().Evaluate(y, nullptr));
+      return v;
+    };
+    struct Sample {
+      double t;
+      Vector y;
+    };
+    std::vector<Sample> samples;
+    PhaseFlow flow(model.phase(phase), integrator);
+    PhaseFlowResult res;
+    flow.Integrate(x, xi, horizon - elapsed, false, &res,
+                   [&](double t, const Eigen::Ref<const Vector>& y) { samples.push_back({t, y}); });
+    if (!res.ok() && samples.size() < 2) {
+      result.message = fmt::format("integrating mode '{}' failed: {}", a.modes()[mode].name, res.message);
+      return result;
+    }
+    // The first downward crossing among the watched functions.
+    int first = -1;
+    double t_cross = std::numeric_limits<double>::infinity();
+    Vector x_cross;
+    std::vector<double> before = values(samples[0].y);
+    for (std::size_t s = 1; s < samples.size() && first < 0; ++s) {
+      const std::vector<double> after = values(samples[s].y);
+      for (std::size_t j = 0; j < after.size(); ++j) {
+        if (!(before[j] > 0 && after[j] <= 0)) continue;
+        // Bisection in [t_{s-1}, t_s], integrating from sample s-1.
+        double lo = 0, hi = samples[s].t - samples[s - 1].t;
+        Vector y_hi = samples[s].y;
+        for (int b = 0; b < kBisections; ++b) {
+          const double mid = 0.5 * (lo + hi);
+          PhaseFlowResult r;
+          flow.Integrate(samples[s - 1].y, xi, mid, false, &r);
+          if (!r.ok()) break;
+          if (values(r.x)[j] > 0) lo = mid;
+          else hi = mid, y_hi = r.x;
+        }
+        if (samples[s - 1].t + hi < t_cross) t_cross = samples[s - 1].t + hi, first = static_cast<int>(j), x_cross = y_hi;
+      }
+      before = after;
+    }
+    if (first < 0) {
+      result.message = fmt::format("no guard out of mode '{}' is crossed within t = {:.6g}", a.modes()[mode].name,
+                                   horizon - elapsed);
+      return result;
+    }
+    elapsed += t_cross;
+    if (last && first == static_cast<int>(out.size())) {  // back at the section
+      result.ok = true;
+      result.same_word = result.taken == word;
+      result.return_error = (x_cross - x1).norm();
+      return result;
+    }
+    const int tau = out[first];
+    result.taken.push_back(tau);
+    if (phase_of_transition[tau] < 0 || leg == m) {
+      result.ok = true;
+      result.message = fmt::format("the automaton takes '{}' (at t = {:.10g}), which the word does not take there",
+                                   a.transitions()[tau].name, elapsed);
+      return result;
+    }
+    model.phase(phase_of_transition[tau]).Reset(x_cross, &x, nullptr);
+    mode = a.transitions()[tau].to;
+  }
+  HYBRIDCONT_UNREACHABLE();
+}
+
+}  // namespace hybridcont
