@@ -14,6 +14,7 @@
 
 #include "cli_runner.h"
 #include "csv_columns.h"
+#include "hybridcont/model_builder.h"
 #include "hybridcont/model_file.h"
 #include "hybridcont/shooting_layout.h"
 
@@ -149,6 +150,115 @@ TEST(WordChange, RemovedFlightPhaseGivesTheSameOrbitAndAMismatchIsNamed) {
   ASSERT_EQ(off.size(), 1u);
   EXPECT_FALSE(off[0].accepted);
   EXPECT_NE(off[0].reason.find("of 'apex'"), std::string::npos) << off[0].reason;
+}
+
+}  // namespace
+}  // namespace hybridcont
+
+namespace hybridcont {
+namespace {
+
+// The same automaton in C++: phases written once as templates (model_builder.h), a factory that builds the
+// cyclic model of any word, and the guards as smooth functions.
+template <class T>
+struct CeilingParameters {
+  T g = 1.0;
+  T h = 1.0;
+};
+struct Fly {
+  template <class T, class Q>
+  static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
+    StateVector<T> f(2);
+    f << x(1), T(-p.g);
+    return f;
+  }
+  template <class T, class Q>
+  static T FirstIntegral(const StateVector<T>& x, const Q& p) {
+    return 0.5 * x(1) * x(1) + p.g * x(0);
+  }
+  template <class T, class Q>
+  static StateVector<T> Reset(const StateVector<T>& x, const Q&) {
+    StateVector<T> y(2);
+    y << x(0), -x(1);
+    return y;
+  }
+};
+struct FlyToFloor : Fly {
+  template <class T, class Q>
+  static T Event(const StateVector<T>& x, const Q&) {
+    return x(0);
+  }
+};
+struct FlyToCeiling : Fly {
+  template <class T, class Q>
+  static T Event(const StateVector<T>& x, const Q& p) {
+    return p.h - x(0);
+  }
+};
+struct Section {  // the ball passing y = 1/4 downwards
+  template <class T, class Q>
+  static T Anchor(const StateVector<T>& x, const Q&) {
+    return x(0) - 0.25;
+  }
+};
+class Guard : public SmoothFunction {  // y (floor) or h − y (ceiling); parameters [g, h]
+ public:
+  explicit Guard(bool ceiling) : ceiling_(ceiling) {}
+  double Evaluate(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& p, RowVector* dx,
+                  RowVector* dp) const override {
+    const double s = ceiling_ ? -1 : 1;
+    if (dx) *dx = RowVector::Zero(2), (*dx)(0) = s;
+    if (dp) *dp = RowVector::Zero(p.size()), (*dp)(1) = ceiling_ ? 1 : 0;
+    return ceiling_ ? p(1) - x(0) : x(0);
+  }
+
+ private:
+  bool ceiling_;
+};
+
+TEST(WordChange, CppAutomatonInsertsTheCeilingWhereTheApexTouchesIt) {
+  const auto factory = [](const Word& word) {
+    ModelBuilder<CeilingParameters<double>> b("ball-ceiling-cpp", "ball between floor and ceiling");
+    b.Parameter("g", [](auto& p) -> auto& { return p.g; }, "gravity", ParameterRange::Positive())
+        .Parameter("h", [](auto& p) -> auto& { return p.h; }, "ceiling", ParameterRange::Positive());
+    for (int t : word) {
+      if (t == 0) b.AddPhase<FlyToFloor>("fly", {"y", "v"}, Vector(Eigen::Vector2d(0.5, -0.3)));
+      else b.AddPhase<FlyToCeiling>("fly", {"y", "v"}, Vector(Eigen::Vector2d(0.5, 0.3)));
+    }
+    b.SetAnchor<Section>();
+    return b.Build();
+  };
+  const auto automaton =
+      HybridAutomaton::Create("ball-ceiling-cpp", {{"fly", {"y", "v"}}},
+                              {{"floor", 0, 0, std::make_shared<Guard>(false)},
+                               {"ceiling", 0, 0, std::make_shared<Guard>(true)}},
+                              0, factory);
+  const Word floor_only = automaton->WordOf({"floor"});
+  EXPECT_EQ(floor_only, Word({0}));
+  const HybridModel model = automaton->ModelForWord(floor_only);
+  ASSERT_EQ(model.observables().size(), 1u);  // the ceiling competes with the floor
+  EXPECT_EQ(model.observables()[0].name, "ceiling_guard");
+  // The floor-only orbit at H = g h = 1: down from y = 1/4 to the floor, up to the apex y = 1 (time √2) and
+  // down to y = 1/4.
+  const ShootingLayout layout(model);
+  const double v_section = std::sqrt(2 * 0.75), t_down = std::sqrt(2.0) - std::sqrt(2 * 0.75);
+  Vector u = Vector::Zero(layout.num_unknowns());
+  u(layout.time_index(0)) = t_down;
+  u(layout.state_offset(0)) = 0.25;
+  u(layout.state_offset(0) + 1) = -v_section;
+  u(layout.time_index(1)) = 2 * std::sqrt(2.0) - t_down;
+  u(layout.state_offset(1) + 1) = std::sqrt(2.0);
+  u(layout.H_index()) = 1;
+  std::string why;
+  const std::vector<WordChange> c = WordsWithTransition(model, u, 1, 1, std::sqrt(2.0), IntegratorOptions{}, &why);
+  ASSERT_EQ(c.size(), 1u) << why;
+  EXPECT_TRUE(c[0].accepted) << c[0].reason;
+  EXPECT_FALSE(c[0].singular);  // a fold of the new word's family, a regular point of its map
+  EXPECT_EQ(c[0].word, Word({0, 1}));
+  EXPECT_LT(c[0].residual, 1e-9);
+  EXPECT_LT(c[0].state_difference, 1e-10);
+  EXPECT_LT(c[0].period_difference, 1e-10);
+  EXPECT_EQ(automaton->WordName(c[0].word), "fly (floor) > fly (ceiling)");
 }
 
 }  // namespace

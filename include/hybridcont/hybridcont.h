@@ -3,6 +3,7 @@
 #ifndef HYBRIDCONT_HYBRIDCONT_H_
 #define HYBRIDCONT_HYBRIDCONT_H_
 
+#include "hybridcont/automaton_replay.h"
 #include "hybridcont/branch_switching.h"
 #include "hybridcont/classification.h"
 #include "hybridcont/continuation.h"
@@ -13,6 +14,7 @@
 #include "hybridcont/floquet.h"
 #include "hybridcont/floquet_test_functions.h"
 #include "hybridcont/flow.h"
+#include "hybridcont/hybrid_automaton.h"
 #include "hybridcont/model.h"
 #include "hybridcont/model_builder.h"
 #include "hybridcont/model_setup.h"
@@ -33,6 +35,7 @@
 #include "hybridcont/test_function_root.h"
 #include "hybridcont/timebased_shooting.h"
 #include "hybridcont/types.h"
+#include "hybridcont/word_change.h"
 #include "hybridcont/zero_problem.h"
 
 #endif  // HYBRIDCONT_HYBRIDCONT_H_
