@@ -17,6 +17,7 @@
 #include "hybridcont/model_builder.h"
 #include "hybridcont/model_file.h"
 #include "hybridcont/shooting_layout.h"
+#include "models/ball_flight.h"
 
 namespace hybridcont {
 namespace {
@@ -162,34 +163,13 @@ namespace {
 // cyclic model of any word, and the guards as smooth functions.
 template <class T>
 struct CeilingParameters {
+  T m = 1.0;
   T g = 1.0;
   T h = 1.0;
 };
-struct Fly {
-  template <class T, class Q>
-  static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
-    StateVector<T> f(2);
-    f << x(1), T(-p.g);
-    return f;
-  }
-  template <class T, class Q>
-  static T FirstIntegral(const StateVector<T>& x, const Q& p) {
-    return 0.5 * x(1) * x(1) + p.g * x(0);
-  }
-  template <class T, class Q>
-  static StateVector<T> Reset(const StateVector<T>& x, const Q&) {
-    StateVector<T> y(2);
-    y << x(0), -x(1);
-    return y;
-  }
-};
-struct FlyToFloor : Fly {
-  template <class T, class Q>
-  static T Event(const StateVector<T>& x, const Q&) {
-    return x(0);
-  }
-};
-struct FlyToCeiling : Fly {
+// The built-in ball's flight (models/ball_flight.h) ends at the floor; the same flight ends at the ceiling.
+using FlyToFloor = internal::BallFlight;
+struct FlyToCeiling : internal::BallFlight {
   template <class T, class Q>
   static T Event(const StateVector<T>& x, const Q& p) {
     return p.h - x(0);
@@ -201,15 +181,15 @@ struct Section {  // the ball passing y = 1/4 downwards
     return x(0) - 0.25;
   }
 };
-class Guard : public SmoothFunction {  // y (floor) or h − y (ceiling); parameters [g, h]
+class Guard : public SmoothFunction {  // y (floor) or h − y (ceiling); parameters [m, g, h]
  public:
   explicit Guard(bool ceiling) : ceiling_(ceiling) {}
   double Evaluate(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& p, RowVector* dx,
                   RowVector* dp) const override {
     const double s = ceiling_ ? -1 : 1;
     if (dx) *dx = RowVector::Zero(2), (*dx)(0) = s;
-    if (dp) *dp = RowVector::Zero(p.size()), (*dp)(1) = ceiling_ ? 1 : 0;
-    return ceiling_ ? p(1) - x(0) : x(0);
+    if (dp) *dp = RowVector::Zero(p.size()), (*dp)(2) = ceiling_ ? 1 : 0;
+    return ceiling_ ? p(2) - x(0) : x(0);
   }
 
  private:
@@ -219,7 +199,8 @@ class Guard : public SmoothFunction {  // y (floor) or h − y (ceiling); parame
 TEST(WordChange, CppAutomatonInsertsTheCeilingWhereTheApexTouchesIt) {
   const auto factory = [](const Word& word) {
     ModelBuilder<CeilingParameters<double>> b("ball-ceiling-cpp", "ball between floor and ceiling");
-    b.Parameter("g", [](auto& p) -> auto& { return p.g; }, "gravity", ParameterRange::Positive())
+    b.Parameter("m", [](auto& p) -> auto& { return p.m; }, "mass", ParameterRange::Positive())
+        .Parameter("g", [](auto& p) -> auto& { return p.g; }, "gravity", ParameterRange::Positive())
         .Parameter("h", [](auto& p) -> auto& { return p.h; }, "ceiling", ParameterRange::Positive());
     for (int t : word) {
       if (t == 0) b.AddPhase<FlyToFloor>("fly", {"y", "v"}, Vector(Eigen::Vector2d(0.5, -0.3)));
