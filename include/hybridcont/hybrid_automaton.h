@@ -55,17 +55,6 @@ struct AutomatonTransition {
 // The cyclic sequence of transitions an orbit takes; word[0] leaves the anchor mode.
 using Word = std::vector<int>;
 
-// g = 0 with zero gradients: a placeholder guard (a word resolved before the guards are known).
-class ConstantFunction : public SmoothFunction {
- public:
-  double Evaluate(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& p, RowVector* dx,
-                  RowVector* dp) const override {
-    if (dx) *dx = RowVector::Zero(x.size());
-    if (dp) *dp = RowVector::Zero(p.size());
-    return 0.0;
-  }
-};
-
 class HybridAutomaton : public std::enable_shared_from_this<HybridAutomaton> {
  public:
   // The cyclic model of a checked word, phases named after their modes (observables, symmetries and
@@ -77,6 +66,10 @@ class HybridAutomaton : public std::enable_shared_from_this<HybridAutomaton> {
   static std::shared_ptr<HybridAutomaton> Create(std::string name, std::vector<AutomatonMode> modes,
                                                  std::vector<AutomatonTransition> transitions, int anchor_mode,
                                                  WordModelFactory factory);
+  // The same names and connections without dynamics (guards may be null, no factory): for reading and
+  // checking words (WordOf, CheckWord, WordName) before the guards exist; ModelForWord is not available.
+  static std::shared_ptr<HybridAutomaton> Graph(std::string name, std::vector<AutomatonMode> modes,
+                                                std::vector<AutomatonTransition> transitions, int anchor_mode);
 
   const std::string& name() const { return name_; }
   const std::vector<AutomatonMode>& modes() const { return modes_; }

@@ -14,6 +14,9 @@ namespace {
 // Bisection steps refining a crossing time between two accepted steps: 2^-60 of a step, below the
 // integrator's accuracy.
 constexpr int kBisections = 60;
+// A leg is first integrated over its duration in the word times 1 + kLegMargin (plus kLegMargin): the
+// automaton's crossing of a physical orbit lies at that duration, up to the integration error.
+constexpr double kLegMargin = 0.05;
 
 }  // namespace
 
@@ -58,35 +61,50 @@ AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u,
     std::vector<Sample> samples;
     PhaseFlow flow(model.phase(phase), integrator);
     PhaseFlowResult res;
-    flow.Integrate(x, xi, horizon - elapsed, false, &res,
-                   [&](double t, const Eigen::Ref<const Vector>& y) { samples.push_back({t, y}); });
-    if (!res.ok() && samples.size() < 2) {
+    // The word's own duration of this leg, with a margin, first; the rest of the horizon only when no guard is
+    // crossed within it (the orbit is not one of the automaton then, or leaves the word later).
+    const double expected = std::abs(u(layout.time_index(leg))) * (1 + kLegMargin) + kLegMargin;
+    const auto integrate = [&](const Vector& from, double t0, double duration) {
+      flow.Integrate(from, xi, duration, false, &res, [&](double t, const Eigen::Ref<const Vector>& y) {
+        if (t > 0 || samples.empty()) samples.push_back({t0 + t, y});
+      });
+      return res.ok() || samples.size() >= 2;
+    };
+    if (!integrate(x, 0, std::min(expected, horizon - elapsed))) {
       result.message = fmt::format("integrating mode '{}' failed: {}", a.modes()[mode].name, res.message);
       return result;
     }
-    // The first downward crossing among the watched functions.
+    // The first downward crossing among the watched functions in the samples so far.
     int first = -1;
     double t_cross = std::numeric_limits<double>::infinity();
     Vector x_cross;
-    std::vector<double> before = values(samples[0].y);
-    for (std::size_t s = 1; s < samples.size() && first < 0; ++s) {
-      const std::vector<double> after = values(samples[s].y);
-      for (std::size_t j = 0; j < after.size(); ++j) {
-        if (!(before[j] > 0 && after[j] <= 0)) continue;
-        // Bisection in [t_{s-1}, t_s], integrating from sample s-1.
-        double lo = 0, hi = samples[s].t - samples[s - 1].t;
-        Vector y_hi = samples[s].y;
-        for (int b = 0; b < kBisections; ++b) {
-          const double mid = 0.5 * (lo + hi);
-          PhaseFlowResult r;
-          flow.Integrate(samples[s - 1].y, xi, mid, false, &r);
-          if (!r.ok()) break;
-          if (values(r.x)[j] > 0) lo = mid;
-          else hi = mid, y_hi = r.x;
+    const auto scan = [&]() {
+      std::vector<double> before = values(samples[0].y);
+      for (std::size_t s = 1; s < samples.size() && first < 0; ++s) {
+        const std::vector<double> after = values(samples[s].y);
+        for (std::size_t j = 0; j < after.size(); ++j) {
+          if (!(before[j] > 0 && after[j] <= 0)) continue;
+          // Bisection in [t_{s-1}, t_s], integrating from sample s-1.
+          double lo = 0, hi = samples[s].t - samples[s - 1].t;
+          Vector y_hi = samples[s].y;
+          for (int b = 0; b < kBisections; ++b) {
+            const double mid = 0.5 * (lo + hi);
+            PhaseFlowResult r;
+            flow.Integrate(samples[s - 1].y, xi, mid, false, &r);
+            if (!r.ok()) break;
+            if (values(r.x)[j] > 0) lo = mid;
+            else hi = mid, y_hi = r.x;
+          }
+          if (samples[s - 1].t + hi < t_cross) t_cross = samples[s - 1].t + hi, first = static_cast<int>(j), x_cross = y_hi;
         }
-        if (samples[s - 1].t + hi < t_cross) t_cross = samples[s - 1].t + hi, first = static_cast<int>(j), x_cross = y_hi;
+        before = after;
       }
-      before = after;
+    };
+    scan();
+    if (first < 0 && samples.back().t < horizon - elapsed) {  // not within the expected duration: the rest
+      const Sample last = samples.back();
+      samples.erase(samples.begin(), samples.end() - 1);
+      if (integrate(last.y, last.t, horizon - elapsed - last.t)) scan();
     }
     if (first < 0) {
       result.message = fmt::format("no guard out of mode '{}' is crossed within t = {:.6g}", a.modes()[mode].name,

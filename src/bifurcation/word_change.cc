@@ -81,7 +81,8 @@ WordChange Check(const HybridModel& model, const Vector& u, Word word, const std
   for (int j = 0; j < k; ++j) c.u_mapped(layout.xi_index(j)) = u(old_layout.xi_index(j));
   if (layout.has_level()) c.u_mapped(layout.H_index()) = u(old_layout.H_index());
   Vector r;
-  const EvaluationStatus status = map.Evaluate(c.u_mapped, &r, nullptr);
+  Matrix dr;  // for the correction below; the same evaluation gives the residual
+  const EvaluationStatus status = map.Evaluate(c.u_mapped, &r, &dr);
   if (!status.ok) {
     c.reason = "the new word's map fails there: " + status.message;
     return c;
@@ -120,8 +121,6 @@ WordChange Check(const HybridModel& model, const Vector& u, Word word, const std
     return c;
   }
   // Corrected in the new word from the kernel direction of its Jacobian (regular at a fold in H̄ too).
-  Matrix dr;
-  map.Evaluate(c.u_mapped, &r, &dr);
   Eigen::JacobiSVD<Matrix> svd(dr, Eigen::ComputeFullV);
   const Vector tau = svd.matrixV().col(dr.cols() - 1);
   const double smallest = svd.singularValues()(svd.singularValues().size() - 1);

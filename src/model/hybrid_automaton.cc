@@ -10,6 +10,17 @@ namespace hybridcont {
 std::shared_ptr<HybridAutomaton> HybridAutomaton::Create(std::string name, std::vector<AutomatonMode> modes,
                                                          std::vector<AutomatonTransition> transitions, int anchor_mode,
                                                          WordModelFactory factory) {
+  for (const AutomatonTransition& t : transitions) {
+    if (!t.guard) throw std::invalid_argument("automaton '" + name + "', transition '" + t.name + "': no guard");
+  }
+  if (!factory) throw std::invalid_argument("automaton '" + name + "': no model factory");
+  std::shared_ptr<HybridAutomaton> a = Graph(std::move(name), std::move(modes), std::move(transitions), anchor_mode);
+  a->factory_ = std::move(factory);
+  return a;
+}
+
+std::shared_ptr<HybridAutomaton> HybridAutomaton::Graph(std::string name, std::vector<AutomatonMode> modes,
+                                                        std::vector<AutomatonTransition> transitions, int anchor_mode) {
   const std::string where = "automaton '" + name + "'";
   const int num_modes = static_cast<int>(modes.size());
   if (num_modes == 0) throw std::invalid_argument(where + ": no modes");
@@ -29,7 +40,6 @@ std::shared_ptr<HybridAutomaton> HybridAutomaton::Create(std::string name, std::
     if (t.from < 0 || t.from >= num_modes || t.to < 0 || t.to >= num_modes) {
       throw std::invalid_argument(where + ", transition '" + t.name + "': its modes are not modes of the automaton");
     }
-    if (!t.guard) throw std::invalid_argument(where + ", transition '" + t.name + "': no guard");
     ++outgoing[t.from];
   }
   for (int m = 0; m < num_modes; ++m) {
@@ -37,13 +47,11 @@ std::shared_ptr<HybridAutomaton> HybridAutomaton::Create(std::string name, std::
       throw std::invalid_argument(where + ": mode '" + modes[m].name + "' has no transition out of it");
     }
   }
-  if (!factory) throw std::invalid_argument(where + ": no model factory");
   std::shared_ptr<HybridAutomaton> a(new HybridAutomaton());
   a->name_ = std::move(name);
   a->modes_ = std::move(modes);
   a->transitions_ = std::move(transitions);
   a->anchor_mode_ = anchor_mode;
-  a->factory_ = std::move(factory);
   return a;
 }
 
@@ -152,6 +160,7 @@ std::string HybridAutomaton::WordName(const Word& word) const {
 
 HybridModel HybridAutomaton::ModelForWord(const Word& word) const {
   CheckWord(word);
+  HYBRIDCONT_DEMAND(factory_ != nullptr);  // an automaton made by Create, not Graph
   HybridModel model = factory_(word);
   HYBRIDCONT_DEMAND(model.num_phases() == static_cast<int>(word.size()));
   for (std::size_t k = 0; k < transitions_.size(); ++k) {

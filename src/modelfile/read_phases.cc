@@ -207,13 +207,10 @@ void Reader::ReadWord() {
   if (n == nullptr) {
     Fail(&root_, "word", "missing field 'word' (the modes of the cycle the run starts on, e.g. [\"stance\", \"flight\"])");
   }
-  std::vector<AutomatonTransition> transitions = automaton_.transitions;
-  for (AutomatonTransition& t : transitions) t.guard = std::make_shared<ConstantFunction>();  // names only
-  const auto names = std::make_shared<std::vector<std::string>>(StringArray(*n, "word"));
-  try {
-    automaton_.word = HybridAutomaton::Create(spec_.name, automaton_.modes, transitions, automaton_.anchor_mode,
-                                              [](const Word&) -> HybridModel { HYBRIDCONT_UNREACHABLE(); })
-                          ->WordOf(*names);
+  const std::vector<std::string> names = StringArray(*n, "word");
+  try {  // the guards are read later: the automaton's names and connections resolve the word
+    automaton_.word =
+        HybridAutomaton::Graph(spec_.name, automaton_.modes, automaton_.transitions, automaton_.anchor_mode)->WordOf(names);
   } catch (const std::invalid_argument& e) {
     const std::string what = e.what();
     Fail(n, "word", what.substr(what.find(": ") + 2));
