@@ -153,6 +153,80 @@ TEST(WordChange, RemovedFlightPhaseGivesTheSameOrbitAndAMismatchIsNamed) {
   EXPECT_NE(off[0].reason.find("of 'apex'"), std::string::npos) << off[0].reason;
 }
 
+
+// Written as a new user would, from the format reference alone: Shaw & Holmes' linear oscillator against a
+// rigid wall at x = d. Below H = d²/2 it swings freely (word: the cut `top`), above it hits the wall: period
+// 2π − 2 arccos(d/A), A = √(2H). The free swing's guard v crosses zero upwards inside its phase: a cut's
+// guard marks a time and does not bound the state, so the free family is physical.
+TEST(WordChange, OscillatorAgainstAWallChangesItsWordAtHalfDSquared) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_word_wall";
+  fs::create_directories(dir);
+  {
+    std::ofstream f(dir / "wall.toml");
+    f << R"toml(hybridcont = 1
+name = "wall-oscillator"
+description = "Shaw & Holmes: a linear oscillator against a rigid wall at x = d, which it reaches above H = d^2/2"
+word = ["top"]
+
+[parameters]
+d = { value = 0.5, range = "(0, inf)", description = "wall position" }
+
+[[modes]]
+name = "swing"
+states = ["x", "v"]
+ode = { x = "v", v = "-x" }
+energy = "0.5*(v^2 + x^2)"
+anchor = "x"
+
+[[transitions]]
+name = "top"
+from = "swing"
+to = "swing"
+event = "v"
+
+[[transitions]]
+name = "wall"
+from = "swing"
+to = "swing"
+event = "d - x"
+reset.v = "-v"
+
+[start]
+kind = "guess"
+values = { H = 0.05, t1 = 4.71238898038469, t2 = 1.5707963267949, x1_x = 0, x1_v = -0.316227766016838, x2_x = 0.316227766016838, x2_v = 0 }
+
+[run]
+bounds = { xi = [-1, 1], H = [0.02, 0.5], period = [-20, 20] }
+)toml";
+  }
+  const CliResult r = RunTool({"run", (dir / "wall.toml").string(), "--out", (dir / "out").string(), "--quiet",
+                               "--no-plots", "--threads", "1", "--overwrite"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(dir / "out" / "summary.json");
+  const nlohmann::json s = nlohmann::json::parse(in);
+  ASSERT_EQ(s["word_changes"].size(), 1u);
+  EXPECT_TRUE(s["word_changes"][0]["accepted"].get<bool>());
+  EXPECT_NEAR(s["word_changes"][0]["H"].get<double>(), 0.125, 1e-10);
+  int free_points = 0, wall_points = 0;
+  for (const nlohmann::json& b : s["branches"]) {
+    const auto col = ReadColumns(dir / "out" / b["file"].get<std::string>());
+    for (std::size_t i = 0; i < col.at("H").size(); ++i) {
+      if (col.at("physical")[i] != 1) continue;
+      const double H = col.at("H")[i], T = col.at("T")[i];
+      if (H < 0.125 - 1e-9) {
+        EXPECT_NEAR(T, 2 * M_PI, 1e-10) << "H = " << H;
+        ++free_points;
+      } else if (H > 0.125 + 1e-9) {
+        EXPECT_NEAR(T, 2 * M_PI - 2 * std::acos(0.5 / std::sqrt(2 * H)), 1e-9) << "H = " << H;
+        ++wall_points;
+      }
+      EXPECT_LT(col.at("automaton_replay_error")[i], 1e-8);
+    }
+  }
+  EXPECT_GT(free_points, 5);
+  EXPECT_GT(wall_points, 5);
+  fs::remove_all(dir);
+}
 }  // namespace
 }  // namespace hybridcont
 

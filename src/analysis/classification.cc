@@ -135,7 +135,9 @@ Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const Or
   // First crossing: the trajectory stays on the positive side of its event inside the phase (no earlier
   // downward crossing, no start beyond it), and the anchor is not crossed earlier in the return segment.
   for (int i = 0; i <= m; ++i) {
-    const bool bounds = i < m && model.phase(i).event_bounds_state();
+    // A phase that ends at a cut of its automaton (hybrid_automaton.h) has a guard that only marks a time.
+    const bool cut = model.automaton() && model.automaton()->transitions()[model.word()[i % m]].cut;
+    const bool bounds = i < m && !cut && model.phase(i).event_bounds_state();
     const double t = FirstViolation(model, trace, i, options.samples_per_step, /*forbid_negative=*/bounds);
     if (!std::isnan(t)) {
       os << (i < m ? "event" : "anchor") << " of segment " << i + 1 << " violated at t = " << t << " < "
