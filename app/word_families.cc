@@ -10,6 +10,7 @@
 
 #include "hybridcont/corrector.h"
 #include "hybridcont/orbit_observables.h"
+#include "hybridcont/setup_evaluation.h"
 #include "hybridcont/timebased_shooting.h"
 #include "hybridcont/word_change.h"
 #include "model_exploration.h"
@@ -41,6 +42,9 @@ struct Degeneracy {
   double t = 0;         // where in the segment (guards)
   std::string where;
 };
+
+// The first branch id of an explored diagram (renumbered after the run's).
+int FirstId(const BifurcationDiagram& d) { return d.branches.empty() ? -1 : d.branches.front().id; }
 
 std::string Names(const std::vector<std::string>& names) {
   std::string text;
@@ -173,7 +177,101 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
     handled.emplace_back(entry, u);
     return false;
   };
+  // The entry of `word`, made on first use; -1 (and why) where its exploration cannot be set up.
+  const auto EntryOf = [&](const Word& word, std::string* why) {
+    for (std::size_t e = 0; e < words.size(); ++e) {
+      if (words[e].word == word) return static_cast<int>(e);
+    }
+    if (static_cast<int>(words.size()) >= kMaxWords) {
+      *why = fmt::format("{} words explored already", kMaxWords);
+      return -1;
+    }
+    WordEntry w;
+    w.word = word;
+    w.owned = std::make_unique<HybridModel>(automaton.ModelForWord(word));
+    for (int p = 0; p < static_cast<int>(model.parameters().size()); ++p) {
+      w.owned->SetParameterValue(p, model.parameter_value(p));
+    }
+    w.model = w.owned.get();
+    try {
+      w.exploration = std::make_unique<ModelExploration>(
+          *w.model, DefaultScenario(*w.model), integrator,
+          WordOptions(setup.exploration, ShootingLayout(model), ShootingLayout(*w.model)));
+    } catch (const std::invalid_argument& e) {
+      *why = e.what();
+      return -1;
+    }
+    words.push_back(std::move(w));
+    return static_cast<int>(words.size()) - 1;
+  };
+  // The family of word entry `target` through the orbit u, both directions: its points analysed and written,
+  // its branches and special points numbered after the run's so far.
+  const auto Explore = [&](int target, const Vector& u) {
+    WordEntry& w = words[target];
+    const int offset = writer.next_branch_id();
+    TimeBasedShooting floquet_map(*w.model, integrator);
+    const ShootingLayout word_layout(*w.model);
+    int skipped = 0;
+    BifurcationDiagram d = w.exploration->RunFromStarts({u}, [&](const ProgressInfo& info, const Vector& v) {
+      const int branch = info.branch_id + offset;
+      if (info.point_index == 0) writer.SetBranchModel(branch, *w.model);
+      PointRecord record = RecordOf(info, v);
+      AnalyzePoint(*w.model, integrator, floquet_map, replay, &record);
+      writer.AddPoint(branch, record);
+      if (!quiet) {
+        out << fmt::format("  b{:<3} #{:<4} H = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {} ({})\n", branch,
+                           info.point_index, v(word_layout.H_index()), word_layout.Period(v), info.step,
+                           info.newton_iterations, ToString(record.classification.reason),
+                           automaton.WordName(w.word));
+      }
+    }, &skipped);
+    if (d.status == ExplorationStatus::kStartFailed) return d;
+    RenumberDiagram(offset, static_cast<int>(special_points->size()), &d);
+    for (nlohmann::json& sp : SpecialPointsJson(d, word_layout, w.model, integrator)) {
+      sp["word"] = w.model->WordModeNames();
+      special_points->push_back(sp);
+    }
+    for (const Branch& b : d.branches) {
+      writer.EndBranch(b);
+      w.branches.branches.push_back(b);
+    }
+    return d;
+  };
   std::deque<std::pair<int, BifurcationDiagram>> to_scan = {{0, diagram}};
+  // The starts the model declares in other words: their families first, scanned like the rest.
+  for (std::size_t i = 0; i < model.setup().word_starts.size(); ++i) {
+    const StartSpec& start = model.setup().word_starts[i];
+    std::string why;
+    const int target = EntryOf(start.word, &why);
+    const std::string name = automaton.WordName(start.word);
+    if (target < 0) {
+      report += fmt::format("  start in word {}: not explored, {}\n", name, why);
+      continue;
+    }
+    const HybridModel& word_model = *words[target].model;
+    const ShootingLayout layout(word_model);
+    const Vector guess = StartPoint(word_model, start);
+    TimeBasedShooting map(word_model, integrator);
+    Corrector corrector(&map);
+    Vector u;
+    const CorrectorResult corrected = corrector.CorrectFixedComponent(guess, layout.H_index(), guess(layout.H_index()), &u);
+    if (!corrected.converged()) {
+      report += fmt::format("  start in word {}: the guess does not converge to an orbit at H = {}: {}\n", name,
+                            guess(layout.H_index()), corrected.message);
+      continue;
+    }
+    if (!quiet) out << fmt::format("word {} from its start:\n", name);
+    const BifurcationDiagram d = Explore(target, u);
+    if (d.status == ExplorationStatus::kStartFailed) {
+      report += fmt::format("  start in word {}: not explored, {}\n", name, d.message);
+      continue;
+    }
+    for (const Branch& b : d.branches) writer.AnnotateBranch(b.id, {{"started_in_word", name}});
+    report += fmt::format("  start in word {} (H = {:.10f}): {} branches ({} to {}), {} special points\n", name,
+                          u(layout.H_index()), d.branches.size(), FirstId(d),
+                          FirstId(d) + static_cast<int>(d.branches.size()) - 1, d.special_points.size());
+    to_scan.emplace_back(target, d);
+  }
   while (!to_scan.empty()) {
     const int entry = to_scan.front().first;
     const BifurcationDiagram scan = std::move(to_scan.front().second);
@@ -241,76 +339,31 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
           changes.push_back(j);
           continue;
         }
-        if (target >= 0) {
-        } else if (static_cast<int>(words.size()) >= kMaxWords) {
-          j["reason"] = fmt::format("not explored: {} words explored already", kMaxWords);
+        if (target < 0 && (target = EntryOf(c.word, &why)) < 0) {
+          j["reason"] = "not explored: " + why;
           report += fmt::format("    {}: {}\n", c.rule, j["reason"].get<std::string>());
           changes.push_back(j);
           continue;
-        } else {
-          WordEntry w;
-          w.word = c.word;
-          w.owned = std::make_unique<HybridModel>(automaton.ModelForWord(c.word));
-          for (int p = 0; p < static_cast<int>(model.parameters().size()); ++p) {
-            w.owned->SetParameterValue(p, model.parameter_value(p));
-          }
-          w.model = w.owned.get();
-          try {
-            w.exploration = std::make_unique<ModelExploration>(
-                *w.model, DefaultScenario(*w.model), integrator,
-                WordOptions(setup.exploration, ShootingLayout(model), ShootingLayout(*w.model)));
-          } catch (const std::invalid_argument& e) {
-            j["reason"] = std::string("not explored: ") + e.what();
-            report += fmt::format("    {}: {}\n", c.rule, j["reason"].get<std::string>());
-            changes.push_back(j);
-            continue;
-          }
-          words.push_back(std::move(w));
-          target = static_cast<int>(words.size()) - 1;
         }
         // Explore the new word's family from the orbit, both directions.
-        WordEntry& w = words[target];
-        const int offset = writer.next_branch_id();
-        TimeBasedShooting floquet_map(*w.model, integrator);
-        const ShootingLayout word_layout(*w.model);
         if (!quiet) out << fmt::format("word {} from {}:\n", automaton.WordName(c.word), c.rule);
-        int skipped = 0;
-        BifurcationDiagram d = w.exploration->RunFromStarts({c.u}, [&](const ProgressInfo& info, const Vector& u) {
-          const int branch = info.branch_id + offset;
-          if (info.point_index == 0) writer.SetBranchModel(branch, *w.model);
-          PointRecord record = RecordOf(info, u);
-          AnalyzePoint(*w.model, integrator, floquet_map, replay, &record);
-          writer.AddPoint(branch, record);
-          if (!quiet) {
-            out << fmt::format("  b{:<3} #{:<4} H = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {} ({})\n", branch,
-                               info.point_index, u(word_layout.H_index()), word_layout.Period(u), info.step,
-                               info.newton_iterations, ToString(record.classification.reason),
-                               automaton.WordName(c.word));
-          }
-        }, &skipped);
+        BifurcationDiagram d = Explore(target, c.u);
         if (d.status == ExplorationStatus::kStartFailed) {
           j["reason"] = "not explored: " + d.message;
           report += fmt::format("    {}: {}\n", c.rule, j["reason"].get<std::string>());
           changes.push_back(j);
           continue;
         }
-        RenumberDiagram(offset, static_cast<int>(special_points->size()), &d);
-        for (nlohmann::json& sp : SpecialPointsJson(d, word_layout, w.model, integrator)) {
-          sp["word"] = w.model->WordModeNames();
-          special_points->push_back(sp);
-        }
         nlohmann::json ids = nlohmann::json::array();
         for (const Branch& b : d.branches) {
-          writer.EndBranch(b);
           writer.AnnotateBranch(b.id, {{"handed_over_from", id}});
           ids.push_back(b.id);
-          w.branches.branches.push_back(b);
         }
         j["to_branches"] = ids;
         report += fmt::format("    {}: accepted, same orbit to {:.1e} (state at the section), {:.1e} (period); word {}: "
                               "{} branches ({} to {}), {} special points\n",
                               c.rule, c.state_difference, c.period_difference, automaton.WordName(c.word),
-                              d.branches.size(), offset, offset + static_cast<int>(d.branches.size()) - 1,
+                              d.branches.size(), FirstId(d), FirstId(d) + static_cast<int>(d.branches.size()) - 1,
                               d.special_points.size());
         changes.push_back(j);
         to_scan.emplace_back(target, std::move(d));

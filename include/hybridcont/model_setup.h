@@ -58,6 +58,9 @@ struct StartSpec {
     std::string description;
   };
   std::vector<Condition> conditions;
+  // A hybrid automaton's start in another word than the model's (hybrid_automaton.h: transition indices);
+  // its values name that word's unknowns. Empty: the model's own word.
+  std::vector<int> word;
 };
 
 struct BoundSpec {
@@ -141,6 +144,9 @@ struct ModelSetup {
   // Further starts ([[start]] in a model file), each traced as a family of its own: for models without
   // first integral, whose families need not meet (the walker's long- and short-period gaits).
   std::vector<StartSpec> more_starts;
+  // A hybrid automaton's starts in other words ([[start]] with `word`): gaits that no change of the phase
+  // sequence need connect (walking and running), each explored after the model's own word.
+  std::vector<StartSpec> word_starts;
   RunSpec run;
   std::vector<FamilyRule> families;
   std::vector<QuantitySpec> quantities;

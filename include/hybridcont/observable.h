@@ -63,8 +63,11 @@ struct Observable {
   std::vector<std::shared_ptr<const SmoothFunction>> phases;
   // An admissibility constraint (kind kMinimum or kFinal): a physical orbit keeps the value >= 0.
   bool constraint = false;
-  // A competing transition's guard (hybrid_automaton.h): a segment's start value does not count, since a
-  // phase may begin where the guard is 0 (right after that very transition, or a simultaneous one).
+  // A competing transition's guard (hybrid_automaton.h). It fires at a downward zero crossing, so it counts
+  // only where it is reached from above: from the first time it is positive in its phase. A phase that begins
+  // on it (within round-off: right after that very transition, or one with the same guard) or below it (a
+  // swing foot under the ground as it passes the stance leg) leaves it unarmed until it has risen above 0;
+  // where it never does, the value is -max g over its phases (>= 0: the margin by which it stays unreached).
   bool guard = false;
 };
 

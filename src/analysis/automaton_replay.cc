@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -17,6 +18,9 @@ constexpr int kBisections = 60;
 // A leg is first integrated over its duration in the word times 1 + kLegMargin (plus kLegMargin): the
 // automaton's crossing of a physical orbit lies at that duration, up to the integration error.
 constexpr double kLegMargin = 0.05;
+// A guard at most this where a leg begins is on it, not above it (orbit_observables.cc's tolerance): it is
+// crossed only after it has been positive.
+constexpr double kGuardStartTolerance = 1e-8;
 
 }  // namespace
 
@@ -54,6 +58,17 @@ AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u,
       if (last) v.push_back(model.anchor().Evaluate(y, nullptr));
       return v;
     };
+    // Their rates along the flow, ġ = ∇g · f.
+    const Phase& ph = model.phase(phase);
+    const auto rates = [&](const Eigen::Ref<const Vector>& y) {
+      Vector f;
+      ph.UnfoldedVectorField(y, xi, &f, nullptr, nullptr);
+      std::vector<double> v;
+      RowVector dg;
+      for (int t : out) a.transitions()[t].guard->Evaluate(y, p, &dg, nullptr), v.push_back(dg.dot(f));
+      if (last) model.anchor().Evaluate(y, &dg), v.push_back(dg.dot(f));
+      return v;
+    };
     struct Sample {
       double t;
       Vector y;
@@ -78,26 +93,51 @@ AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u,
     int first = -1;
     double t_cross = std::numeric_limits<double>::infinity();
     Vector x_cross;
+    // The integrator's steps may step over a shallow dip of a guard (a swing foot that grazes the ground): where
+    // a guard positive at both ends of a step has its rate go from negative to positive, its minimum in between
+    // is located (bisection on the rate) and, if it is <= 0, the crossing lies before it.
+    const auto state_at = [&](const Vector& from, double t) {
+      PhaseFlowResult r;
+      flow.Integrate(from, xi, t, false, &r);
+      return r.ok() ? r.x : Vector();
+    };
     const auto scan = [&]() {
-      std::vector<double> before = values(samples[0].y);
+      std::vector<double> before = values(samples[0].y), rate_before = rates(samples[0].y);
+      if (samples[0].t == 0) {
+        for (double& v : before) v = v > kGuardStartTolerance ? v : 0.0;  // on or below a guard: not above it
+      }
       for (std::size_t s = 1; s < samples.size() && first < 0; ++s) {
-        const std::vector<double> after = values(samples[s].y);
+        const Vector& y0 = samples[s - 1].y;
+        const std::vector<double> after = values(samples[s].y), rate_after = rates(samples[s].y);
         for (std::size_t j = 0; j < after.size(); ++j) {
-          if (!(before[j] > 0 && after[j] <= 0)) continue;
-          // Bisection in [t_{s-1}, t_s], integrating from sample s-1.
-          double lo = 0, hi = samples[s].t - samples[s - 1].t;
+          double hi = samples[s].t - samples[s - 1].t;
           Vector y_hi = samples[s].y;
+          if (before[j] > 0 && after[j] > 0 && rate_before[j] < 0 && rate_after[j] > 0) {
+            double lo = 0;  // the minimum: the rate's zero
+            for (int b = 0; b < kBisections; ++b) {
+              const double mid = 0.5 * (lo + hi);
+              const Vector y = state_at(y0, mid);
+              if (y.size() == 0) break;
+              if (rates(y)[j] < 0) lo = mid;
+              else hi = mid, y_hi = y;
+            }
+            if (!(values(y_hi)[j] <= 0)) continue;
+          } else if (!(before[j] > 0 && after[j] <= 0)) {
+            continue;
+          }
+          // Bisection in [t_{s-1}, t_{s-1} + hi], integrating from sample s-1.
+          double lo = 0;
           for (int b = 0; b < kBisections; ++b) {
             const double mid = 0.5 * (lo + hi);
-            PhaseFlowResult r;
-            flow.Integrate(samples[s - 1].y, xi, mid, false, &r);
-            if (!r.ok()) break;
-            if (values(r.x)[j] > 0) lo = mid;
-            else hi = mid, y_hi = r.x;
+            const Vector y = state_at(y0, mid);
+            if (y.size() == 0) break;
+            if (values(y)[j] > 0) lo = mid;
+            else hi = mid, y_hi = y;
           }
           if (samples[s - 1].t + hi < t_cross) t_cross = samples[s - 1].t + hi, first = static_cast<int>(j), x_cross = y_hi;
         }
         before = after;
+        rate_before = rate_after;
       }
     };
     scan();

@@ -155,19 +155,21 @@ ExpressionModelSpec ExpressionWordSpec(const ExpressionModelSpec& spec, const Wo
   if (!file_word) {
     w.setup.start = StartSpec{};
     w.setup.more_starts.clear();
+    w.setup.word_starts.clear();
     w.setup.families.clear();
     w.setup.quantities.clear();
     w.setup.figures.clear();
-    // Drawings of the modes the word visits; those for given segments of the file's word do not apply.
-    auto& drawings = w.setup.drawing.phases;
-    drawings.erase(std::remove_if(drawings.begin(), drawings.end(),
-                                  [&](const DrawingSpec::PhaseDrawing& d) {
-                                    return !d.segments.empty() ||
-                                           std::none_of(w.phases.begin(), w.phases.end(),
-                                                        [&](const ExpressionPhaseSpec& p) { return p.name == d.phase; });
-                                  }),
-                   drawings.end());
   }
+  // Drawings of the modes the word visits (a file's drawing keyed by mode covers all of its words); those
+  // for given segments of the file's word do not apply to another.
+  auto& drawings = w.setup.drawing.phases;
+  drawings.erase(std::remove_if(drawings.begin(), drawings.end(),
+                                [&](const DrawingSpec::PhaseDrawing& d) {
+                                  return (!file_word && !d.segments.empty()) ||
+                                         std::none_of(w.phases.begin(), w.phases.end(),
+                                                      [&](const ExpressionPhaseSpec& p) { return p.name == d.phase; });
+                                }),
+                 drawings.end());
   return w;
 }
 

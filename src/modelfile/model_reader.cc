@@ -252,9 +252,10 @@ void Reader::CheckSetupValue(const SetupValue& v, const std::vector<std::string>
                   v.where);
 }
 
-std::vector<std::string> Reader::UnknownNames() const {
+std::vector<std::string> Reader::UnknownNames() const { return UnknownNames(WordPhases()); }
+
+std::vector<std::string> Reader::UnknownNames(const std::vector<int>& word) const {
   std::vector<std::string> names;
-  const std::vector<int>& word = WordPhases();
   const int m = static_cast<int>(word.size());
   for (int i = 0; i <= m; ++i) names.push_back("t" + std::to_string(i + 1));
   for (int i = 0; i <= m; ++i) {
@@ -297,6 +298,14 @@ void Reader::CheckUnknown(const toml::node* n, const std::string& field, const s
   if (std::find(names.begin(), names.end(), name) == names.end()) {
     Fail(n, field, "'" + name + "' is not an unknown of the model (unknowns: " + JoinNames(names) +
                        (allow_period ? "; or 'period', the sum of all durations" : "") + ")");
+  }
+}
+
+void Reader::CheckWordUnknown(const toml::node* n, const std::string& field, const std::string& name,
+                              const std::vector<int>& word) const {
+  const std::vector<std::string> names = UnknownNames(word);
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    Fail(n, field, "'" + name + "' is not an unknown of the start's word (unknowns: " + JoinNames(names) + ")");
   }
 }
 

@@ -71,12 +71,17 @@ class Reader {
   void CheckSetupValue(const SetupValue& v, const std::vector<std::string>& extra_symbols);
   // Names of the time-based layout's unknowns: t1..t<m+1>, x<i>_<state>, xi (xi1.. for k > 1), H.
   std::vector<std::string> UnknownNames() const;
+  // The same for a word of the file's automaton (catalogue phases).
+  std::vector<std::string> UnknownNames(const std::vector<int>& word) const;
 
   // Checks shared by several sections.
   // A symbol name must be an identifier that is not a function or a reserved name.
   void CheckName(const toml::node* n, const std::string& field, const std::string& name) const;
   // `name` must be an unknown of the time-based layout (or, with allow_period, "period").
   void CheckUnknown(const toml::node* n, const std::string& field, const std::string& name, bool allow_period) const;
+  // `name` must be an unknown of `word`'s time-based layout.
+  void CheckWordUnknown(const toml::node* n, const std::string& field, const std::string& name,
+                        const std::vector<int>& word) const;
   static std::string JoinNames(const std::vector<std::string>& names);
   // The symbols of an orbit's columns: the unknowns, T and the quantities.
   std::vector<std::string> OrbitSymbols() const;
@@ -88,8 +93,10 @@ class Reader {
   void ReadParameters();
   void ReadDefinitions();
   void ReadStart();
-  // One start table ([start] or an element of [[start]]).
-  StartSpec ReadStartTable(const toml::table& t, const std::string& field);
+  void ReadWordStarts(const toml::array& a);
+  // One start table ([start] or an element of [[start]]); its values name `word`'s unknowns (empty: the
+  // file's word).
+  StartSpec ReadStartTable(const toml::table& t, const std::string& field, const std::vector<int>& word = {});
   void ReadRun();
   void ReadFamilies();
   void ReadQuantities();

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "hybridcont/hybrid_automaton.h"
+
 namespace hybridcont::internal {
 
 void Reader::ReadVersion() {
@@ -100,6 +102,10 @@ void Reader::ReadDefinitions() {
 void Reader::ReadStart() {
   const toml::node* n = root_.get("start");
   if (n == nullptr) Fail(&root_, "start", "missing table [start] (where the exploration begins)");
+  if (const toml::array* a = n->as_array(); a != nullptr && !transition_tables_.empty()) {
+    ReadWordStarts(*a);
+    return;
+  }
   if (const toml::array* a = n->as_array()) {  // [[start]]: several starts, one family each
     if (conservative_) {
       Fail(n, "start", "several starts ([[start]]) are for models without first integral (conservative = false); "
@@ -115,14 +121,62 @@ void Reader::ReadStart() {
     }
     return;
   }
-  spec_.setup.start = ReadStartTable(RequiredTable(root_, "start", ""), "start");
+  const toml::table& t = RequiredTable(root_, "start", "");
+  if (const toml::node* w = t.get("word")) {
+    Fail(w, "start.word", "a start in another word is a [[start]] table beside the file word's start");
+  }
+  spec_.setup.start = ReadStartTable(t, "start");
 }
 
-StartSpec Reader::ReadStartTable(const toml::table& st, const std::string& field) {
+// An automaton's [[start]]: one start per word (`word`, the file's word where absent); a model without first
+// integral may also give several starts of one word. The file's word needs one.
+void Reader::ReadWordStarts(const toml::array& a) {
+  if (a.empty()) Fail(&a, "start", "at least one start");
+  bool own = false;
+  std::vector<std::vector<int>> words;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::string field = "start[" + std::to_string(i) + "]";
+    if (!a.get(i)->is_table()) Fail(a.get(i), field, "expected a [[start]] table");
+    const toml::table& t = *a.get(i)->as_table();
+    std::vector<int> word = automaton_.word;
+    if (const toml::node* w = t.get("word")) {
+      try {
+        word = HybridAutomaton::Graph(spec_.name, automaton_.modes, automaton_.transitions, automaton_.anchor_mode)
+                   ->WordOf(StringArray(*w, field + ".word"));
+      } catch (const std::invalid_argument& e) {
+        const std::string what = e.what();
+        Fail(w, field + ".word", what.substr(what.find(": ") + 2));
+      }
+    }
+    if (conservative_ && std::find(words.begin(), words.end(), word) != words.end()) {
+      Fail(a.get(i), field + ".word", "a second start of this word: a conservative model's exploration branches from "
+                                      "one start per word");
+    }
+    words.push_back(word);
+    StartSpec s = ReadStartTable(t, field, word == automaton_.word ? std::vector<int>{} : word);
+    if (s.word.empty() && !own) {
+      spec_.setup.start = std::move(s);
+      own = true;
+    } else if (s.word.empty()) {
+      spec_.setup.more_starts.push_back(std::move(s));
+    } else {
+      spec_.setup.word_starts.push_back(std::move(s));
+    }
+  }
+  if (!own) Fail(&a, "start", "no start of the file's word (top-level `word`): give one without `word`");
+}
+
+StartSpec Reader::ReadStartTable(const toml::table& st, const std::string& field, const std::vector<int>& word) {
   const toml::table* t = &st;
   StartSpec start;
-  CheckKeys(*t, field, {"kind", "values", "conditions", "cycles"});
+  start.word = word;
+  if (!transition_tables_.empty()) CheckKeys(*t, field, {"kind", "values", "conditions", "cycles", "word"});
+  else CheckKeys(*t, field, {"kind", "values", "conditions", "cycles"});
   const std::string kind = OptionalString(*t, "kind", field, "singular");
+  if (!word.empty() && kind != "guess") {
+    Fail(t->get("kind") ? t->get("kind") : t, field + ".kind",
+         "a start in another word is an approximate orbit (kind = \"guess\"), which Newton corrects at its level H");
+  }
   if (kind == "singular") start.kind = StartSpec::Kind::kSingular;
   else if (kind == "guess") start.kind = StartSpec::Kind::kGuess;
   else if (kind == "simulation") start.kind = StartSpec::Kind::kSimulation;
@@ -134,7 +188,8 @@ StartSpec Reader::ReadStartTable(const toml::table& st, const std::string& field
   if (const toml::table* values = OptionalTable(*t, "values", field)) {
     for (auto&& [key, node] : *values) {
       const std::string name(key.str());
-      CheckUnknown(&node, field + ".values." + name, name, false);
+      if (word.empty()) CheckUnknown(&node, field + ".values." + name, name, false);
+      else CheckWordUnknown(&node, field + ".values." + name, name, word);
       SetupValue v = AsSetupValue(node, field + ".values." + name);
       CheckSetupValue(v, {});
       start.values.push_back({name, v});
@@ -151,7 +206,8 @@ StartSpec Reader::ReadStartTable(const toml::table& st, const std::string& field
       const toml::table& terms = RequiredTable(ct, "terms", cf);
       for (auto&& [key, node] : terms) {
         const std::string name(key.str());
-        CheckUnknown(&node, cf + ".terms." + name, name, false);
+        if (word.empty()) CheckUnknown(&node, cf + ".terms." + name, name, false);
+        else CheckWordUnknown(&node, cf + ".terms." + name, name, word);
         cond.terms.push_back({name, AsNumber(node, cf + ".terms." + name)});
       }
       if (cond.terms.empty()) Fail(&terms, cf + ".terms", "a condition needs at least one term");

@@ -11,6 +11,11 @@ namespace hybridcont {
 
 namespace {
 
+// A competing guard at most this where its phase begins is on it, not above it: the phase begins where the
+// transition before it fired, and a guard equal to that one's (two legs landing at the same height) is 0
+// there up to the corrector's tolerance.
+constexpr double kGuardStartTolerance = 1e-8;
+
 // The phase with the quadrature state q' = g(x) appended: x_aug = [x; q]. Its first integrals, event and
 // reset are the phase's, blind to q, so that the unfolded field is [f + ξ∇H; g] and the flow's
 // sensitivities carry dq/d(x0, ξ, p).
@@ -314,11 +319,49 @@ EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector
   double best_end = std::numeric_limits<double>::infinity();  // constraints: the smaller end value
   int end_segment = -1;
   double end_t = 0.0;
+  double unarmed = std::numeric_limits<double>::infinity();  // guards: -max g where never reached from above
+  int unarmed_segment = -1;
+  double unarmed_t = 0.0;
   PhaseFlowResult res;
   std::vector<Sample> samples;
   Vector f;
   RowVector dg;
-  for (int s = 0; s < layout_.num_segments(); ++s) {
+  // Guards: whether segment s begins armed (observable.h). A segment that begins after a transition that
+  // changes the motion begins armed only above the guard; one that begins at the section or after a cut
+  // continues its predecessor's motion, and so its arming: armed if the predecessor began armed or was
+  // above the guard after its start (a chain of cuts without any transition is one motion).
+  const int num_segments = layout_.num_segments();
+  const auto start_value = [&](int s) {
+    const SmoothFunction* g = o.phases[s % m].get();
+    return g == nullptr ? 0.0 : sign * g->Evaluate(u.segment(layout_.state_offset(s), layout_.dim(s)), p, nullptr, nullptr);
+  };
+  const auto continuous = [&](int s) {
+    return s == 0 || (model_->automaton() != nullptr &&
+                      model_->automaton()->transitions()[model_->word()[(s - 1) % m]].cut);
+  };
+  const auto positive_after_start = [&](int s) {
+    const SmoothFunction* g = o.phases[s % m].get();
+    if (g == nullptr) return false;
+    bool positive = false;
+    PhaseFlowResult r;
+    flows_[s % m].Integrate(u.segment(layout_.state_offset(s), layout_.dim(s)), xi, u(layout_.time_index(s)), false,
+                            &r, [&](double t, const Eigen::Ref<const Vector>& x) {
+                              if (t != 0.0 && sign * g->Evaluate(x, p, nullptr, nullptr) > 0.0) positive = true;
+                            });
+    counters_ += r.counters;
+    return positive;
+  };
+  const auto armed_at_start = [&](int s) {
+    for (int depth = 0; depth < num_segments; ++depth) {
+      if (start_value(s) > kGuardStartTolerance) return true;
+      if (!continuous(s)) return false;
+      s = s == 0 ? num_segments - 1 : s - 1;
+      if (o.phases[s % m] == nullptr) return false;
+      if (positive_after_start(s)) return true;
+    }
+    return false;
+  };
+  for (int s = 0; s < num_segments; ++s) {
     const int i = s % m;
     const SmoothFunction* g = o.phases[i].get();
     if (g == nullptr) continue;
@@ -373,18 +416,42 @@ EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector
       double unused;
       return res.ok() ? h_and_slope(res.x, &unused) : std::numeric_limits<double>::infinity();
     };
+    // A competing guard counts from where it is reached from above (observable.h): armed[j] says whether it
+    // has been positive by sample j (a segment begins armed as armed_at_start says). Other observables count
+    // everywhere.
+    std::vector<char> armed(ns, 1);
+    if (o.guard) {
+      bool on = armed_at_start(s);
+      for (int j = 0; j < ns; ++j) armed[j] = on = on || (j > 0 && h[j] > 0.0);
+      for (int j = 1; j < ns; ++j) {
+        if (!armed[j] && -h[j] < unarmed) unarmed = -h[j], unarmed_segment = s, unarmed_t = samples[j].t;
+      }
+    }
     // Interior local minima of h.
     for (int a = 0; a + 1 < ns; ++a) {
-      if (!(dh[a] < 0.0 && dh[a + 1] > 0.0)) continue;
+      if (!(dh[a] < 0.0 && dh[a + 1] > 0.0) || !armed[a]) continue;
       double t_star = 0.0;
       const double v = refine(a, &t_star);
       if (v < best) best = v, best_segment = s, best_t = t_star, best_interior = true;
     }
     // The ends.
     for (const int j : {0, ns - 1}) {
-      if (o.guard && j == 0 && ns > 1) continue;  // a guard may be 0 where its phase begins (observable.h)
+      if (o.guard && ((j == 0 && ns > 1) || !armed[j])) continue;  // a guard may be 0 where its phase begins
       if (h[j] < best_end) best_end = h[j], end_segment = s, end_t = samples[j].t;
     }
+  }
+  // A guard never reached from above: -max g over its phases (>= 0; 0 where it comes up to 0 from below).
+  if (o.guard && best_segment < 0 && end_segment < 0) {
+    HYBRIDCONT_DEMAND(unarmed_segment >= 0);
+    last_interior_ = false;
+    last_segment_ = unarmed_segment;
+    last_time_ = unarmed_t;
+    const bool at_end = unarmed_t == u(layout_.time_index(unarmed_segment));
+    const EvaluationStatus status =
+        ValueAt(*o.phases[unarmed_segment % m], unarmed_segment, unarmed_t, at_end, u, value, du);
+    *value = -*value;
+    if (du != nullptr) *du = -*du;
+    return status;
   }
   // Minimum and maximum: the smallest of all; a constraint: the smallest interior minimum, else the ends.
   const bool use_end = o.constraint ? !best_interior : best_end < best;
