@@ -50,12 +50,16 @@ void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator,
 }
 
 bool IsPhysical(const HybridModel& model, const Vector& u, const IntegratorOptions& integrator) {
+  return ClassifyPoint(model, u, integrator).physical;
+}
+
+Classification ClassifyPoint(const HybridModel& model, const Vector& u, const IntegratorOptions& integrator) {
   Classification c;
   if (!ClassifyByUnknowns(model, u, ClassificationOptions{}, &c)) {
     const OrbitTrace trace(model, u, integrator);
     c = ClassifyOrbit(model, u, trace, ClassificationOptions{});
   }
-  return c.physical;
+  return c;
 }
 
 void SetFreeParameters(const ShootingLayout& layout, const Vector& u, HybridModel* model) {

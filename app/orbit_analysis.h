@@ -31,6 +31,8 @@ void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator,
 // Whether the time-based point u (the model's own layout) is a physical orbit of the model (classified by
 // its unknowns, or else along its trace).
 bool IsPhysical(const HybridModel& model, const Vector& u, const IntegratorOptions& integrator);
+// Its classification.
+Classification ClassifyPoint(const HybridModel& model, const Vector& u, const IntegratorOptions& integrator);
 
 // Sets the free parameters of `layout` on *model to their values in u.
 void SetFreeParameters(const ShootingLayout& layout, const Vector& u, HybridModel* model);

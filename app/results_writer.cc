@@ -167,7 +167,14 @@ void ResultsWriter::AnnotateBranch(int branch_id, const nlohmann::json& fields) 
   WriteSummary();
 }
 
+const std::vector<ResultsWriter::ClassifiedPoint>& ResultsWriter::ClassifiedPoints(int branch_id) const {
+  static const std::vector<ClassifiedPoint> kNone;
+  const auto it = classified_.find(branch_id);
+  return it == classified_.end() ? kNone : it->second;
+}
+
 void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
+  classified_[branch_id].push_back({p.index, p.u, p.classification});
   if (!write_error_.empty()) return;  // a full disk: keep what is there, write nothing more
   const auto other = branch_models_.find(branch_id);
   const ShootingLayout& layout = other == branch_models_.end() ? layout_ : other->second.layout;

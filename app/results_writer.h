@@ -94,6 +94,13 @@ class ResultsWriter {
   // outlive the writer.
   void SetBranchModel(int branch_id, const HybridModel& model);
   void AddPoint(int branch_id, const PointRecord& point);
+  // The points added to a branch so far, with their classification (empty for an unknown branch).
+  struct ClassifiedPoint {
+    int index = 0;
+    Vector u;
+    Classification classification;
+  };
+  const std::vector<ClassifiedPoint>& ClassifiedPoints(int branch_id) const;
   // Adds `fields` to the summary entry of branch `branch_id` (after EndBranch) and rewrites summary.json.
   void AnnotateBranch(int branch_id, const nlohmann::json& fields);
   // Records the finished branch's metadata and rewrites summary.json.
@@ -132,6 +139,7 @@ class ResultsWriter {
     std::vector<std::string> word;  // its modes (HybridModel::WordModeNames)
   };
   std::map<int, BranchModel> branch_models_;  // branches of another model (SetBranchModel)
+  std::map<int, std::vector<ClassifiedPoint>> classified_;
   std::map<int, std::ofstream> branch_files_;
   std::map<int, int> points_per_branch_;
   std::string write_error_;

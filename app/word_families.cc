@@ -106,6 +106,13 @@ void TouchedGuards(const HybridModel& model, const BifurcationDiagram& d, const 
       best = j, smallest = std::abs(v), segment = evaluator.last_extremum_segment(), t = evaluator.last_extremum_time();
     }
     if (best < 0) continue;
+    // Only where the orbit is physical but for this guard: a boundary crossed by a non-physical family hands
+    // nothing over.
+    const Classification c = ClassifyPoint(model, u, integrator);
+    if (!c.physical && !(c.reason == OrbitClass::kConstraintViolated &&
+                         c.detail.find("'" + model.observables()[best].name + "'") != std::string::npos)) {
+      continue;
+    }
     Degeneracy g;
     g.branch = sp.branch_id;
     g.u = u;
@@ -115,6 +122,49 @@ void TouchedGuards(const HybridModel& model, const BifurcationDiagram& d, const 
     g.where = fmt::format("special point {} (CB of {})", sp.id, model.observables()[best].name);
     out->push_back(std::move(g));
   }
+}
+
+// Where a physical family of a word ends without a change of its phase sequence to offer: the first point
+// beyond is classified missed-event (the phase's own guard crossed from above before its end: a tangential
+// touch-down inside the phase), wrong-direction or grazing (the event met with zero crossing speed at the
+// phase's end). The orbit that takes the transition at the touch point is another orbit of the same word (a
+// grazing bifurcation), so these ends are recorded with their reason, bracketed by the two points.
+struct PhysicalEnd {
+  int branch = -1;
+  double H_physical = 0, H_beyond = 0;
+  int index_physical = 0, index_beyond = 0;
+  Classification beyond;
+};
+
+std::vector<PhysicalEnd> PhysicalEnds(const HybridModel& model, const BifurcationDiagram& d, const ResultsWriter& writer) {
+  const ShootingLayout layout(model);
+  std::vector<PhysicalEnd> ends;
+  for (const Branch& b : d.branches) {
+    if (b.image_of >= 0) continue;  // an image's ends are the images of its source's
+    const auto& points = writer.ClassifiedPoints(b.id);
+    for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+      const bool a = points[i].classification.physical, z = points[i + 1].classification.physical;
+      if (a == z) continue;
+      const auto& in = a ? points[i] : points[i + 1];
+      const auto& out = a ? points[i + 1] : points[i];
+      const OrbitClass c = out.classification.reason;
+      if (c != OrbitClass::kMissedEvent && c != OrbitClass::kWrongDirection && c != OrbitClass::kGrazing) continue;
+      if (out.index == 0 && b.parent_special_point < 0) continue;  // the start itself (declared or handed over)
+      ends.push_back({b.id, in.u(layout.H_index()), out.u(layout.H_index()), in.index, out.index, out.classification});
+    }
+  }
+  return ends;
+}
+
+std::string EndReason(OrbitClass c) {
+  if (c == OrbitClass::kMissedEvent) {
+    return "a phase's own guard is touched from above before the phase's end (a tangential touch-down inside the "
+           "phase): beyond, this word's orbit crosses that guard early; the orbit that takes the transition at the "
+           "touch point is another orbit of the same word (a grazing bifurcation), not a change of the phase "
+           "sequence";
+  }
+  return "a phase's event is met with zero crossing speed at the phase's end (grazing at the transition): beyond, "
+         "the guard is met from below, which no transition of the automaton takes";
 }
 
 // The run's options on another word's layout: bounds and targets on unknowns it has, the period's bound (a sum
@@ -280,6 +330,22 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
     std::vector<Degeneracy> found;
     ZeroDurations(word_model, scan, integrator, &found);
     TouchedGuards(word_model, scan, integrator, &found);
+    for (const PhysicalEnd& e : PhysicalEnds(word_model, scan, writer)) {
+      const std::string at = fmt::format("end of a physical family ({})", ToString(e.beyond.reason));
+      report += fmt::format("  word {}: {} at H in [{:.10f}, {:.10f}] (branch {} between points {} and {}; {}):\n    "
+                            "refused: {}\n",
+                            automaton.WordName(words[entry].word), at, std::min(e.H_physical, e.H_beyond),
+                            std::max(e.H_physical, e.H_beyond), e.branch, std::min(e.index_physical, e.index_beyond),
+                            std::max(e.index_physical, e.index_beyond), e.beyond.detail, EndReason(e.beyond.reason));
+      changes.push_back({{"from_word", word_model.WordModeNames()},
+                         {"from_branch", e.branch},
+                         {"at", at},
+                         {"H", 0.5 * (e.H_physical + e.H_beyond)},
+                         {"H_bracket", {e.H_physical, e.H_beyond}},
+                         {"detail", e.beyond.detail},
+                         {"accepted", false},
+                         {"reason", EndReason(e.beyond.reason)}});
+    }
     for (const Degeneracy& g : found) {
       if (seen(entry, g.u)) continue;
       const ShootingLayout layout(word_model);

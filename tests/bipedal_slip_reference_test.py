@@ -146,3 +146,39 @@ def test_gait_periods_match_an_independent_integration_at_three_energies(results
         assert taken == transitions
         assert abs(t - period) < 1e-8 * max(1.0, period), (p["H"], t, period)
         assert np.max(np.abs(x_end - np.array(x1))) < 1e-8, (p["H"], x_end, x1)
+
+
+def zero_flight_level():
+    """The level where symmetric running loses its flight: the stance from landing at (-l0 sin b, l0 cos b)
+    with a horizontal velocity v passes mid-stance with dy = 0, so it lifts off with dy = 0 at the mirror
+    point; H = v^2 / 2 + g l0 cos b (both springs at rest)."""
+    def dy_at_midstance(v):
+        mid = lambda t, s: s[0]
+        mid.terminal, mid.direction = True, 1
+        sol = solve_ivp(stance, [0, 10], [-S, C, v, 0.0], events=mid, method="DOP853", rtol=1e-13, atol=1e-13)
+        return sol.y_events[0][0][3]
+    v = brentq(dy_at_midstance, 1.0, 1.1, xtol=1e-15)
+    return 0.5 * v * v + G * C
+
+
+def test_running_without_flight_hands_over_to_a_double_support_of_zero_duration(results):
+    _, summary = results
+    traded = [c for c in summary["word_changes"] if c.get("accepted") and "traded" in c.get("rule", "")]
+    assert len(traded) == 1, summary["word_changes"]
+    c = traded[0]
+    assert c["from_word"] == ["stance", "flight", "stance", "flight"]
+    assert c["to_word"] == ["stance", "double", "stance", "flight"]
+    assert abs(c["H"] - zero_flight_level()) < 1e-8
+    assert c["state_difference"] < 1e-10 and c["period_difference"] < 1e-10
+
+
+def test_every_physical_orbit_is_replayed_by_the_automaton(results):
+    out, summary = results
+    count = 0
+    for b in summary["branches"]:
+        with open(out / b["file"]) as f:
+            for row in csv.DictReader(f):
+                if row["physical"] == "1":
+                    assert float(row["automaton_replay_error"]) < 1e-8, (b["id"], row["index"])
+                    count += 1
+    assert count >= 100

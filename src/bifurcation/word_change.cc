@@ -182,8 +182,43 @@ std::vector<WordChange> WordsWithoutPhase(const HybridModel& model, const Vector
                         },
                         integrator));
   }
+  // The zero-duration phase traded for one of another mode between the same neighbours (a running stride's
+  // flight of zero duration is a double support of zero duration where both legs meet the ground at once):
+  // τ1 into that mode, at once τ2 out of it. The new word's map decides whether the guards and resets agree.
   if (out.empty()) {
-    *why = fmt::format("no transition from mode '{}' to mode '{}' takes the place of phase {} ({})",
+    for (int tau1 : a.TransitionsFrom(before.from)) {
+      const AutomatonTransition& t1 = a.transitions()[tau1];
+      if (t1.to == before.to || t1.cut) continue;
+      for (int tau2 : a.TransitionsFrom(t1.to)) {
+        const AutomatonTransition& t2 = a.transitions()[tau2];
+        if (t2.to != after.to || t2.cut) continue;
+        Word next = w;
+        next[segment - 1] = tau1;
+        next[segment] = tau2;
+        const std::string rule =
+            fmt::format("phase {} ({}) of zero duration traded for one in '{}': {} then {} replaced by {} then {}",
+                        segment + 1, a.modes()[before.to].name, a.modes()[t1.to].name, before.name, after.name,
+                        t1.name, t2.name);
+        out.push_back(Check(model, u, next, rule,
+                            [&](const HybridModel& nm, std::vector<Piece>* pieces, std::string*) {
+                              *pieces = Pieces(layout, u);
+                              // The new mode's state: τ1's reset of the state where phase `segment` began.
+                              const Piece& last = (*pieces)[segment - 1];
+                              Vector x_end;
+                              std::string unused;
+                              if (!FlowTo(model, layout, u, segment - 1, last.t, integrator, &x_end, &unused)) {
+                                return false;
+                              }
+                              (*pieces)[segment] = {0.0, ResetOf(nm, segment - 1, x_end)};
+                              return true;
+                            },
+                            integrator));
+      }
+    }
+  }
+  if (out.empty()) {
+    *why = fmt::format("no transition from mode '{}' to mode '{}' takes the place of phase {} ({}), nor a pair "
+                       "through another mode",
                        a.modes()[before.from].name, a.modes()[after.to].name, segment + 1, a.modes()[before.to].name);
   }
   return out;
