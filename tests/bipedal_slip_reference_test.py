@@ -10,15 +10,14 @@ its state after its period.
 Environment: HYBRIDCONT_BIN (the hybridcont executable), HYBRIDCONT_MODELS (the models folder).
 """
 import csv
-import json
 import math
 import os
-import subprocess
 
-import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
+
+from automaton_reference import check_periods_at_three_energies, run_model
 
 BIN = os.environ.get("HYBRIDCONT_BIN", "build/hybridcont")
 MODELS = os.environ.get("HYBRIDCONT_MODELS", "models")
@@ -26,7 +25,6 @@ MODELS = os.environ.get("HYBRIDCONT_MODELS", "models")
 # Parameters of models/bipedal-slip.toml (m = l0 = g = 1).
 K, BETA, G = 20.0, 0.36, 1.0
 S, C = math.sin(BETA), math.cos(BETA)
-ARMING = 1e-8  # a guard at most this where a leg begins is on it, not above it
 
 
 def stance(t, s):
@@ -63,69 +61,10 @@ MODES = {
 ANCHOR = ("anchor", lambda s: -s[0], None, None)  # mid-stance: x crosses 0 upward
 
 
-def first_crossing(rhs, x0, watched, horizon=20.0, chunk=0.5, grid=400):
-    """The first guard crossed from above: (index, time, state)."""
-    armed = [g(x0) > ARMING for _, g, _, _ in watched]
-    t0, x = 0.0, np.array(x0, float)
-    while t0 < horizon:
-        sol = solve_ivp(rhs, [t0, t0 + chunk], x, method="DOP853", rtol=1e-12, atol=1e-12, dense_output=True)
-        ts = np.linspace(t0, t0 + chunk, grid)
-        values = [[g(sol.sol(t)) for _, g, _, _ in watched] for t in ts]
-        for a in range(1, grid):
-            hits = []
-            for j in range(len(watched)):
-                before, after = values[a - 1][j], values[a][j]
-                if armed[j] and before > 0 and after <= 0:
-                    g = watched[j][1]
-                    hits.append((brentq(lambda t: g(sol.sol(t)), ts[a - 1], ts[a], xtol=1e-15, rtol=1e-15), j))
-                if after > 0:
-                    armed[j] = True
-            if hits:
-                t, j = min(hits)
-                return j, t, sol.sol(t)
-        t0, x = t0 + chunk, sol.y[:, -1]
-    raise AssertionError("no guard crossed")
-
-
-def replay(x1, legs):
-    """Simulates the automaton from the section state x1 (mode stance); the transitions taken, the time to
-    the section after `legs` transitions, and the state there."""
-    mode, x, t, taken = "stance", list(x1), 0.0, []
-    for leg in range(legs + 1):
-        rhs, out = MODES[mode]
-        watched = list(out) + ([ANCHOR] if leg == legs else [])
-        j, dt, x_end = first_crossing(rhs, x, watched)
-        t += dt
-        name, _, target, reset = watched[j]
-        if name == "anchor":
-            return taken, t, np.array(x_end)
-        taken.append(name)
-        if leg == legs:
-            return taken, t, np.array(x_end)
-        mode, x = target, reset(list(x_end))
-    raise AssertionError("unreachable")
-
-
 @pytest.fixture(scope="module")
 def results(tmp_path_factory):
-    out = tmp_path_factory.mktemp("bipedal")
-    subprocess.run([BIN, "run", os.path.join(MODELS, "bipedal-slip.toml"), "--out", str(out), "--quiet",
-                    "--no-plots"], check=True, stdout=subprocess.DEVNULL)
-    with open(out / "summary.json") as f:
-        summary = json.load(f)
-    return out, summary
-
-
-def physical_points(out, summary, word):
-    points = []
-    for b in summary["branches"]:
-        if b.get("word") != word:
-            continue
-        with open(out / b["file"]) as f:
-            for row in csv.DictReader(f):
-                if row["physical"] == "1":
-                    points.append({k: float(row[k]) for k in row if k == "H" or k[0] in "tx" and k[1].isdigit()})
-    return points
+    out = tmp_path_factory.mktemp("run")
+    return out, run_model(BIN, os.path.join(MODELS, "bipedal-slip.toml"), out)
 
 
 @pytest.mark.parametrize("word,transitions", [
@@ -133,19 +72,7 @@ def physical_points(out, summary, word):
     (["stance", "flight", "stance", "flight"], ["liftoff", "landing", "liftoff", "landing"]),
 ])
 def test_gait_periods_match_an_independent_integration_at_three_energies(results, word, transitions):
-    out, summary = results
-    points = physical_points(out, summary, word)
-    assert len(points) >= 3, f"fewer than three physical orbits of {word}"
-    levels = sorted({round(p["H"], 6): p for p in points}.items())
-    chosen = [levels[0][1], levels[len(levels) // 2][1], levels[-1][1]]
-    assert chosen[-1]["H"] - chosen[0]["H"] > 1e-3  # three distinct energies
-    for p in chosen:
-        x1 = [p["x1_x"], p["x1_y"], p["x1_dx"], p["x1_dy"]]
-        period = sum(p[f"t{i}"] for i in range(1, 6))
-        taken, t, x_end = replay(x1, len(transitions))
-        assert taken == transitions
-        assert abs(t - period) < 1e-8 * max(1.0, period), (p["H"], t, period)
-        assert np.max(np.abs(x_end - np.array(x1))) < 1e-8, (p["H"], x_end, x1)
+    check_periods_at_three_energies(*results, word, transitions, MODES, ANCHOR, ("x", "y", "dx", "dy"))
 
 
 def zero_flight_level():

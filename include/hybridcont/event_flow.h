@@ -106,6 +106,9 @@ struct EventFlowOptions {
   // |g(x0)| at or below this counts as "starting on the guard" (then g_dot decides: moving down is a
   // zero-duration phase, moving up is ignored). Round-off of a reset map lands within ~1e-15 of the guard.
   double start_tolerance = 1e-12;
+  // A hybrid automaton's guard (observable.h) fires where it is crossed from above: a start on it moving down
+  // is then a guard not yet armed, integrated on until it has been above 0, not a zero-duration phase.
+  bool from_above = false;
 
   // Empty if valid; otherwise names the field, its value and the violated constraint.
   std::string Validate() const;

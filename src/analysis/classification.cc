@@ -35,6 +35,10 @@ namespace {
 
 Classification NonPhysical(OrbitClass reason, const std::string& detail) { return {false, reason, detail}; }
 
+// An automaton's guard at most this where its phase begins is on it, not above it (as in
+// orbit_observables.cc and automaton_replay.cc).
+constexpr double kGuardStartTolerance = 1e-8;
+
 // The scalar guard of segment i (event e_i for i < m, anchor a for the return segment).
 double Guard(const HybridModel& model, int i, const Vector& x, RowVector* grad) {
   if (i < model.num_phases()) return model.phase(i).Event(x, grad);
@@ -46,7 +50,7 @@ double Guard(const HybridModel& model, int i, const Vector& x, RowVector* grad) 
 // the start (the end of a rod below the ground right after the other end's impact). Searched on the
 // Hermite interpolant of every step. Returns the local time or NaN if none.
 double FirstViolation(const HybridModel& model, const OrbitTrace& trace, int i, int samples_per_step,
-                      bool forbid_negative) {
+                      bool forbid_negative, bool from_above) {
   const auto& nodes = trace.segment(i);
   const double end = trace.duration(i);
   // Crossings within this fraction of the segment's end are the end crossing itself.
@@ -55,6 +59,9 @@ double FirstViolation(const HybridModel& model, const OrbitTrace& trace, int i, 
   constexpr double kPenetration = 1e-9;
   double previous = Guard(model, i, nodes.front().x, nullptr);
   if (forbid_negative && previous < -kPenetration) return 0.0;
+  // An automaton's guard fires where it is crossed from above (observable.h): a phase that begins on it
+  // (within kGuardStartTolerance) or below it is not beyond it until it has been above it.
+  if (from_above && previous <= kGuardStartTolerance) previous = 0.0;
   for (std::size_t j = 0; j + 1 < nodes.size(); ++j) {
     // Samples follow the motion, not just the steps: an exactly integrable flight (the rod's) is crossed in
     // a few large steps while the guard oscillates (sin of a fast angle). Sub-intervals are short enough
@@ -137,8 +144,10 @@ Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const Or
   for (int i = 0; i <= m; ++i) {
     // A phase that ends at a cut of its automaton (hybrid_automaton.h) has a guard that only marks a time.
     const bool cut = model.automaton() && model.automaton()->transitions()[model.word()[i % m]].cut;
-    const bool bounds = i < m && !cut && model.phase(i).event_bounds_state();
-    const double t = FirstViolation(model, trace, i, options.samples_per_step, /*forbid_negative=*/bounds);
+    const bool automaton = model.automaton() != nullptr;
+    const bool bounds = i < m && !cut && !automaton && model.phase(i).event_bounds_state();
+    const double t = FirstViolation(model, trace, i, options.samples_per_step, /*forbid_negative=*/bounds,
+                                    /*from_above=*/automaton && i < m);
     if (!std::isnan(t)) {
       os << (i < m ? "event" : "anchor") << " of segment " << i + 1 << " violated at t = " << t << " < "
          << trace.duration(i);

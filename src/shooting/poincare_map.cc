@@ -42,7 +42,9 @@ std::string PoincareResult::BriefReport() const {
 PoincareMap::PoincareMap(const HybridModel& model, PoincareOptions options) : model_(&model), options_(options) {
   if (const std::string why = options.Validate(); !why.empty()) throw std::invalid_argument(why);
   const int m = model.num_phases();
-  for (int i = 0; i <= m; ++i) flows_.emplace_back(model.phase(i), options.event);
+  EventFlowOptions event = options.event;
+  event.from_above = model.automaton() != nullptr;  // guards of an automaton fire when crossed from above
+  for (int i = 0; i <= m; ++i) flows_.emplace_back(model.phase(i), event);
 }
 
 PoincareStatus PoincareMap::Evaluate(const Eigen::Ref<const Vector>& x0, const Eigen::Ref<const Vector>& xi,
