@@ -734,6 +734,58 @@ def figure_h_t(res, svg, written):
     save(fig, res, "H_T", svg, written)
 
 
+def figure_words(res, svg, written):
+    """A run across the words of an automaton: its physical orbits only, one colour per word, over the period
+    and (where the model declares it) the mean forward speed; accepted changes of the phase sequence are
+    stars at the orbit where the new word's family begins."""
+    words = res.summary.get("words")
+    if not isinstance(words, list) or len(words) < 2:
+        return
+    names = [str(w.get("name", "?")) for w in words if isinstance(w, dict)]
+    word_of = {}
+    for k, w in enumerate(words):
+        for i in (w.get("branches") or []) if isinstance(w, dict) else []:
+            word_of[i] = k
+    has_speed = any(res.column(b, "speed") is not None for b in res.branches)
+    xnames = ["T", "speed"] if has_speed else ["T"]
+    fig, axes = plt.subplots(1, len(xnames), figsize=(6.0 * len(xnames), 4.4), squeeze=False)
+    drawn = set()
+    for b in res.branches:
+        k = word_of.get(b["id"])
+        phys = b["table"].num("physical")
+        if k is None or phys is None:
+            continue
+        for ax, xname in zip(axes[0], xnames):
+            xs, ys = res.column(b, xname), res.column(b, res.family)
+            if xs is None or ys is None:
+                continue
+            pts = [(x, y) for x, y, p in zip(xs, ys, phys) if p == 1 and finite(x, y)]
+            if pts:
+                ax.plot([x for x, _ in pts], [y for _, y in pts], ".", ms=3.5, color=branch_colour(k),
+                        label=names[k] if k not in drawn else None)
+                drawn.add(k)
+    by_id = {b["id"]: b for b in res.branches}
+    for change in res.summary.get("word_changes") or []:
+        if not isinstance(change, dict) or not change.get("accepted") or not change.get("to_branches"):
+            continue
+        b = by_id.get(change["to_branches"][0])
+        if b is None:
+            continue
+        for ax, xname in zip(axes[0], xnames):
+            xs, ys = res.column(b, xname), res.column(b, res.family)
+            if xs and ys and finite(xs[0], ys[0]):
+                ax.plot(xs[0], ys[0], "*", ms=11, color="k", zorder=5)
+    for ax, xname in zip(axes[0], xnames):
+        ax.set_xlabel(axis_label(xname) if xname == "T" else "mean forward speed", fontsize=9)
+        ax.set_ylabel(axis_label(res.family), fontsize=9)
+        ax.grid(alpha=0.3)
+    axes[0][0].set_title("physical orbits by phase sequence: " + model_title(res), fontsize=10)
+    if drawn:
+        axes[0][0].legend(fontsize=8, frameon=False, title="word (* a change of the phase sequence)",
+                           title_fontsize=8)
+    save(fig, res, "words", svg, written)
+
+
 def has_nonzero_xi(res):
     for b in res.branches:
         xi = res.column(b, "xi")
@@ -1276,11 +1328,12 @@ def main(argv):
     if has_nonzero_xi(res):
         jobs.append(("H_T_xi", lambda w: figure_h_t_xi(res, args.svg, w)))
     jobs.append(("curves", lambda w: figure_curves(res, args.svg, w)))
+    jobs.append(("words", lambda w: figure_words(res, args.svg, w)))
     if res.presentation is None:
         warn("%s has no 'presentation' (written by an older hybridcont): only the generic figures are drawn"
              % res.summary_path)
     else:
-        names = set(("H_T", "H_T_xi", "keyframes", "curves"))
+        names = set(("H_T", "H_T_xi", "keyframes", "curves", "words"))
         for spec in res.presentation["figures"]:
             if spec["name"] in names:
                 warn("%s is declared twice or would overwrite a generic figure; skipped" % spec["file"])
