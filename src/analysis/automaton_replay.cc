@@ -95,7 +95,8 @@ AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u,
     Vector x_cross;
     // The integrator's steps may step over a shallow dip of a guard (a swing foot that grazes the ground): where
     // a guard positive at both ends of a step has its rate go from negative to positive, its minimum in between
-    // is located (bisection on the rate) and, if it is <= 0, the crossing lies before it.
+    // is located (bisection on the rate) and, if it is <= 0, the crossing lies before it. Likewise a shallow
+    // bump above 0 of a guard negative at both ends arms it, and the crossing lies after its maximum.
     const auto state_at = [&](const Vector& from, double t) {
       PhaseFlowResult r;
       flow.Integrate(from, xi, t, false, &r);
@@ -112,9 +113,9 @@ AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u,
         for (std::size_t j = 0; j < after.size(); ++j) {
           double hi = samples[s].t - samples[s - 1].t;
           Vector y_hi = samples[s].y;
+          double lo = 0;
           if (before[j] > 0 && after[j] > 0 && rate_before[j] < 0 && rate_after[j] > 0) {
-            double lo = 0;  // the minimum: the rate's zero
-            for (int b = 0; b < kBisections; ++b) {
+            for (int b = 0; b < kBisections; ++b) {  // the minimum: the rate's zero
               const double mid = 0.5 * (lo + hi);
               const Vector y = state_at(y0, mid);
               if (y.size() == 0) break;
@@ -122,11 +123,25 @@ AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u,
               else hi = mid, y_hi = y;
             }
             if (!(values(y_hi)[j] <= 0)) continue;
+            lo = 0;
+          } else if (before[j] <= 0 && after[j] <= 0 && rate_before[j] > 0 && rate_after[j] < 0) {
+            // A bump above 0 between the samples (a foot that barely clears the ground) arms the guard, and
+            // it is crossed on the way down after the maximum.
+            double top = hi;
+            Vector y_top = y_hi;
+            for (int b = 0; b < kBisections; ++b) {  // the maximum: the rate's zero
+              const double mid = 0.5 * (lo + top);
+              const Vector y = state_at(y0, mid);
+              if (y.size() == 0) break;
+              if (rates(y)[j] > 0) lo = mid;
+              else top = mid, y_top = y;
+            }
+            if (!(values(y_top)[j] > 0)) continue;
+            lo = top;
           } else if (!(before[j] > 0 && after[j] <= 0)) {
             continue;
           }
-          // Bisection in [t_{s-1}, t_{s-1} + hi], integrating from sample s-1.
-          double lo = 0;
+          // Bisection in [t_{s-1} + lo, t_{s-1} + hi], integrating from sample s-1.
           for (int b = 0; b < kBisections; ++b) {
             const double mid = 0.5 * (lo + hi);
             const Vector y = state_at(y0, mid);

@@ -422,7 +422,15 @@ EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector
     std::vector<char> armed(ns, 1);
     if (o.guard) {
       bool on = armed_at_start(s);
-      for (int j = 0; j < ns; ++j) armed[j] = on = on || (j > 0 && h[j] > 0.0);
+      for (int j = 0; j < ns; ++j) {
+        // A bump above 0 between samples j-1 and j (a foot that barely clears the ground) arms it too.
+        if (!on && j > 0 && h[j - 1] <= 0.0 && h[j] <= 0.0 && dh[j - 1] > 0.0 && dh[j] < 0.0) {
+          double t_top = 0.0;
+          const double top = refine(j - 1, &t_top);
+          on = std::isfinite(top) && top > 0.0;
+        }
+        armed[j] = on = on || (j > 0 && h[j] > 0.0);
+      }
       for (int j = 1; j < ns; ++j) {
         if (!armed[j] && -h[j] < unarmed) unarmed = -h[j], unarmed_segment = s, unarmed_t = samples[j].t;
       }
