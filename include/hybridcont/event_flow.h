@@ -88,6 +88,12 @@ class FunctionGuard : public Guard {
   Function g_;
 };
 
+// An automaton's guard at most this where its phase begins is on it, not above it: the phase begins where
+// the transition before it fired, and a guard equal to that one's (two legs landing at the same height) is 0
+// there up to the corrector's tolerance. One value for every place that decides a crossing (the event flow,
+// the guard constraints, the classification and the automaton's simulation).
+inline constexpr double kGuardStartTolerance = 1e-8;
+
 struct EventFlowOptions {
   // rtol, atol, initial_step, min_step and max_steps as for time-based flows (the same accuracy for both
   // formulations makes their results comparable). `method` is not used: event location needs a dense
@@ -106,8 +112,9 @@ struct EventFlowOptions {
   // |g(x0)| at or below this counts as "starting on the guard" (then g_dot decides: moving down is a
   // zero-duration phase, moving up is ignored). Round-off of a reset map lands within ~1e-15 of the guard.
   double start_tolerance = 1e-12;
-  // A hybrid automaton's guard (observable.h) fires where it is crossed from above: a start on it moving down
-  // is then a guard not yet armed, integrated on until it has been above 0, not a zero-duration phase.
+  // A hybrid automaton's guard (observable.h) fires where it is crossed from above: a start on it (within
+  // kGuardStartTolerance) or below it is then a guard not yet armed, integrated on until it has been above 0,
+  // not a zero-duration phase.
   bool from_above = false;
 
   // Empty if valid; otherwise names the field, its value and the violated constraint.

@@ -1,3 +1,4 @@
+#include "hybridcont/event_flow.h"
 #include "hybridcont/automaton_replay.h"
 
 #include <fmt/format.h>
@@ -18,9 +19,6 @@ constexpr int kBisections = 60;
 // A leg is first integrated over its duration in the word times 1 + kLegMargin (plus kLegMargin): the
 // automaton's crossing of a physical orbit lies at that duration, up to the integration error.
 constexpr double kLegMargin = 0.05;
-// A guard at most this where a leg begins is on it, not above it (orbit_observables.cc's tolerance): it is
-// crossed only after it has been positive.
-constexpr double kGuardStartTolerance = 1e-8;
 
 }  // namespace
 

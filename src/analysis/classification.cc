@@ -1,3 +1,4 @@
+#include "hybridcont/event_flow.h"
 #include "hybridcont/classification.h"
 
 #include <algorithm>
@@ -35,12 +36,8 @@ namespace {
 
 Classification NonPhysical(OrbitClass reason, const std::string& detail) { return {false, reason, detail}; }
 
-// An automaton's guard at most this where its phase begins is on it, not above it (as in
-// orbit_observables.cc and automaton_replay.cc).
-constexpr double kGuardStartTolerance = 1e-8;
-
 // The scalar guard of segment i (event e_i for i < m, anchor a for the return segment).
-double Guard(const HybridModel& model, int i, const Vector& x, RowVector* grad) {
+double SegmentGuard(const HybridModel& model, int i, const Vector& x, RowVector* grad) {
   if (i < model.num_phases()) return model.phase(i).Event(x, grad);
   return model.anchor().Evaluate(x, grad);
 }
@@ -57,7 +54,7 @@ double FirstViolation(const HybridModel& model, const OrbitTrace& trace, int i, 
   const double end_slack = 1e-9 * std::max(1.0, std::abs(end));
   // Round-off below zero at the start of a phase (a reset onto its own guard) is not a penetration.
   constexpr double kPenetration = 1e-9;
-  double previous = Guard(model, i, nodes.front().x, nullptr);
+  double previous = SegmentGuard(model, i, nodes.front().x, nullptr);
   if (forbid_negative && previous < -kPenetration) return 0.0;
   // An automaton's guard fires where it is crossed from above (observable.h): a phase that begins on it
   // (within kGuardStartTolerance) or below it is not beyond it until it has been above it.
@@ -76,7 +73,7 @@ double FirstViolation(const HybridModel& model, const OrbitTrace& trace, int i, 
       const double t = nodes[j].t + (nodes[j + 1].t - nodes[j].t) * s / samples;
       if (std::abs(end - t) <= end_slack) return std::nan("");
       const Vector x = s == samples ? nodes[j + 1].x : trace.Interpolate(i, static_cast<int>(j), t);
-      const double g = Guard(model, i, x, nullptr);
+      const double g = SegmentGuard(model, i, x, nullptr);
       if ((previous > 0.0 && g <= 0.0) || (forbid_negative && g < -kPenetration)) return t;
       previous = g;
     }
@@ -129,7 +126,7 @@ Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const Or
   for (int i = 0; i <= m; ++i) {
     const TraceNode& end = trace.segment(i).back();
     RowVector grad;
-    Guard(model, i, end.x, &grad);
+    SegmentGuard(model, i, end.x, &grad);
     const double speed = grad.dot(end.f) / std::max(grad.norm() * end.f.norm(), 1e-300);
     if (speed > -options.grazing_tolerance) {
       os << (i < m ? "event of segment " : "anchor at the end of segment ") << i + 1

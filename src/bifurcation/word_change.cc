@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
@@ -185,7 +186,7 @@ std::vector<WordChange> WordsWithoutPhase(const HybridModel& model, const Vector
   // The zero-duration phase traded for one of another mode between the same neighbours (a running stride's
   // flight of zero duration is a double support of zero duration where both legs meet the ground at once):
   // τ1 into that mode, at once τ2 out of it. The new word's map decides whether the guards and resets agree.
-  if (out.empty()) {
+  if (std::none_of(out.begin(), out.end(), [](const WordChange& c) { return c.accepted; })) {
     for (int tau1 : a.TransitionsFrom(before.from)) {
       const AutomatonTransition& t1 = a.transitions()[tau1];
       if (t1.to == before.to || t1.cut) continue;
@@ -200,13 +201,12 @@ std::vector<WordChange> WordsWithoutPhase(const HybridModel& model, const Vector
                         segment + 1, a.modes()[before.to].name, a.modes()[t1.to].name, before.name, after.name,
                         t1.name, t2.name);
         out.push_back(Check(model, u, next, rule,
-                            [&](const HybridModel& nm, std::vector<Piece>* pieces, std::string*) {
+                            [&](const HybridModel& nm, std::vector<Piece>* pieces, std::string* failure) {
                               *pieces = Pieces(layout, u);
                               // The new mode's state: τ1's reset of the state where phase `segment` began.
                               const Piece& last = (*pieces)[segment - 1];
                               Vector x_end;
-                              std::string unused;
-                              if (!FlowTo(model, layout, u, segment - 1, last.t, integrator, &x_end, &unused)) {
+                              if (!FlowTo(model, layout, u, segment - 1, last.t, integrator, &x_end, failure)) {
                                 return false;
                               }
                               (*pieces)[segment] = {0.0, ResetOf(nm, segment - 1, x_end)};

@@ -164,7 +164,7 @@ EventFlowStatus EventFlow::Integrate(const Eigen::Ref<const Vector>& x0, const E
                   0.0, w.z, g_prev, g_dot_prev);
   }
   if (observer) observer(0.0, x0);
-  if (options_.from_above && g_prev <= options_.start_tolerance) {
+  if (options_.from_above && g_prev <= kGuardStartTolerance) {
     g_prev = std::min(g_prev, 0.0);  // on or below the guard: not above it
   } else if (std::abs(g_prev) <= options_.start_tolerance && g_dot_prev < 0.0) {
     std::ostringstream os;

@@ -140,6 +140,13 @@ void Reader::ReadWordStarts(const toml::array& a) {
     const toml::table& t = *a.get(i)->as_table();
     std::vector<int> word = automaton_.word;
     if (const toml::node* w = t.get("word")) {
+      if (!conservative_) {
+        Fail(w, field + ".word", "starts in other words are for conservative models (a run along a parameter "
+                                 "follows the start's word only)");
+      }
+      if (const toml::node* c = t.get("conditions")) {
+        Fail(c, field + ".conditions", "a start in another word is a regular orbit: it has no start conditions");
+      }
       try {
         word = HybridAutomaton::Graph(spec_.name, automaton_.modes, automaton_.transitions, automaton_.anchor_mode)
                    ->WordOf(StringArray(*w, field + ".word"));

@@ -1,3 +1,4 @@
+#include "hybridcont/event_flow.h"
 #include "hybridcont/orbit_observables.h"
 
 #include <boost/math/tools/toms748_solve.hpp>
@@ -10,11 +11,6 @@
 namespace hybridcont {
 
 namespace {
-
-// A competing guard at most this where its phase begins is on it, not above it: the phase begins where the
-// transition before it fired, and a guard equal to that one's (two legs landing at the same height) is 0
-// there up to the corrector's tolerance.
-constexpr double kGuardStartTolerance = 1e-8;
 
 // The phase with the quadrature state q' = g(x) appended: x_aug = [x; q]. Its first integrals, event and
 // reset are the phase's, blind to q, so that the unfolded field is [f + ξ∇H; g] and the flow's
@@ -424,14 +420,16 @@ EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector
       bool on = armed_at_start(s);
       for (int j = 0; j < ns; ++j) {
         // A bump above 0 between samples j-1 and j (a foot that barely clears the ground) arms it too.
-        if (!on && j > 0 && h[j - 1] <= 0.0 && h[j] <= 0.0 && dh[j - 1] > 0.0 && dh[j] < 0.0) {
+        const bool below_before = j == 1 ? h[0] <= kGuardStartTolerance : h[j - 1] <= 0.0;
+        if (!on && j > 0 && below_before && h[j] <= 0.0 && dh[j - 1] > 0.0 && dh[j] < 0.0) {
           double t_top = 0.0;
           const double top = refine(j - 1, &t_top);
           on = std::isfinite(top) && top > 0.0;
         }
         armed[j] = on = on || (j > 0 && h[j] > 0.0);
       }
-      for (int j = 1; j < ns; ++j) {
+      // A zero-duration segment has its start alone.
+      for (int j = ns > 1 ? 1 : 0; j < ns; ++j) {
         if (!armed[j] && -h[j] < unarmed) unarmed = -h[j], unarmed_segment = s, unarmed_t = samples[j].t;
       }
     }
@@ -450,6 +448,7 @@ EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector
   }
   // A guard never reached from above: -max g over its phases (>= 0; 0 where it comes up to 0 from below).
   if (o.guard && best_segment < 0 && end_segment < 0) {
+    HYBRIDCONT_DEMAND(sign == 1.0);  // a guard is a minimum (hybrid_automaton.cc)
     HYBRIDCONT_DEMAND(unarmed_segment >= 0);
     last_interior_ = false;
     last_segment_ = unarmed_segment;
