@@ -96,3 +96,14 @@ def check_periods_at_three_energies(out, summary, word, transitions, modes, anch
         assert taken == transitions
         assert abs(t - period) < 1e-8 * max(1.0, period), (p["H"], t, period)
         assert np.max(np.abs(x_end - np.array(x1))) < 1e-8, (p["H"], x_end, x1)
+
+
+def model_run_fixture(binary, model_file):
+    """A module-scoped pytest fixture `results`: (results folder, summary) of one run of `model_file`."""
+    import pytest
+
+    @pytest.fixture(scope="module")
+    def results(tmp_path_factory):
+        out = tmp_path_factory.mktemp("run")
+        return out, run_model(binary, model_file, out)
+    return results

@@ -17,7 +17,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from automaton_reference import check_periods_at_three_energies, run_model
+from automaton_reference import check_periods_at_three_energies, model_run_fixture
 
 BIN = os.environ.get("HYBRIDCONT_BIN", "build/hybridcont")
 MODELS = os.environ.get("HYBRIDCONT_MODELS", "models")
@@ -61,10 +61,7 @@ MODES = {
 ANCHOR = ("anchor", lambda s: -s[0], None, None)  # mid-stance: x crosses 0 upward
 
 
-@pytest.fixture(scope="module")
-def results(tmp_path_factory):
-    out = tmp_path_factory.mktemp("run")
-    return out, run_model(BIN, os.path.join(MODELS, "bipedal-slip.toml"), out)
+results = model_run_fixture(BIN, os.path.join(MODELS, "bipedal-slip.toml"))
 
 
 @pytest.mark.parametrize("word,transitions", [

@@ -13,7 +13,7 @@ import os
 
 import pytest
 
-from automaton_reference import check_periods_at_three_energies, run_model
+from automaton_reference import check_periods_at_three_energies, model_run_fixture
 
 BIN = os.environ.get("HYBRIDCONT_BIN", "build/hybridcont")
 MODELS = os.environ.get("HYBRIDCONT_MODELS", "models")
@@ -72,10 +72,7 @@ MODES = {
 ANCHOR = ("anchor", lambda s: -s[0], None, None)  # mid-stance
 
 
-@pytest.fixture(scope="module")
-def results(tmp_path_factory):
-    out = tmp_path_factory.mktemp("run")
-    return out, run_model(BIN, os.path.join(MODELS, "bipedal-slip-swing.toml"), out)
+results = model_run_fixture(BIN, os.path.join(MODELS, "bipedal-slip-swing.toml"))
 
 
 @pytest.mark.parametrize("word,transitions", [
