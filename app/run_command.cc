@@ -24,6 +24,7 @@
 #include "hybridcont/conservation_check.h"
 #include "hybridcont/exploration.h"
 #include "hybridcont/period_doubling.h"
+#include "hybridcont/setup_evaluation.h"
 #include "hybridcont/timebased_shooting.h"
 #include "model_exploration.h"
 #include "model_options.h"
@@ -401,6 +402,15 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   const nlohmann::json options_json = OptionsJson(args, setup);
   const std::unique_ptr<ModelExploration> exploration = MakeExploration(args, model, setup, formulation);
   CheckConservationAtStart(model, args.model, exploration->shooting().layout(), setup.scenario.start);
+  // An automaton's starts in other words take transitions the file's word may not: their words are checked
+  // too, at their typical states and their starts.
+  for (const StartSpec& start : model.setup().word_starts) {
+    HybridModel word_model = model.automaton()->ModelForWord(start.word);
+    for (int p = 0; p < static_cast<int>(model.parameters().size()); ++p) {
+      word_model.SetParameterValue(p, model.parameter_value(p));
+    }
+    CheckConservationAtStart(word_model, args.model, ShootingLayout(word_model), StartPoint(word_model, start));
+  }
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / model.name() : fs::path(args.out_dir);
   ResultsWriter::PrepareDirectory(dir, model.name(), args.overwrite);
 

@@ -34,6 +34,26 @@ nlohmann::json RunModel(const std::string& file, const fs::path& dir) {
   return nlohmann::json::parse(in);
 }
 
+// A start in another word is checked for energy conservation like the file's word: the bipedal model's
+// landing (a transition of the running word only) placing the foot 0.01 off the leg's rest length is refused
+// before anything is written.
+TEST(WordChange, StartInAnotherWordHasItsResetsCheckedForConservation) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_word_conservation";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ifstream in(std::string(HYBRIDCONT_SOURCE_DIR) + "/models/bipedal-slip.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string landing = "reset.x = \"-l0*sin(beta)\"";
+  ASSERT_NE(text.find(landing), std::string::npos);
+  text.replace(text.find(landing), landing.size(), "reset.x = \"-l0*sin(beta) + 0.01\"");
+  std::ofstream(dir / "biped.toml") << text;
+  const CliResult r = RunTool({"run", (dir / "biped.toml").string(), "--out", (dir / "out").string(), "--quiet",
+                               "--no-plots"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("reset 'flight' -> 'stance'"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
 // Floor only (g = h = 1): period 2 sqrt(2H); floor and ceiling: twice the time from the floor up to h.
 TEST(WordChange, BallBetweenFloorAndCeilingChangesItsWordAtGh) {
   const fs::path dir = fs::temp_directory_path() / "hybridcont_word_ball";
