@@ -38,14 +38,27 @@ int OnTracedBranch(const ContinuationPoint& p, std::span<const Branch* const> br
   return -1;
 }
 
+namespace {
+
+// |a.u − b.u| <= a's and b's interval widths + tolerance·(1 + ||b.u||), componentwise.
+bool WithinPrecisions(const SpecialPoint& a, const SpecialPoint& b, double tolerance) {
+  Vector allowed = Vector::Constant(a.u.size(), tolerance * (1 + b.u.norm()));
+  for (const SpecialPoint* p : {&a, &b}) {
+    if (p->interval_width.size() == allowed.size()) allowed += p->interval_width.cwiseAbs();
+  }
+  return ((a.u - b.u).cwiseAbs().array() <= allowed.array()).all();
+}
+
+}  // namespace
+
 std::string KnownBranchMessage(int other) { return "runs along branch " + std::to_string(other) + " (already traced)"; }
 
 bool BranchRegistry::Register(SpecialPoint* point, int depth) {
   for (const SpecialPoint& known : points_) {
     const bool comparable = point->type == known.type || (point->type == SpecialPointType::kSimpleBifurcation &&
                                                           known.type == SpecialPointType::kSingularStart);
-    if (comparable && point->component == known.component &&
-        (point->u - known.u).lpNorm<Eigen::Infinity>() <= same_point_tolerance_ * (1 + known.u.norm())) {
+    if (comparable && point->component == known.component && point->u.size() == known.u.size() &&
+        WithinPrecisions(*point, known, same_point_tolerance_)) {
       point->duplicate_of = known.id;
       point->id = known.id;
       AddPassingRays(known.id, *point);

@@ -35,7 +35,11 @@ class BranchRegistry {
       : same_point_tolerance_(options.same_point_tolerance), same_direction_cosine_(options.same_direction_cosine) {}
 
   // Gives a special point found on a branch its diagram id (a known point: duplicate_of) and records the
-  // rays of the branch through it. True for a new point.
+  // rays of the branch through it. True for a new point. A known point of the same kind is the same point
+  // when every component differs by at most the two points' precisions (SpecialPoint::interval_width)
+  // plus same_point_tolerance·(1 + ||u||): two crossing branches locate their common SB point each to
+  // its own precision, and next to a singular place that is the noise level (~1e-6 on the SLIP), not
+  // the tolerance.
   bool Register(SpecialPoint* point, int depth);
   // Stores `point` as a new unique point found at `depth`; returns its id.
   int AddUnique(SpecialPoint point, int depth);

@@ -2,6 +2,7 @@
 #include "continuation/jacobian_tolerance_scope.h"
 
 #include <Eigen/QR>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <array>
 #include <cstdio>
@@ -232,6 +233,18 @@ bool Segment::RefinedProbe(ZeroProblem* refined, const Probe& probe, Probe* fine
   return correction->allFinite();
 }
 
+bool Segment::SmallestSingularValue(const Probe& probe, double* sigma_min) {
+  const JacobianToleranceScope exact(problem_, 0.0, JacobianToleranceScope::Mode::kExactly);
+  if (!problem_->Evaluate(probe.u, nullptr, &dr_).ok) return false;
+  const Eigen::Index n = dr_.cols();
+  Matrix bordered(n, n);
+  bordered.topRows(n - 1) = dr_;
+  bordered.row(n - 1) = a_.tangent.transpose();
+  if (!bordered.allFinite()) return false;
+  *sigma_min = Eigen::BDCSVD<Matrix>(bordered).singularValues()(n - 1);
+  return true;
+}
+
 namespace {
 
 // The bracket of LocateRoot: its ends in σ, their probes and test values, and the Illinois state.
@@ -320,16 +333,41 @@ Trial CorrectTrial(Segment* segment, const Bracket& bracket, double x0, double m
   return trial;
 }
 
+// A trial point that could not be corrected, in a bracket at whose ends the points the corrector accepts
+// may lie farther from the curve than kResolvedFraction of its width (residual_tolerance / σ_min,
+// Segment::SmallestSingularValue): the curve is not resolved on the bracket's scale, and the failure says
+// so, whatever Newton did (it diverges, or jumps along the nearly singular direction from an interpolant
+// built on scattered ends).
+bool IllConditioned(Segment* segment, const Bracket& bracket, double residual_tolerance, RootLocation* out) {
+  double scatter = 0;
+  for (const Segment::Probe* end : {&bracket.lo_probe, &bracket.hi_probe}) {
+    double sigma_min = 0;
+    if (!segment->SmallestSingularValue(*end, &sigma_min)) return false;
+    scatter = std::max(scatter, residual_tolerance / sigma_min);
+  }
+  if (!(scatter >= Segment::kResolvedFraction * (bracket.hi - bracket.lo))) return false;
+  out->conditioning_scatter = scatter;
+  return true;
+}
+
 // Located to the noise level. The bracket ends are themselves points accepted inside the noise: near the
 // SB they scatter across both branches, and an end on the crossing branch carries a test value of the
 // wrong sign. The SB is then only known to lie within a few bracket widths (or the scatter) of the
 // bracket: kNoiseMargin (docs/design/continuation.md, "Location to the noise level").
 RootLocation NoiseLimited(const Bracket& bracket, const Trial& trial, double sigma_b, RootLocation* out) {
   out->noise_limited = true;
-  out->message = "located to the noise level: a trial point inside the bracket has |r| = " +
-                 FormatShort(trial.probe.residual) + " before any correction, and Newton's correction of that " +
-                 "noise is not small against the bracket (the precision is the bracket widened by " +
-                 "four times its width, or that correction if larger, on both sides: an estimate, not a bound)";
+  if (out->conditioning_scatter > 0) {
+    out->message = "located to the noise level: at the bracket (width " + FormatShort(bracket.hi - bracket.lo) +
+                   ") the bordered Jacobian is so nearly singular that points accepted at the residual " +
+                   "tolerance may lie " + FormatShort(out->conditioning_scatter) + " off the curve, and a trial " +
+                   "point inside it could not be corrected (the precision is the bracket widened by four times " +
+                   "its width on both sides: an estimate, not a bound)";
+  } else {
+    out->message = "located to the noise level: a trial point inside the bracket has |r| = " +
+                   FormatShort(trial.probe.residual) + " before any correction, and Newton's correction of that " +
+                   "noise is not small against the bracket (the precision is the bracket widened by " +
+                   "four times its width, or that correction if larger, on both sides: an estimate, not a bound)";
+  }
   RootLocation located = bracket.Finish(out, true);
   const double margin = std::max(trial.scatter, kNoiseMargin * (bracket.hi - bracket.lo));
   const double lowest = std::min(0.0, sigma_b), highest = std::max(0.0, sigma_b);
@@ -385,6 +423,8 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
     out.iterations = it;
     if (!trial.corrected) {
       if (trial.noise_limited) return NoiseLimited(bracket, trial, segment->sigma_b(), &out);
+      if (IllConditioned(segment, bracket, segment->residual_tolerance(), &out)) return NoiseLimited(bracket, trial, segment->sigma_b(), &out);
+      out.uncorrectable = true;
       out.message = message;
       return bracket.Finish(&out, false);
     }

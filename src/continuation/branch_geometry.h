@@ -92,6 +92,7 @@ class Segment {
   // Angle (radians) by which the integrator noise may turn a correct induced tangent.
   static constexpr double kTangentNoise = 1e-6;
   double sigma_b() const { return sigma_b_; }
+  double residual_tolerance() const { return corrector_->options().residual_tolerance; }
   const ContinuationPoint& a() const { return a_; }
   const ContinuationPoint& b() const { return b_; }
   // Probes at the two ends, from the stored points (plus one evaluation of dr for the SB test).
@@ -102,6 +103,11 @@ class Segment {
   // segment), *correction the refined Newton correction −[dr; τ_aᵀ]⁻¹[r; 0]: how far the refined curve
   // lies from probe.u on the probe's hyperplane. False if the evaluation or the bordered matrix fails.
   bool RefinedProbe(ZeroProblem* refined, const Probe& probe, Probe* fine, Vector* correction);
+  // The smallest singular value of the bordered matrix [dr; τ_aᵀ] at probe.u: points that the corrector
+  // accepts on the curve (|r| <= residual_tolerance) may lie up to residual_tolerance / σ_min from it.
+  // Small where dr loses rank: at an SB point, or where several singular values vanish at once (the
+  // SLIP's loop where all phase durations vanish). False if dr cannot be evaluated.
+  bool SmallestSingularValue(const Probe& probe, double* sigma_min);
 
  private:
   Corrector* corrector_;
@@ -145,6 +151,12 @@ struct RootLocation {
   // tolerance already, yet Newton's correction of it left the bracket (Segment::Evaluate). The bracket,
   // between corrected points with test values of opposite sign, is then the honest precision.
   bool noise_limited = false;
+  // Noise-limited by the conditioning: the largest residual_tolerance / σ_min at the bracket ends
+  // (Segment::SmallestSingularValue); 0 otherwise.
+  double conditioning_scatter = 0;
+  // Not located because a trial point could not be corrected (not for the noise level): the bracket
+  // may not hold one smooth curve.
+  bool uncorrectable = false;
   std::string message;        // why only bracketed
 };
 

@@ -54,15 +54,16 @@ void SpecialPointDetector::Sample(ContinuationPoint* point) {
   HYBRIDCONT_DEMAND(point->test_values.size() == static_cast<Eigen::Index>(function_types_.size()));
 }
 
-void SpecialPointDetector::Detect(size_t index, bool from_singular, Branch* branch) {
+bool SpecialPointDetector::Detect(size_t index, bool from_singular, Branch* branch) {
   HYBRIDCONT_DEMAND(index + 1 < branch->points.size());
   const ContinuationPoint& a = branch->points[index];
   const ContinuationPoint& b = branch->points[index + 1];
   std::vector<SpecialPoint> found;
   std::vector<SpecialPoint> bracket_only;  // each found point as its root finder left it
+  one_curve_ = true;
   if (from_singular) {
     DetectTestFunctions(index, true, branch);
-    return;
+    return true;
   }
   if (detect_bifurcations_ && a.sb_test != 0 && b.sb_test != 0 && std::signbit(a.sb_test) != std::signbit(b.sb_test)) {
     found.push_back(Locate(SpecialPointType::kSimpleBifurcation, -1,
@@ -77,6 +78,7 @@ void SpecialPointDetector::Detect(size_t index, bool from_singular, Branch* bran
   PlaceTurningPointsAtSbPoints(b.arclength - a.arclength, bracket_only, &found);
   Insert(std::move(found), branch);
   DetectTestFunctions(index, false, branch);
+  return one_curve_;
 }
 
 void SpecialPointDetector::Insert(std::vector<SpecialPoint> found, Branch* branch) {
@@ -112,6 +114,8 @@ SpecialPoint SpecialPointDetector::LocateOn(const Curve& curve, const Continuati
   SpecialPoint point;
   point.type = type;
   point.status = root.located ? LocationStatus::kLocated : LocationStatus::kBracketed;
+  const bool continuation_point = type == SpecialPointType::kSimpleBifurcation || type == SpecialPointType::kTurningPoint;
+  if (continuation_point && !root.located && root.uncorrectable) one_curve_ = false;
   point.branch_id = branch->id;
   point.index = static_cast<int>(index);
   point.arclength = a.arclength + root.sigma;
@@ -135,9 +139,16 @@ SpecialPoint SpecialPointDetector::LocateOn(const Curve& curve, const Continuati
   point.iterations = root.iterations;
   point.message = root.message;
   // An interval wider than the bracket (noise-limited locations widen it, AddIntegrationError may):
-  // the components vary over all of it.
-  const auto cover = [](SpecialPoint* p) {
-    p->interval_width = p->interval_width.cwiseMax(p->tangent.cwiseAbs() * p->precision());
+  // the components vary over all of it, by |τ|·P to first order and ½|dτ/ds|·P² more to second over
+  // a length P (dτ/ds from the step's end tangents): the second-order term is the whole variation of
+  // the turning component at a turning point.
+  const double step_length = std::abs(b.arclength - a.arclength);
+  const Vector bending = step_length > 0 ? Vector((b.tangent - a.tangent).cwiseAbs() / step_length)
+                                         : Vector::Zero(a.u.size());
+  const auto cover = [&bending](SpecialPoint* p) {
+    const double length = p->precision();
+    p->interval_width =
+        p->interval_width.cwiseMax(p->tangent.cwiseAbs() * length + 0.5 * bending * length * length);
   };
   cover(&point);
   bracket_only->push_back(point);

@@ -9,7 +9,7 @@
 //
 //   SpecialPointDetector detector(&problem, &corrector, &solver, options);
 //   detector.Sample(&point);                               // test functions at each branch point
-//   detector.Detect(branch.points.size() - 2, &branch);   // inserts into branch.special_points
+//   detector.Detect(branch.points.size() - 2, false, &branch);  // inserts into branch.special_points
 #ifndef HYBRIDCONT_SRC_CONTINUATION_SPECIAL_POINT_DETECTOR_H_
 #define HYBRIDCONT_SRC_CONTINUATION_SPECIAL_POINT_DETECTOR_H_
 
@@ -44,7 +44,11 @@ class SpecialPointDetector {
   // into branch->special_points in arclength order (ids renumbered: the position). from_singular: the
   // step starts at a bifurcation point, whose SB and turning tests vanish there (not searched), and
   // whose test functions' zeros belong to the parent branch (test_function.h).
-  void Detect(size_t index, bool from_singular, Branch* branch);
+  // Returns false when the step does not hold one smooth curve: an SB or turning point's test changes
+  // sign across it, but a trial point between its ends cannot be corrected onto any curve, nor is the
+  // failure the noise level of a singular place (a step from one branch onto another that passes close
+  // by: the stepper rejects it and retries shorter).
+  bool Detect(size_t index, bool from_singular, Branch* branch);
   // The test functions' zeros of branch->points from `from` on found again: their values sampled anew
   // and every step from `from` searched. For branches mapped by a symmetry (exploration.h), under which
   // a test function need not be invariant (time reversal turns a physical orbit into a non-physical one).
@@ -148,6 +152,7 @@ class SpecialPointDetector {
   std::vector<int> turning_;  // indices of the turning-point components
   bool detect_bifurcations_;
   bool check_integration_error_;
+  bool one_curve_ = true;  // Detect's result: no located SB or turning point failed on an uncorrectable trial
   double location_tolerance_;
   int max_location_iterations_;
   std::unique_ptr<TestFunctions> functions_;  // the options' test functions (own copy), or nullptr

@@ -107,41 +107,54 @@ class ContinuationStepper::Impl {
   // points of the new interval, the user's stop and max_points.
   StepStatus Step() {
     if (finished()) return StepStatus::kFinished;
-    const ContinuationPoint& a = branch_.points.back();
-    ContinuationPoint b;
-    double next_h = 0;
-    if (const std::optional<StepStatus> given_up = Advance(a, &b, &next_h)) return *given_up;
-    b.arclength = a.arclength + (b.u - a.u).norm();
+    for (int retry = 0;; ++retry) {
+      const ContinuationPoint& a = branch_.points.back();
+      ContinuationPoint b;
+      double next_h = 0;
+      if (const std::optional<StepStatus> given_up = Advance(a, &b, &next_h)) return *given_up;
+      b.arclength = a.arclength + (b.u - a.u).norm();
 
-    TerminationReason reason = TerminationReason::kNotFinished;
-    std::string message;
-    if (!stops_.stops().empty() && !stops_.Apply(a, &b, &branch_.newton_iterations, &reason, &message)) {
-      return Finish(reason, message);
-    }
-    if (reason == TerminationReason::kNotFinished && options_.detect_closed_loop && ClosesLoop(a, b)) {
-      CloseLoop(a, &b);
-      reason = TerminationReason::kClosedLoop;
-      message = "the branch returned to its start point";
-    }
-    if (reason != TerminationReason::kClosedLoop) detector_.Sample(&b);  // a closed loop's b is its start
-    branch_.points.push_back(std::move(b));  // a is invalid from here on
-    const size_t count = branch_.points.size();
-    // The first interval of a branch from a singular point starts at the bifurcation point itself.
-    const bool from_singular = start_singular_ && (count == 2 || reason == TerminationReason::kClosedLoop);
-    detector_.Detect(count - 2, from_singular, &branch_);
-    controller_.set_h(next_h);
-    if (reason == TerminationReason::kNotFinished) {
-      if (options_.stop_predicate && options_.stop_predicate(branch_.points.back().u)) {
-        reason = TerminationReason::kUserStop;
-        message = "stop_predicate returned true";
-      } else if (static_cast<int>(count) >= options_.max_points) {
-        reason = TerminationReason::kMaxPoints;
-        message = "max_points = " + std::to_string(options_.max_points) + " reached";
+      TerminationReason reason = TerminationReason::kNotFinished;
+      std::string message;
+      if (!stops_.stops().empty() && !stops_.Apply(a, &b, &branch_.newton_iterations, &reason, &message)) {
+        return Finish(reason, message);
       }
+      if (reason == TerminationReason::kNotFinished && options_.detect_closed_loop && ClosesLoop(a, b)) {
+        CloseLoop(a, &b);
+        reason = TerminationReason::kClosedLoop;
+        message = "the branch returned to its start point";
+      }
+      if (reason != TerminationReason::kClosedLoop) detector_.Sample(&b);  // a closed loop's b is its start
+      const bool may_retry = reason == TerminationReason::kNotFinished && retry < kOneCurveRetries &&
+                             !controller_.at_min_step();
+      std::vector<SpecialPoint> before;
+      if (may_retry) before = branch_.special_points;
+      branch_.points.push_back(std::move(b));  // a is invalid from here on
+      const size_t count = branch_.points.size();
+      // The first interval of a branch from a singular point starts at the bifurcation point itself.
+      const bool from_singular = start_singular_ && (count == 2 || reason == TerminationReason::kClosedLoop);
+      if (!detector_.Detect(count - 2, from_singular, &branch_) && may_retry) {
+        // The step left its branch for another one passing close by (special_point_detector.h): the
+        // point and what was found on the step are dropped, and the step is taken again at half length.
+        branch_.points.pop_back();
+        branch_.special_points = std::move(before);
+        Reject(0.5);
+        continue;
+      }
+      controller_.set_h(next_h);
+      if (reason == TerminationReason::kNotFinished) {
+        if (options_.stop_predicate && options_.stop_predicate(branch_.points.back().u)) {
+          reason = TerminationReason::kUserStop;
+          message = "stop_predicate returned true";
+        } else if (static_cast<int>(count) >= options_.max_points) {
+          reason = TerminationReason::kMaxPoints;
+          message = "max_points = " + std::to_string(options_.max_points) + " reached";
+        }
+      }
+      Report();
+      if (reason != TerminationReason::kNotFinished) return Finish(reason, message);
+      return StepStatus::kContinuing;
     }
-    Report();
-    if (reason != TerminationReason::kNotFinished) return Finish(reason, message);
-    return StepStatus::kContinuing;
   }
 
   void Terminate(TerminationReason reason, const std::string& message) { Finish(reason, message); }
@@ -182,6 +195,9 @@ class ContinuationStepper::Impl {
   // proposed after it. Returns kFinished when the branch ends instead (step too small, or a start along
   // a curve of singular points).
   static constexpr std::size_t kJumpHistory = 8;  // accepted steps that size a jump across a singular point
+  // Times a step whose special points show that it left its branch is halved and taken again (Step);
+  // after that it is kept, with its special point bracketed only.
+  static constexpr int kOneCurveRetries = 3;
 
   std::optional<StepStatus> Advance(const ContinuationPoint& a, ContinuationPoint* b, double* next_h) {
     const ContinuationPoint* previous = branch_.points.size() >= 2 ? &branch_.points[branch_.points.size() - 2] : nullptr;
