@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 
+#include "bifurcation/branch_registry.h"
 #include "continuation/bordered_solver.h"
 #include "continuation/branch_geometry.h"
 #include "continuation_test_problems.h"
@@ -211,6 +212,34 @@ TEST(SpecialPointPrecision, SlipSpecialPointsMoveWithinTheirPrecisionWhenTheTole
   EXPECT_GE(at_sb, 2);  // the loop's reflection midpoint and where branch 18 passes the zero-duration family
   // Most points: the integration error (1e-11..5e-10) exceeds the 2.5e-12 bracket.
   EXPECT_GE(widened, compared / 2);
+}
+
+// Two crossing branches locate their common SB point each to its own precision: the two locations are one
+// point when every component differs by at most their interval widths plus same_point_tolerance·(1 + ||u||)
+// (here 1e-6 · (1 + √5) = 3.24e-6), and two points are distinct when they differ by more.
+TEST(SpecialPointPrecision, OneSbPointLocatedFromTwoBranchesIsOnePointWithinTheirPrecisions) {
+  const auto sb = [](double x, double width) {
+    SpecialPoint p;
+    p.type = SpecialPointType::kSimpleBifurcation;
+    p.status = LocationStatus::kLocated;
+    p.u = Eigen::Vector2d(x, 2);
+    p.interval_width = Eigen::Vector2d::Constant(width);
+    return p;
+  };
+  const ExplorationOptions options;
+  ASSERT_EQ(options.same_point_tolerance, 1e-6);
+  internal::BranchRegistry registry(options);
+  SpecialPoint first = sb(1, 2e-6), second = sb(1 + 7e-6, 2e-6), third = sb(1 + 7.5e-6, 0);
+  EXPECT_TRUE(registry.Register(&first, 1));
+  EXPECT_FALSE(registry.Register(&second, 2));  // 7e-6 <= 3.24e-6 + 2e-6 + 2e-6
+  EXPECT_EQ(second.duplicate_of, first.id);
+  EXPECT_TRUE(registry.Register(&third, 2));    // 7.5e-6 > 3.24e-6 + 2e-6 + 0
+  // Without widths only the tolerance counts: 5e-6 apart are two points.
+  internal::BranchRegistry exact(options);
+  SpecialPoint a = sb(1, 0), b = sb(1 + 5e-6, 0), c = sb(1 + 3e-6, 0);
+  EXPECT_TRUE(exact.Register(&a, 1));
+  EXPECT_TRUE(exact.Register(&b, 1));
+  EXPECT_FALSE(exact.Register(&c, 1));
 }
 
 }  // namespace
