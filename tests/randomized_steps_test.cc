@@ -1,8 +1,8 @@
 // Nothing missed when the step size changes: the exploration of each built-in model under 20 randomized
 // step-size settings (first step and largest step, each a random factor in [1/4, 2] of the scenario's)
 // finds the special points of the default run again, as many of each type, each where the two runs'
-// stated precisions (SpecialPoint::interval_width, componentwise) allow, and no others. A special point
-// stepped over by a larger step, or found only by a lucky one, fails here.
+// stated precisions (SpecialPoint::interval_width, componentwise) allow, and no others, on as many
+// branches. A special point stepped over by a larger step, or found only by a lucky one, fails here.
 //
 // Points located to the noise level (next to an SB point: docs/design/continuation.md, "Location to the
 // noise level", and turning points at one) are placed along their branch to their interval, but Newton's
@@ -38,6 +38,7 @@ struct StepRun {
   std::vector<Found> found;
   int H = -1;  // index of H̄ in u
   int too_small = 0;  // branches that ended because the step fell below min_step
+  size_t branches = 0;
 };
 
 StepRun SpecialPoints(const HybridModel& model, double initial_factor, double max_factor) {
@@ -52,6 +53,7 @@ StepRun SpecialPoints(const HybridModel& model, double initial_factor, double ma
   EXPECT_EQ(diagram.status, ExplorationStatus::kCompleted) << model.name() << ": " << diagram.message;
   StepRun run;
   run.H = exploration.shooting().UnknownIndex("H");
+  run.branches = diagram.branches.size();
   for (const Branch& branch : diagram.branches) {
     run.too_small += branch.termination == TerminationReason::kStepTooSmall ? 1 : 0;
   }
@@ -97,6 +99,8 @@ TEST_P(RandomizedSteps, FindTheSameSpecialPoints) {
     // No branch may end for a step too small: that loses every point and switch beyond it.
     EXPECT_EQ(run.too_small, 0) << name << ": first step x" << a << ", largest step x" << b;
     lost_branches += run.too_small;
+    // The same families: a step onto a neighbouring branch would trace a traced family again (or miss one).
+    EXPECT_EQ(run.branches, reference_run.branches) << name << ": first step x" << a << ", largest step x" << b;
     std::map<SpecialPointType, int> found_counts;
     for (const Found& f : found) ++found_counts[f.type];
     bool same = found_counts == counts;
@@ -114,6 +118,7 @@ TEST_P(RandomizedSteps, FindTheSameSpecialPoints) {
       same = same && excess <= 0;
       worst = std::max(worst, distance);
     }
+    same = same && run.branches == reference_run.branches;
     failed += same ? 0 : 1;
   }
   std::printf("%s: %zu special points (", name.c_str(), reference.size());
