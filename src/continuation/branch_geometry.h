@@ -103,8 +103,9 @@ class Segment {
   // segment), *correction the refined Newton correction −[dr; τ_aᵀ]⁻¹[r; 0]: how far the refined curve
   // lies from probe.u on the probe's hyperplane. False if the evaluation or the bordered matrix fails.
   bool RefinedProbe(ZeroProblem* refined, const Probe& probe, Probe* fine, Vector* correction);
-  // The smallest singular value of the bordered matrix [dr; τ_aᵀ] at probe.u: points that the corrector
-  // accepts on the curve (|r| <= residual_tolerance) may lie up to residual_tolerance / σ_min from it.
+  // The smallest singular value of the bordered matrix [dr; τ_aᵀ] at probe.u, estimated as 1/||B⁻¹||₁
+  // (within a factor √n): points that the corrector accepts on the curve (|r| <= residual_tolerance) may
+  // lie up to residual_tolerance / σ_min from it.
   // Small where dr loses rank: at an SB point, or where several singular values vanish at once (the
   // SLIP's loop where all phase durations vanish). False if dr cannot be evaluated.
   bool SmallestSingularValue(const Probe& probe, double* sigma_min);
