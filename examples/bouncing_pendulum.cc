@@ -37,6 +37,8 @@ MassMatrix<T> Mass(const StateVector<T>& x, const PendulumParameters& p) {
 }
 
 struct Flight {
+  // The state dimension: derivatives compiled for it only (optional; compiles several times faster).
+  static constexpr int kDimension = 4;  // y, theta, dy, dtheta
   template <class T>
   static StateVector<T> VectorField(const StateVector<T>& x, const PendulumParameters& p) {
     using std::cos, std::sin;
@@ -71,6 +73,7 @@ struct Flight {
 };
 
 struct Apex {
+  static constexpr int kDimension = 4;
   template <class T>
   static T Anchor(const StateVector<T>& x, const PendulumParameters&) {
     return x(2);

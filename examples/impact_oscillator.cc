@@ -26,6 +26,8 @@ struct OscillatorParameters {
 
 // The single phase: functions written once, as templates over the scalar type T.
 struct FreeOscillation {
+  // The state dimension: derivatives compiled for it only (optional; compiles several times faster).
+  static constexpr int kDimension = 2;  // x, v
   template <class T>
   static StateVector<T> VectorField(const StateVector<T>& x, const OscillatorParameters& p) {
     StateVector<T> f(2);
@@ -49,6 +51,7 @@ struct FreeOscillation {
 };
 
 struct LeftTurningPoint {
+  static constexpr int kDimension = 2;
   template <class T>
   static T Anchor(const StateVector<T>& x, const OscillatorParameters&) {
     return -x(1);

@@ -157,5 +157,67 @@ TEST(DerivativeCheck, AutoDiffOscillatorPasses) {
   EXPECT_TRUE(CheckDerivatives(model, DerivativeCheckOptions{}).passed());
 }
 
+// A functor that declares its state dimension (kDimension) has its derivatives compiled for that dimension
+// only: the same numbers as the dispatch over every dimension, and a phase whose state names disagree with
+// the declaration is refused with the phase named.
+struct DeclaredPhase : WrongPhase {
+  static constexpr int kDimension = 2;
+};
+struct DeclaredAnchor : WrongAnchor {
+  static constexpr int kDimension = 2;
+};
+struct MisdeclaredPhase : WrongPhase {
+  static constexpr int kDimension = 3;
+};
+
+TEST(DerivativeCheck, DeclaredDimensionGivesTheSameDerivatives) {
+  const auto build = [](auto phase, auto anchor) {
+    ModelBuilder<WrongParameters> b("oscillator", "harmonic oscillator");
+    b.AddPhase<decltype(phase)>("free", {"q", "p"}, Vector::Constant(2, 0.5));
+    b.SetAnchor<decltype(anchor)>();
+    return b.Build();
+  };
+  const HybridModel dispatched = build(WrongPhase{}, WrongAnchor{});
+  const HybridModel declared = build(DeclaredPhase{}, DeclaredAnchor{});
+  const Vector x = Eigen::Vector2d(0.3, -0.7);
+  Vector f1, f2, H1, H2, y1, y2;
+  Matrix df1, df2, dH1, dH2, D1, D2;
+  std::vector<Matrix> d2H1, d2H2;
+  RowVector de1, de2, da1, da2;
+  dispatched.phase(0).VectorField(x, &f1, &df1);
+  declared.phase(0).VectorField(x, &f2, &df2);
+  dispatched.phase(0).FirstIntegrals(x, &H1, &dH1, &d2H1);
+  declared.phase(0).FirstIntegrals(x, &H2, &dH2, &d2H2);
+  EXPECT_EQ(dispatched.phase(0).Event(x, &de1), declared.phase(0).Event(x, &de2));
+  dispatched.phase(0).Reset(x, &y1, &D1);
+  declared.phase(0).Reset(x, &y2, &D2);
+  EXPECT_EQ(dispatched.anchor().Evaluate(x, &da1), declared.anchor().Evaluate(x, &da2));
+  EXPECT_EQ(f1, f2);
+  EXPECT_EQ(df1, df2);
+  EXPECT_EQ(df2, (Matrix(2, 2) << 0, 1, -1, 0).finished());
+  EXPECT_EQ(H1, H2);
+  EXPECT_EQ(dH1, dH2);
+  ASSERT_EQ(d2H2.size(), 1u);
+  EXPECT_EQ(d2H1[0], d2H2[0]);
+  EXPECT_EQ(d2H2[0], Matrix::Identity(2, 2));
+  EXPECT_EQ(de1, de2);
+  EXPECT_EQ(y1, y2);
+  EXPECT_EQ(D1, D2);
+  EXPECT_EQ(da1, da2);
+  EXPECT_TRUE(CheckDerivatives(declared, DerivativeCheckOptions{}).passed());
+
+  ModelBuilder<WrongParameters> b("oscillator", "harmonic oscillator");
+  b.AddPhase<MisdeclaredPhase>("free", {"q", "p"}, Vector::Constant(2, 0.5));
+  b.SetAnchor<WrongAnchor>();
+  try {
+    b.Build();
+    ADD_FAILURE() << "a phase of 2 states whose functions declare kDimension = 3 was built";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("phase 'free': its functions declare kDimension = 3, but 2 state names"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace hybridcont

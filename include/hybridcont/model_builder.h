@@ -28,6 +28,11 @@
 // A phase functor may define `FirstIntegrals` (returning a StateVector<T> of k values) instead of
 // `FirstIntegral` when the system has k > 1 hybrid first integrals (the paper's remark on N_H > 1).
 //
+// A functor (phase or anchor) may declare its state dimension, `static constexpr int kDimension = 2;`:
+// its derivatives are then compiled for that dimension only, not for every dimension up to the jets'
+// capacity (several times faster to compile; the numbers are the same). AddPhase throws
+// std::invalid_argument when the state names do not match it.
+//
 // Parameters that can be free unknowns (continuation in a model parameter, shooting_layout.h): write the
 // parameter struct as a template over its scalar, the functions over any parameter type Q, and register
 // each parameter by an accessor; the builder then differentiates in the parameters exactly too:

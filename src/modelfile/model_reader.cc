@@ -257,9 +257,9 @@ std::vector<std::string> Reader::UnknownNames() const { return UnknownNames(Word
 std::vector<std::string> Reader::UnknownNames(const std::vector<int>& word) const {
   std::vector<std::string> names;
   const int m = static_cast<int>(word.size());
-  for (int i = 0; i <= m; ++i) names.push_back("t" + std::to_string(i + 1));
+  for (int i = 0; i <= m; ++i) names.push_back(std::string("t").append(std::to_string(i + 1)));
   for (int i = 0; i <= m; ++i) {
-    for (const std::string& s : spec_.phases[word[i % m]].state_names) names.push_back("x" + std::to_string(i + 1) + "_" + s);
+    for (const std::string& s : spec_.phases[word[i % m]].state_names) names.push_back(std::string("x").append(std::to_string(i + 1)).append("_").append(s));
   }
   if (num_integrals_ == 0) {  // no unfolding, no level: the run's parameter carries the family
     if (!spec_.setup.run.parameter.empty()) names.push_back(spec_.setup.run.parameter);

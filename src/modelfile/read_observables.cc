@@ -23,8 +23,8 @@ std::vector<std::string> Reader::LayoutNames() const {
   const std::vector<int>& word = WordPhases();
   const int m = static_cast<int>(word.size());
   for (int i = m; i >= 0; --i) {
-    names.push_back("t" + std::to_string(i + 1));
-    for (const std::string& s : spec_.phases[word[i % m]].state_names) names.push_back("x" + std::to_string(i + 1) + "_" + s);
+    names.push_back(std::string("t").append(std::to_string(i + 1)));
+    for (const std::string& s : spec_.phases[word[i % m]].state_names) names.push_back(std::string("x").append(std::to_string(i + 1)).append("_").append(s));
   }
   for (int j = 0; j < num_integrals_; ++j) names.push_back(num_integrals_ == 1 ? "xi" : "xi" + std::to_string(j + 1));
   if (num_integrals_ > 0) names.push_back("H");

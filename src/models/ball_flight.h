@@ -16,6 +16,7 @@ struct BallParameters {
 
 // x = [y, dy]
 struct BallFlight {
+  static constexpr int kDimension = 2;  // y, dy
   template <class T, class Q>
   static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
     StateVector<T> f(2);
@@ -39,6 +40,7 @@ struct BallFlight {
 };
 
 struct BallApex {
+  static constexpr int kDimension = 2;
   template <class T, class Q>
   static T Anchor(const StateVector<T>& x, const Q&) {
     return x(1);

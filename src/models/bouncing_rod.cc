@@ -20,6 +20,7 @@ struct RodParameters {
 // Flight until the end on side `kSide` (-1: left, +1: right) hits the ground.
 template <int kSide>
 struct RodFlight {
+  static constexpr int kDimension = 4;  // y, alpha, dy, dalpha
   template <class T, class Q>
   static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
     StateVector<T> f(4);
@@ -48,6 +49,7 @@ struct RodFlight {
 };
 
 struct Apex {
+  static constexpr int kDimension = 4;
   template <class T, class Q>
   static T Anchor(const StateVector<T>& x, const Q&) {
     return x(2);

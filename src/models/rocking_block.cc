@@ -20,6 +20,7 @@ struct BlockParameters {
 };
 
 struct Rocking {
+  static constexpr int kDimension = 2;  // alpha, dalpha
   template <class T, class Q>
   static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
     using std::sin;
@@ -45,6 +46,7 @@ struct Rocking {
 };
 
 struct TurningPoint {
+  static constexpr int kDimension = 2;
   template <class T, class Q>
   static T Anchor(const StateVector<T>& x, const Q&) {
     return x(1);

@@ -18,6 +18,7 @@ struct SlipParameters {
 };
 
 struct Stance {
+  static constexpr int kDimension = 4;  // alpha, l, dalpha, dl
   template <class T, class Q>
   static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
     using std::cos;
@@ -56,6 +57,7 @@ struct Stance {
 };
 
 struct Flight {
+  static constexpr int kDimension = 5;  // y, alpha, dx, dy, dalpha
   template <class T, class Q>
   static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
     StateVector<T> f(5);
@@ -83,6 +85,7 @@ struct Flight {
 };
 
 struct Nadir {
+  static constexpr int kDimension = 4;  // the stance state
   template <class T, class Q>
   static T Anchor(const StateVector<T>& x, const Q&) {
     return -x(3);

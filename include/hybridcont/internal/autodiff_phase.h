@@ -16,6 +16,7 @@
 #include <array>
 #include <functional>
 #include <cmath>
+#include <concepts>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -26,6 +27,7 @@
 #include <unsupported/Eigen/AutoDiff>
 
 #include "hybridcont/internal/hessian_jet.h"
+#include "hybridcont/invariant.h"
 #include "hybridcont/model.h"
 
 namespace hybridcont::internal {
@@ -62,6 +64,27 @@ decltype(auto) DispatchOnDimension(int n, Fn&& fn) {
     case 7: return fn(std::integral_constant<int, 7>{});
     case 8: return fn(std::integral_constant<int, 8>{});
     default: return fn(std::integral_constant<int, Eigen::Dynamic>{});
+  }
+}
+
+// A functor may declare its state dimension, static constexpr int kDimension: its derivatives are then
+// compiled for that dimension only (DispatchOnDimension compiles every one of 1..kMaxFixedJetDim and the
+// bounded-dynamic path, most of a model file's compile time). The same jets as the dispatch would choose.
+template <class F>
+concept DeclaresDimension = requires {
+  { F::kDimension } -> std::convertible_to<int>;
+};
+
+// fn(std::integral_constant<int, N>) for F's declared dimension n (DeclaresDimension), else
+// DispatchOnDimension(n, fn). n must be the declared dimension (checked where the phase is built).
+template <class F, class Fn>
+decltype(auto) DispatchFor(int n, Fn&& fn) {
+  if constexpr (DeclaresDimension<F>) {
+    HYBRIDCONT_DEMAND(n == F::kDimension);
+    constexpr int N = F::kDimension <= kMaxFixedJetDim ? F::kDimension : Eigen::Dynamic;
+    return fn(std::integral_constant<int, N>{});
+  } else {
+    return DispatchOnDimension(n, std::forward<Fn>(fn));
   }
 }
 
@@ -278,7 +301,15 @@ class AutoDiffPhase final : public Phase {
         binding_(block, slot),
         p_(binding_.values),
         slot_(slot),
-        differentiable_(binding_.template differentiable<F>()) {}
+        differentiable_(binding_.template differentiable<F>()) {
+    if constexpr (DeclaresDimension<F>) {
+      if (dim() != F::kDimension) {
+        throw std::invalid_argument("phase '" + this->name() + "': its functions declare kDimension = " +
+                                    std::to_string(F::kDimension) + ", but " + std::to_string(dim()) +
+                                    " state names are given");
+      }
+    }
+  }
 
   std::unique_ptr<Phase> CloneWith(const ParameterBlock& parameters) const override {
     return std::make_unique<AutoDiffPhase>(name(), state_names(), next_dim(), typical_state(), &parameters, slot_);
@@ -339,7 +370,7 @@ class AutoDiffPhase final : public Phase {
       *f = F::template VectorField<double>(StateVector<double>(x), *p_);
       return;
     }
-    DispatchOnDimension(dim(), [&](auto N) {
+    DispatchFor<F>(dim(), [&](auto N) {
       using J = typename JetTypes<decltype(N)::value>::J;
       Unpack(F::template VectorField<J>(SeedJets<J>(x), *p_), dim(), f, df);
     });
@@ -349,14 +380,14 @@ class AutoDiffPhase final : public Phase {
                       std::vector<Matrix>* d2H) const override {
     const int n = dim();
     if (d2H) {
-      DispatchOnDimension(n, [&](auto N) { Hessians<typename JetTypes<decltype(N)::value>::J2>(x, H, dH, d2H); });
+      DispatchFor<F>(n, [&](auto N) { Hessians<typename JetTypes<decltype(N)::value>::J2>(x, H, dH, d2H); });
       return;
     }
     if (!dH) {
       *H = EvaluateFirstIntegrals<F, P, double>(StateVector<double>(x), *p_);
       return;
     }
-    DispatchOnDimension(n, [&](auto N) {
+    DispatchFor<F>(n, [&](auto N) {
       using J = typename JetTypes<decltype(N)::value>::J;
       Unpack(EvaluateFirstIntegrals<F, P, J>(SeedJets<J>(x), *p_), n, H, dH);
     });
@@ -364,7 +395,7 @@ class AutoDiffPhase final : public Phase {
 
   double Event(const Eigen::Ref<const Vector>& x, RowVector* de) const override {
     if (!de) return F::template Event<double>(StateVector<double>(x), *p_);
-    return DispatchOnDimension(dim(), [&](auto N) {
+    return DispatchFor<F>(dim(), [&](auto N) {
       using J = typename JetTypes<decltype(N)::value>::J;
       StateVector<J> e(1);
       e(0) = F::template Event<J>(SeedJets<J>(x), *p_);
@@ -381,7 +412,7 @@ class AutoDiffPhase final : public Phase {
       *x_next = F::template Reset<double>(StateVector<double>(x), *p_);
       return;
     }
-    DispatchOnDimension(dim(), [&](auto N) {
+    DispatchFor<F>(dim(), [&](auto N) {
       using J = typename JetTypes<decltype(N)::value>::J;
       Unpack(F::template Reset<J>(SeedJets<J>(x), *p_), dim(), x_next, D);
     });
@@ -417,7 +448,7 @@ class AutoDiffPhase final : public Phase {
       return;
     }
     const bool need_hessians = A != nullptr && dissipative && include_hessian_term;
-    DispatchOnDimension(dim(), [&](auto N) {
+    DispatchFor<F>(dim(), [&](auto N) {
       Unfolded<decltype(N)::value>(x, xi, f_tilde, A, B, dissipative, need_hessians);
     });
   }
@@ -513,7 +544,7 @@ class AutoDiffAnchor final : public Anchor {
   double Evaluate(const Eigen::Ref<const Vector>& x, RowVector* da) const override {
     if (!da) return A::template Anchor<double>(StateVector<double>(x), *p_);
     const int n = static_cast<int>(x.size());
-    return DispatchOnDimension(n, [&](auto N) {
+    return DispatchFor<A>(n, [&](auto N) {
       using J = typename JetTypes<decltype(N)::value>::J;
       StateVector<J> a(1);
       a(0) = A::template Anchor<J>(SeedJets<J>(x), *p_);
