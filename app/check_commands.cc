@@ -1,12 +1,14 @@
 // `hybridcont list` and `hybridcont check`.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <iomanip>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 
 #include "commands.h"
+#include "hybridcont/automaton_words.h"
 #include "hybridcont/conservation_check.h"
 #include "hybridcont/derivative_check.h"
 #include "hybridcont/models.h"
@@ -80,13 +82,8 @@ std::string ConservationTable(const ConservationReport& report) {
   return os.str();
 }
 
-}  // namespace
-
-int CheckCommand(const CheckArguments& args, std::ostream& out, std::ostream& err) {
-  if (args.points < 1 || args.points > 1000) {
-    throw std::invalid_argument("--points " + std::to_string(args.points) + ": must lie in [1, 1000]");
-  }
-  const HybridModel model = MakeModelWithOverrides(args.model, args.assignments, &err);
+// The derivative and conservation tables of one cyclic model; true when both pass.
+bool CheckModel(const HybridModel& model, const CheckArguments& args, std::ostream& out) {
   DerivativeCheckOptions options;
   options.num_points = args.points;
   options.seed = args.seed;
@@ -94,7 +91,52 @@ int CheckCommand(const CheckArguments& args, std::ostream& out, std::ostream& er
   out << report.Table();
   const ConservationReport conservation = CheckConservation(model, SampleStates(model, args.points, args.seed));
   out << ConservationTable(conservation);
-  return report.passed() && conservation.passed() ? 0 : 1;
+  return report.passed() && conservation.passed();
+}
+
+}  // namespace
+
+int CheckCommand(const CheckArguments& args, std::ostream& out, std::ostream& err) {
+  if (args.points < 1 || args.points > 1000) {
+    throw std::invalid_argument("--points " + std::to_string(args.points) + ": must lie in [1, 1000]");
+  }
+  const HybridModel model = MakeModelWithOverrides(args.model, args.assignments, &err);
+  if (model.automaton() == nullptr) return CheckModel(model, args, out) ? 0 : 1;
+  // An automaton: its file's word, the words of its other starts, and words through every transition that
+  // none of those takes (a run reaches them by changes of the phase sequence).
+  const HybridAutomaton& automaton = *model.automaton();
+  std::vector<Word> words = {model.word()};
+  for (const StartSpec& start : model.setup().word_starts) {
+    if (std::find(words.begin(), words.end(), start.word) == words.end()) words.push_back(start.word);
+  }
+  std::vector<int> untaken;
+  for (Word& word : WordsThroughEveryTransition(automaton, words, &untaken)) words.push_back(std::move(word));
+  bool passed = true;
+  std::vector<int> taken;
+  for (std::size_t w = 0; w < words.size(); ++w) {
+    std::string takes;
+    for (const int k : TransitionsOf(words[w])) {
+      if (std::find(taken.begin(), taken.end(), k) != taken.end()) continue;
+      taken.push_back(k);
+      takes += (takes.empty() ? "" : ", ") + automaton.transitions()[k].name;
+    }
+    out << fmt::format("{}word {} ({}; takes {})\n", w == 0 ? "" : "\n", automaton.WordName(words[w]),
+                       w == 0 ? "the file's word" : "checked for its transitions", takes.empty() ? "none new" : takes);
+    if (w == 0) {
+      passed = CheckModel(model, args, out) && passed;
+    } else {
+      passed = CheckModel(WordModelAt(model, words[w]), args, out) && passed;
+    }
+  }
+  if (!untaken.empty()) {
+    std::string names;
+    for (const int k : untaken) names += (names.empty() ? "" : ", ") + automaton.transitions()[k].name;
+    out << fmt::format("\ntransitions on no cycle through the anchor mode '{}' (no periodic orbit takes them; not "
+                       "checked): {}\n", automaton.modes()[automaton.anchor_mode()].name, names);
+  }
+  out << fmt::format("\n{} words checked, {} of {} transitions taken: {}\n", words.size(), taken.size(),
+                     automaton.transitions().size(), passed ? "all pass" : "FAILURES above");
+  return passed ? 0 : 1;
 }
 
 }  // namespace hybridcont::app

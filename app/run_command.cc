@@ -21,6 +21,7 @@
 
 #include "commands.h"
 #include "figure_script.h"
+#include "hybridcont/automaton_words.h"
 #include "hybridcont/conservation_check.h"
 #include "hybridcont/exploration.h"
 #include "hybridcont/period_doubling.h"
@@ -403,13 +404,33 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   const std::unique_ptr<ModelExploration> exploration = MakeExploration(args, model, setup, formulation);
   CheckConservationAtStart(model, args.model, exploration->shooting().layout(), setup.scenario.start);
   // An automaton's starts in other words take transitions the file's word may not: their words are checked
-  // too, at their typical states and their starts.
-  for (const StartSpec& start : model.setup().word_starts) {
-    HybridModel word_model = model.automaton()->ModelForWord(start.word);
-    for (int p = 0; p < static_cast<int>(model.parameters().size()); ++p) {
-      word_model.SetParameterValue(p, model.parameter_value(p));
+  // too, at their typical states and their starts; and every transition that none of these words takes, which
+  // only a change of the phase sequence would reach, on a word through it at the typical states.
+  if (model.automaton() != nullptr) {
+    std::vector<Word> checked = {model.word()};
+    for (const StartSpec& start : model.setup().word_starts) {
+      const HybridModel word_model = WordModelAt(model, start.word);
+      CheckConservationAtStart(word_model, args.model, ShootingLayout(word_model), StartPoint(word_model, start));
+      checked.push_back(start.word);
     }
-    CheckConservationAtStart(word_model, args.model, ShootingLayout(word_model), StartPoint(word_model, start));
+    const HybridAutomaton& automaton = *model.automaton();
+    for (const Word& word : WordsThroughEveryTransition(automaton, checked)) {
+      const HybridModel word_model = WordModelAt(model, word);
+      try {
+        CheckConservationAtStart(word_model, args.model, ShootingLayout(word_model), Vector());
+      } catch (const std::invalid_argument& e) {
+        // Named by the transition that brought the word in: the one no start's word takes.
+        std::string transition;
+        for (const int k : word) {
+          const bool taken = std::any_of(checked.begin(), checked.end(), [k](const Word& w) {
+            return std::find(w.begin(), w.end(), k) != w.end();
+          });
+          if (!taken) transition = automaton.transitions()[k].name;
+        }
+        throw std::invalid_argument("transition '" + transition + "', which a change of the phase sequence may take " +
+                                    "(checked on the word " + automaton.WordName(word) + "): " + e.what());
+      }
+    }
   }
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / model.name() : fs::path(args.out_dir);
   ResultsWriter::PrepareDirectory(dir, model.name(), args.overwrite);

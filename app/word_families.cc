@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "hybridcont/automaton_words.h"
 #include "hybridcont/corrector.h"
 #include "hybridcont/orbit_observables.h"
 #include "hybridcont/setup_evaluation.h"
@@ -238,10 +239,7 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
     }
     WordEntry w;
     w.word = word;
-    w.owned = std::make_unique<HybridModel>(automaton.ModelForWord(word));
-    for (int p = 0; p < static_cast<int>(model.parameters().size()); ++p) {
-      w.owned->SetParameterValue(p, model.parameter_value(p));
-    }
+    w.owned = std::make_unique<HybridModel>(WordModelAt(model, word));
     w.model = w.owned.get();
     try {
       w.exploration = std::make_unique<ModelExploration>(

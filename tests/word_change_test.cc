@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "hybridcont/automaton_words.h"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -52,6 +54,54 @@ TEST(WordChange, StartInAnotherWordHasItsResetsCheckedForConservation) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("reset 'flight' -> 'stance'"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+// A transition that only a change of the phase sequence reaches (the ball's ceiling, above H = g h) has its
+// reset checked before anything runs: a ceiling that takes a tenth of the speed is refused, naming it, and
+// `check` shows the word through it.
+TEST(WordChange, TransitionReachedOnlyByAHandOverIsCheckedForConservation) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_word_handover_conservation";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ifstream in(std::string(HYBRIDCONT_SOURCE_DIR) + "/models/ball-ceiling.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string ceiling = "event = \"h - y\"\nreset.v = \"-v\"";
+  ASSERT_NE(text.find(ceiling), std::string::npos);
+  text.replace(text.find(ceiling), ceiling.size(), "event = \"h - y\"\nreset.v = \"-0.9*v\"");
+  std::ofstream(dir / "ball.toml") << text;
+  const CliResult r = RunTool({"run", (dir / "ball.toml").string(), "--out", (dir / "out").string(), "--quiet",
+                               "--no-plots"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("transition 'ceiling'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("does not conserve its energy"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  const CliResult check = RunTool({"check", (dir / "ball.toml").string()});
+  EXPECT_EQ(check.code, 1);
+  EXPECT_NE(check.out.find("word fly (ceiling) (checked for its transitions; takes ceiling)"), std::string::npos)
+      << check.out;
+  EXPECT_NE(check.out.find("2 words checked, 2 of 2 transitions taken: FAILURES above"), std::string::npos) << check.out;
+  // The model as shipped passes on both words.
+  const CliResult shipped = RunTool({"check", std::string(HYBRIDCONT_SOURCE_DIR) + "/models/ball-ceiling.toml"});
+  EXPECT_EQ(shipped.code, 0) << shipped.out;
+  EXPECT_NE(shipped.out.find("2 words checked, 2 of 2 transitions taken: all pass"), std::string::npos) << shipped.out;
+}
+
+// Words through every transition: a shortest cycle from the anchor mode through each transition that the
+// given words do not take; a transition out of a mode the anchor cannot reach is on no cycle.
+TEST(WordChange, WordsThroughEveryTransitionAreShortestCycles) {
+  // A (anchor) -a-> B -b-> A, B -c-> C -d-> A, C -e-> C (a cut), D -f-> A with D unreachable.
+  std::vector<AutomatonMode> modes = {{"A", {"x"}}, {"B", {"x"}}, {"C", {"x"}}, {"D", {"x"}}};
+  std::vector<AutomatonTransition> transitions = {{"a", 0, 1}, {"b", 1, 0}, {"c", 1, 2}, {"d", 2, 0},
+                                                  {"e", 2, 2, nullptr, true}, {"f", 3, 0}};
+  const auto graph = HybridAutomaton::Graph("g", modes, transitions, 0);
+  std::vector<int> untaken;
+  const std::vector<Word> words = WordsThroughEveryTransition(*graph, {{0, 1}}, &untaken);
+  ASSERT_EQ(words.size(), 2u);
+  EXPECT_EQ(words[0], (Word{0, 2, 3}));     // a, c, d
+  EXPECT_EQ(words[1], (Word{0, 2, 4, 3}));  // a, c, the cut e, d
+  EXPECT_EQ(untaken, (std::vector<int>{5}));
+  for (const Word& w : words) EXPECT_NO_THROW(graph->CheckWord(w));
+  EXPECT_EQ(TransitionsOf(Word{0, 2, 4, 2}), (std::vector<int>{0, 2, 4}));
 }
 
 // Floor only (g = h = 1): period 2 sqrt(2H); floor and ceiling: twice the time from the floor up to h.

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 
+#include "hybridcont/automaton_words.h"
 #include "hybridcont/corrector.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/timebased_shooting.h"
@@ -62,10 +63,7 @@ WordChange Check(const HybridModel& model, const Vector& u, Word word, const std
   c.word = word;
   c.rule = rule;
   const HybridAutomaton& a = *model.automaton();
-  HybridModel next = a.ModelForWord(word);
-  for (int p = 0; p < static_cast<int>(model.parameters().size()); ++p) {
-    next.SetParameterValue(p, model.parameter_value(p));
-  }
+  HybridModel next = WordModelAt(model, word);
   std::vector<Piece> pieces;
   if (!build(next, &pieces, &c.reason)) return c;
   const ShootingLayout old_layout(model);
