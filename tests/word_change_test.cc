@@ -36,19 +36,26 @@ nlohmann::json RunModel(const std::string& file, const fs::path& dir) {
   return nlohmann::json::parse(in);
 }
 
+// Writes models/<name> with its one occurrence of `from` replaced by `to` to `path`, in a fresh folder;
+// false when `from` does not occur.
+bool WriteEditedModel(const std::string& name, const std::string& from, const std::string& to, const fs::path& path) {
+  fs::remove_all(path.parent_path());
+  fs::create_directories(path.parent_path());
+  std::ifstream in(std::string(HYBRIDCONT_SOURCE_DIR) + "/models/" + name);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (text.find(from) == std::string::npos) return false;
+  text.replace(text.find(from), from.size(), to);
+  std::ofstream(path) << text;
+  return true;
+}
+
 // A start in another word is checked for energy conservation like the file's word: the bipedal model's
 // landing (a transition of the running word only) placing the foot 0.01 off the leg's rest length is refused
 // before anything is written.
 TEST(WordChange, StartInAnotherWordHasItsResetsCheckedForConservation) {
   const fs::path dir = fs::temp_directory_path() / "hybridcont_word_conservation";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::ifstream in(std::string(HYBRIDCONT_SOURCE_DIR) + "/models/bipedal-slip.toml");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string landing = "reset.x = \"-l0*sin(beta)\"";
-  ASSERT_NE(text.find(landing), std::string::npos);
-  text.replace(text.find(landing), landing.size(), "reset.x = \"-l0*sin(beta) + 0.01\"");
-  std::ofstream(dir / "biped.toml") << text;
+  ASSERT_TRUE(WriteEditedModel("bipedal-slip.toml", "reset.x = \"-l0*sin(beta)\"",
+                               "reset.x = \"-l0*sin(beta) + 0.01\"", dir / "biped.toml"));
   const CliResult r = RunTool({"run", (dir / "biped.toml").string(), "--out", (dir / "out").string(), "--quiet",
                                "--no-plots"});
   EXPECT_EQ(r.code, 2);
@@ -61,14 +68,8 @@ TEST(WordChange, StartInAnotherWordHasItsResetsCheckedForConservation) {
 // `check` shows the word through it.
 TEST(WordChange, TransitionReachedOnlyByAHandOverIsCheckedForConservation) {
   const fs::path dir = fs::temp_directory_path() / "hybridcont_word_handover_conservation";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::ifstream in(std::string(HYBRIDCONT_SOURCE_DIR) + "/models/ball-ceiling.toml");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string ceiling = "event = \"h - y\"\nreset.v = \"-v\"";
-  ASSERT_NE(text.find(ceiling), std::string::npos);
-  text.replace(text.find(ceiling), ceiling.size(), "event = \"h - y\"\nreset.v = \"-0.9*v\"");
-  std::ofstream(dir / "ball.toml") << text;
+  ASSERT_TRUE(WriteEditedModel("ball-ceiling.toml", "event = \"h - y\"\nreset.v = \"-v\"",
+                               "event = \"h - y\"\nreset.v = \"-0.9*v\"", dir / "ball.toml"));
   const CliResult r = RunTool({"run", (dir / "ball.toml").string(), "--out", (dir / "out").string(), "--quiet",
                                "--no-plots"});
   EXPECT_EQ(r.code, 2);
