@@ -66,10 +66,12 @@ ConservationReport CheckConservation(const HybridModel& model, const std::vector
     if (xs.empty()) xs.push_back(phase.typical_state());
     const int k = phase.num_first_integrals();
     for (int j = 0; j < k; ++j) {
-      const std::string h = k == 1 ? "H" : "H" + std::to_string(j + 1);
-      ConservationEntry flow{"phase '" + phase.name() + "': " + h + " kept by the flow (|∇H·f| / |∇H||f|)"};
-      ConservationEntry reset{"reset '" + phase.name() + "' -> '" + next.name() + "': " + h +
-                              " kept (|ΔH| / (|H| + |∇H||x|), on the guard)"};
+      // (std::string(...).append: GCC 12 warns, a false positive, on "literal" + std::string&&)
+      const std::string h = k == 1 ? std::string("H") : std::string("H").append(std::to_string(j + 1));
+      ConservationEntry flow, reset;
+      flow.what = "phase '" + phase.name() + "': " + h + " kept by the flow (|∇H·f| / |∇H||f|)";
+      reset.what = "reset '" + phase.name() + "' -> '" + next.name() + "': " + h +
+                   " kept (|ΔH| / (|H| + |∇H||x|), on the guard)";
       for (const Vector& x0 : xs) {
         Vector f, H;
         Matrix dH;
