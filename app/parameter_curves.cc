@@ -221,7 +221,7 @@ nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& se
         if (!(ta * tb < 0)) continue;
         if (!IsPhysical(model, ua, setup.integrator) && !IsPhysical(model, ub, setup.integrator)) continue;
         const Vector orbit = ua + (ta / (ta - tb)) * (ub - ua);
-        const std::string name = "t" + std::to_string(s + 1);
+        const std::string name = std::string("t").append(std::to_string(s + 1));
         if (OnCurve(traced[name], Eigen::Vector2d(orbit(layout.H_index()), p0), tol)) continue;
         trace({name, false}, orbit, fmt::format("branch {} between points {} and {}", b.id, i, i + 1));
       }

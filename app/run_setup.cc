@@ -61,7 +61,7 @@ void ApplyTargetsAndBounds(const RunArguments& args, const HybridModel& model, C
     }
     if (b.name == "period") {
       std::vector<std::string> durations;
-      for (int i = 0; i <= model.num_phases(); ++i) durations.push_back("t" + std::to_string(i + 1));
+      for (int i = 0; i <= model.num_phases(); ++i) durations.push_back(std::string("t").append(std::to_string(i + 1)));
       c->sum_bounds.assign(1, SumBound{durations, b.lower, b.upper});
     } else {
       std::erase_if(c->bounds, [&](const ComponentBound& x) { return x.component == b.name; });

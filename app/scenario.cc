@@ -16,7 +16,7 @@ Scenario DefaultScenario(const HybridModel& model) {
     const double upper = EvaluateSetupValue(model, b.upper, field + "[1]");
     if (b.component == "period") {
       std::vector<std::string> durations;
-      for (int i = 0; i <= model.num_phases(); ++i) durations.push_back("t" + std::to_string(i + 1));
+      for (int i = 0; i <= model.num_phases(); ++i) durations.push_back(std::string("t").append(std::to_string(i + 1)));
       s.sum_bounds.push_back({durations, lower, upper});
     } else {
       s.bounds.push_back({b.component, lower, upper});

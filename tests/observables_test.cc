@@ -21,7 +21,7 @@ namespace {
 HybridModel Slip() {
   ModelFileOptions options;
   options.compile = false;  // the observables do not depend on it; the interpreter needs no compiler
-  return LoadModelFile(std::string(HYBRIDCONT_SOURCE_DIR) + "/models/slip.toml", options);
+  return LoadModelFile(std::string(HYBRIDCONT_SOURCE_DIR).append("/models/slip.toml"), options);
 }
 
 // A point of the layout that is no orbit but has every phase moving: hopping in place at H̄ = 1.5 with the
