@@ -419,15 +419,15 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
       try {
         CheckConservationAtStart(word_model, args.model, ShootingLayout(word_model), Vector());
       } catch (const std::invalid_argument& e) {
-        // Named by the transition that brought the word in: the one no start's word takes.
-        std::string transition;
-        for (const int k : word) {
+        // Named by the transitions that brought the word in: those no start's word takes.
+        std::string transitions;
+        for (const int k : TransitionsOf(word)) {
           const bool taken = std::any_of(checked.begin(), checked.end(), [k](const Word& w) {
             return std::find(w.begin(), w.end(), k) != w.end();
           });
-          if (!taken) transition = automaton.transitions()[k].name;
+          if (!taken) transitions += (transitions.empty() ? "'" : ", '") + automaton.transitions()[k].name + "'";
         }
-        throw std::invalid_argument("transition '" + transition + "', which a change of the phase sequence may take " +
+        throw std::invalid_argument("transition " + transitions + ", which a change of the phase sequence may take " +
                                     "(checked on the word " + automaton.WordName(word) + "): " + e.what());
       }
     }

@@ -342,7 +342,8 @@ Trial CorrectTrial(Segment* segment, const Bracket& bracket, double x0, double m
 // Segment::SmallestSingularValue): the curve is not resolved on the bracket's scale, and the failure says
 // so, whatever Newton did (it diverges, or jumps along the nearly singular direction from an interpolant
 // built on scattered ends).
-bool IllConditioned(Segment* segment, const Bracket& bracket, double residual_tolerance, RootLocation* out) {
+bool IllConditioned(Segment* segment, const Bracket& bracket, RootLocation* out) {
+  const double residual_tolerance = segment->residual_tolerance();
   double scatter = 0;
   for (const Segment::Probe* end : {&bracket.lo_probe, &bracket.hi_probe}) {
     double sigma_min = 0;
@@ -427,7 +428,7 @@ RootLocation LocateRoot(Segment* segment, const std::function<double(const Segme
     out.iterations = it;
     if (!trial.corrected) {
       if (trial.noise_limited) return NoiseLimited(bracket, trial, segment->sigma_b(), &out);
-      if (IllConditioned(segment, bracket, segment->residual_tolerance(), &out)) return NoiseLimited(bracket, trial, segment->sigma_b(), &out);
+      if (IllConditioned(segment, bracket, &out)) return NoiseLimited(bracket, trial, segment->sigma_b(), &out);
       out.uncorrectable = true;
       out.message = message;
       return bracket.Finish(&out, false);
