@@ -307,6 +307,7 @@ struct WalkerParameters {
   T gamma = 0.009;
 };
 struct WalkerStep {
+  static constexpr int kDimension = 4;  // compiled for this dimension only (model_builder.h)
   template <class T, class Q>
   static StateVector<T> VectorField(const StateVector<T>& x, const Q& p) {
     using std::cos, std::sin;
@@ -333,6 +334,7 @@ struct WalkerStep {
   }
 };
 struct WalkerSection {
+  static constexpr int kDimension = 4;
   template <class T, class Q>
   static T Anchor(const StateVector<T>& x, const Q&) {
     return 2.0 * x(2) - x(3);

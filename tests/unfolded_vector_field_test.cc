@@ -20,6 +20,7 @@ struct PendulaParameters {
 };
 struct Pendula {
   static constexpr int kDof = 5;
+  static constexpr int kDimension = 2 * kDof;  // above kMaxFixedJetDim: the bounded-dynamic jets only
   template <class T>
   static StateVector<T> VectorField(const StateVector<T>& x, const PendulaParameters& c) {
     using std::sin;
@@ -50,6 +51,7 @@ struct Pendula {
   }
 };
 struct PendulaAnchor {
+  static constexpr int kDimension = 2 * Pendula::kDof;
   template <class T>
   static T Anchor(const StateVector<T>& x, const PendulaParameters&) {
     return x(Pendula::kDof);

@@ -321,6 +321,7 @@ struct FlyToCeiling : internal::BallFlight {
   }
 };
 struct Section {  // the ball passing y = 1/4 downwards
+  static constexpr int kDimension = 2;
   template <class T, class Q>
   static T Anchor(const StateVector<T>& x, const Q&) {
     return x(0) - 0.25;

@@ -9,10 +9,12 @@
 //   - interpreted: ExpressionProgram::Evaluate<T>, one instruction at a time over the scalar type T;
 //   - compiled: straight-line C++ generated from the same instructions (model_codegen.h), compiled by the
 //     system compiler and loaded; CompiledPrograms holds its entry points. It computes the same operations
-//     in the same order, so both give the same numbers.
+//     in the same order, so both give the same numbers (second derivatives: equal to rounding, the
+//     interpreter runs them over nested jets, see InterpretAsBoundedDynamic).
 #ifndef HYBRIDCONT_EXPRESSION_MODEL_H_
 #define HYBRIDCONT_EXPRESSION_MODEL_H_
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <string>
@@ -113,6 +115,65 @@ struct CompiledPrograms {
 
 namespace internal {
 
+// The interpreter over a fixed-size jet runs over the bounded-dynamic jet of the same order: inputs copied
+// in, outputs copied out, the same derivatives (first order: the same operations, the same bits; second
+// order: nested jets, equal to rounding). One instantiation of the interpreter serves every dimension
+// instead of one per dimension and order, which was most of the library's compile time (bench/README.md,
+// "Build time"); the interpreter is the path without a compiler, where speed is not the point.
+// The interpreter over the bounded-dynamic jets, out of line (expression_model.cc): a flattened caller
+// (AutoDiffPhase's unfolded field) must not inline it once per dimension.
+void InterpretJets(const ExpressionProgram& program, const double* p, const Jet* x, Jet* out);
+void InterpretJets(const ExpressionProgram& program, const double* p, const Jet2* x, Jet2* out);
+
+template <int N>
+void InterpretAsBoundedDynamic(const ExpressionProgram& program, const double* p,
+                               const Eigen::AutoDiffScalar<Eigen::Matrix<double, N, 1>>* x,
+                               Eigen::AutoDiffScalar<Eigen::Matrix<double, N, 1>>* out) {
+  thread_local std::vector<Jet> xd, od;
+  xd.resize(program.num_inputs());
+  od.resize(program.num_outputs());
+  for (int i = 0; i < program.num_inputs(); ++i) xd[i] = Jet(x[i].value(), x[i].derivatives());
+  InterpretJets(program, p, xd.data(), od.data());
+  for (int i = 0; i < program.num_outputs(); ++i) {
+    out[i].value() = od[i].value();
+    if (od[i].derivatives().size() == N) {
+      out[i].derivatives() = od[i].derivatives();
+    } else {  // a constant output: no derivatives
+      out[i].derivatives().setZero();
+    }
+  }
+}
+
+template <int N>
+void InterpretAsBoundedDynamic(const ExpressionProgram& program, const double* p, const HessianJet<N>* x,
+                               HessianJet<N>* out) {
+  thread_local std::vector<Jet2> xd, od;
+  xd.resize(program.num_inputs());
+  od.resize(program.num_outputs());
+  for (int i = 0; i < program.num_inputs(); ++i) {
+    Jet2& v = xd[i];
+    v.value() = Jet(x[i].value, Eigen::Map<const Eigen::Matrix<double, N, 1>>(x[i].gradient.data()));
+    v.derivatives().resize(N);
+    for (int j = 0; j < N; ++j) {
+      DerivativeVector row(N);
+      for (int l = 0; l < N; ++l) row(l) = x[i].hessian[HessianJet<N>::Packed(std::min(j, l), std::max(j, l))];
+      v.derivatives()(j) = Jet(x[i].gradient[j], row);
+    }
+  }
+  InterpretJets(program, p, xd.data(), od.data());
+  for (int i = 0; i < program.num_outputs(); ++i) {
+    const Jet2& v = od[i];
+    HessianJet<N>& o = out[i];
+    o = HessianJet<N>(v.value().value());
+    // Sizes below N are constants of the nested jets (no derivatives).
+    for (int j = 0; j < N && j < v.value().derivatives().size(); ++j) o.gradient[j] = v.value().derivatives()(j);
+    for (int j = 0; j < N && j < v.derivatives().size(); ++j) {
+      const DerivativeVector& row = v.derivatives()(j).derivatives();
+      for (int l = j; l < N && l < row.size(); ++l) o.hessian[HessianJet<N>::Packed(j, l)] = row(l);
+    }
+  }
+}
+
 // What one phase's functions read: its programs, the parameter values, the compiled entry points.
 struct ExpressionPhaseData {
   const ExpressionProgram* programs[5] = {};
@@ -130,7 +191,11 @@ struct ExpressionPhaseData {
         return;
       }
     }
-    programs[k]->Evaluate(x, parameters, out);
+    if constexpr (KindOf<T>() == ScalarKind::kFixedJet || KindOf<T>() == ScalarKind::kHessianJet) {
+      InterpretAsBoundedDynamic(*programs[k], parameters, x, out);
+    } else {
+      programs[k]->Evaluate(x, parameters, out);
+    }
   }
 };
 

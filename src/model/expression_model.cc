@@ -100,6 +100,13 @@ class ExpressionParameterBlock final : public ParameterBlock,
 
 }  // namespace
 
+void internal::InterpretJets(const ExpressionProgram& program, const double* p, const Jet* x, Jet* out) {
+  program.Evaluate(x, p, out);
+}
+void internal::InterpretJets(const ExpressionProgram& program, const double* p, const Jet2* x, Jet2* out) {
+  program.Evaluate(x, p, out);
+}
+
 std::string internal::ExpressionFunctions::ExplainNonFinite(const Vector& x, const ExpressionPhaseData& d) {
   if (d.phase == nullptr || d.phase->coordinates.empty() || !x.allFinite()) return "";
   const ExpressionProgram& program = d.phase->mass_matrix;
