@@ -180,7 +180,7 @@ TEST(SimplestWalker, GaitAndStrideEigenvaluesAgreeWithAnIndependentRootSolve) {
     S.col(j) = (Stride(zp, &t) - Stride(zm, &t)) / 2e-6;
   }
   Stride(z, &T);
-  const Eigen::Vector2cd mu = S.eigenvalues();
+  const Eigen::Vector2cd mu = Eigenvalues(S);
 
   // The tool's: the first start of the run at gamma = 0.009 (simulation, then Newton).
   const HybridModel model = Load("simplest-walker");
@@ -526,7 +526,7 @@ TEST(CompassGait, GaitsMultipliersAndPeriodDoublingAgreeWithAnIndependentRootSol
     EXPECT_NEAR(layout.Period(u), T, 1e-9);
     // Multipliers: the stride map's three are the tool's (its fourth, of the section map in the full
     // state, is 0: the heel strike puts θs = θw).
-    const Eigen::Vector3cd mu = hand.StrideJacobian(z, 1e-6).eigenvalues();
+    const Eigen::Vector3cd mu = Eigenvalues(hand.StrideJacobian(z, 1e-6));
     const FloquetResult f = ComputeFloquet(run.exploration->shooting(), u);
     ASSERT_TRUE(f.ok()) << f.message;
     int matched = 0;
@@ -553,7 +553,7 @@ TEST(CompassGait, GaitsMultipliersAndPeriodDoublingAgreeWithAnIndependentRootSol
   const auto most_negative = [&](double gamma, Eigen::Vector3d* z) {
     hand.gamma = gamma;
     *z = hand.FixedPoint(*z);
-    const Eigen::Vector3cd mu = hand.StrideJacobian(*z, 1e-6).eigenvalues();
+    const Eigen::Vector3cd mu = Eigenvalues(hand.StrideJacobian(*z, 1e-6));
     double v = 1e300;
     for (int i = 0; i < 3; ++i) {
       if (std::abs(mu(i).imag()) < 1e-9) v = std::min(v, mu(i).real());

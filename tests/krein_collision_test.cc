@@ -9,7 +9,7 @@
 // computed here independently (a 4 x 4 eigenproblem) and the collisions located by bisection.
 #include <gtest/gtest.h>
 
-#include <Eigen/Eigenvalues>
+#include <Eigen/Core>
 
 #include <algorithm>
 #include <cmath>
@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
+#include "hybridcont/floquet.h"
 
 namespace hybridcont {
 namespace {
@@ -70,8 +71,8 @@ double LargestMultiplier(double T) {
   for (const int i : {0, 2}) {
     R(i, i) = std::cos(T), R(i, i + 1) = std::sin(T), R(i + 1, i) = -std::sin(T), R(i + 1, i + 1) = std::cos(T);
   }
-  const Eigen::EigenSolver<Eigen::Matrix4d> eig(S * R);
-  return eig.eigenvalues().cwiseAbs().maxCoeff();
+  const Eigen::VectorXcd mu = Eigenvalues(S * R);
+  return mu.cwiseAbs().maxCoeff();
 }
 
 TEST(KreinCollision, LocatedWhereTheIndependentMultipliersLeaveTheUnitCircle) {

@@ -186,6 +186,11 @@ FloquetResult ComputeFloquet(TimeBasedShooting& shooting, const Vector& u, const
 FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const RowVector& dH0,
                                const FloquetOptions& options = {}, const Matrix* inverse = nullptr);
 
+// The eigenvalues of a real square matrix (Eigen's EigenSolver, without eigenvectors), instantiated once in
+// the library: a caller that needs only the spectrum of a small matrix need not compile the solver again.
+// Empty when the iteration fails.
+Eigen::VectorXcd Eigenvalues(const Matrix& a);
+
 }  // namespace hybridcont
 
 #endif  // HYBRIDCONT_FLOQUET_H_

@@ -304,4 +304,10 @@ FloquetResult ComputeFloquet(TimeBasedShooting& shooting, const Vector& u, const
   return res;
 }
 
+Eigen::VectorXcd Eigenvalues(const Matrix& a) {
+  const Eigen::EigenSolver<Matrix> solver(a, /*computeEigenvectors=*/false);
+  if (solver.info() != Eigen::Success) return Eigen::VectorXcd();
+  return solver.eigenvalues();
+}
+
 }  // namespace hybridcont
