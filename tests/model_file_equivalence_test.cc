@@ -115,5 +115,46 @@ TEST(ModelFileEquivalence, LagrangianRodCompiled) { ExpectSameMap("bouncing-rod"
 TEST(ModelFileEquivalence, LagrangianSlipInterpreted) { ExpectSameMap("slip", false, "slip-lagrangian"); }
 TEST(ModelFileEquivalence, LagrangianSlipCompiled) { ExpectSameMap("slip", true, "slip-lagrangian"); }
 
+// Second derivatives: the interpreter runs a phase's fixed-size Hessian jets over nested bounded-dynamic jets
+// (expression_model.h, InterpretAsBoundedDynamic); its ∇²H and the unfolded field's A = df + Σ ξ_j ∇²H_j are
+// the built-in model's (its own HessianJets) to rounding, at random states near each phase's typical one.
+TEST(ModelFileEquivalence, InterpretedSecondDerivativesAreTheBuiltins) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> d(-0.2, 0.2);
+  for (const std::string& name : {std::string("slip"), std::string("bouncing-rod"), std::string("rocking-block")}) {
+    const HybridModel builtin = MakeBuiltinModel(name);
+    ModelFileOptions options;
+    options.compile = false;
+    const HybridModel file = LoadModelFile(ModelPath(name), options);
+    for (int i = 0; i < builtin.num_phases(); ++i) {
+      const Phase& a = builtin.phase(i);
+      const Phase& b = file.phase(i);
+      for (int trial = 0; trial < 5; ++trial) {
+        Vector x = a.typical_state();
+        for (int j = 0; j < x.size(); ++j) x(j) += d(rng);
+        Vector Ha, Hb;
+        Matrix dHa, dHb;
+        std::vector<Matrix> d2Ha, d2Hb;
+        a.FirstIntegrals(x, &Ha, &dHa, &d2Ha);
+        b.FirstIntegrals(x, &Hb, &dHb, &d2Hb);
+        ASSERT_EQ(d2Ha.size(), d2Hb.size()) << name;
+        EXPECT_LE((dHa - dHb).lpNorm<Eigen::Infinity>(), 1e-13 * (1 + dHa.lpNorm<Eigen::Infinity>())) << name;
+        for (std::size_t k = 0; k < d2Ha.size(); ++k) {
+          EXPECT_LE((d2Ha[k] - d2Hb[k]).lpNorm<Eigen::Infinity>(), 1e-13 * (1 + d2Ha[k].lpNorm<Eigen::Infinity>()))
+              << name << " phase " << i << "\n" << d2Ha[k] << "\n" << d2Hb[k];
+        }
+        const Vector xi = Vector::Constant(static_cast<int>(Ha.size()), 0.3);
+        Vector fa, fb;
+        Matrix Aa, Ab, Ba, Bb;
+        a.UnfoldedVectorField(x, xi, &fa, &Aa, &Ba, /*include_hessian_term=*/true);
+        b.UnfoldedVectorField(x, xi, &fb, &Ab, &Bb, /*include_hessian_term=*/true);
+        EXPECT_LE((fa - fb).lpNorm<Eigen::Infinity>(), 1e-13 * (1 + fa.lpNorm<Eigen::Infinity>())) << name;
+        EXPECT_LE((Aa - Ab).lpNorm<Eigen::Infinity>(), 1e-13 * (1 + Aa.lpNorm<Eigen::Infinity>())) << name;
+        EXPECT_LE((Ba - Bb).lpNorm<Eigen::Infinity>(), 1e-13 * (1 + Ba.lpNorm<Eigen::Infinity>())) << name;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace hybridcont
