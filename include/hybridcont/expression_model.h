@@ -115,16 +115,16 @@ struct CompiledPrograms {
 
 namespace internal {
 
-// The interpreter over a fixed-size jet runs over the bounded-dynamic jet of the same order: inputs copied
-// in, outputs copied out, the same derivatives (first order: the same operations, the same bits; second
-// order: nested jets, equal to rounding). One instantiation of the interpreter serves every dimension
-// instead of one per dimension and order, which was most of the library's compile time (bench/README.md,
-// "Build time"); the interpreter is the path without a compiler, where speed is not the point.
 // The interpreter over the bounded-dynamic jets, out of line (expression_model.cc): a flattened caller
 // (AutoDiffPhase's unfolded field) must not inline it once per dimension.
 void InterpretJets(const ExpressionProgram& program, const double* p, const Jet* x, Jet* out);
 void InterpretJets(const ExpressionProgram& program, const double* p, const Jet2* x, Jet2* out);
 
+// The interpreter over a fixed-size jet runs over the bounded-dynamic jet of the same order: inputs copied
+// in, outputs copied out, the same derivatives (first order: the same operations, the same bits; second
+// order: nested jets, equal to rounding). One instantiation of the interpreter serves every dimension and
+// order, which keeps the library's compile time down (bench/README.md, "Build time"); the interpreter is
+// the path without a compiler, where speed is not the point.
 template <int N>
 void InterpretAsBoundedDynamic(const ExpressionProgram& program, const double* p,
                                const Eigen::AutoDiffScalar<Eigen::Matrix<double, N, 1>>* x,

@@ -141,13 +141,13 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
   res.flow_residual = (monodromy * f0 - f0).norm() / f0.norm();
   if (conservative) res.first_integral_residual = (dH0 * monodromy - dH0).norm() / dH0.norm();
 
-  Eigen::EigenSolver<Matrix> full(monodromy, /*computeEigenvectors=*/false);
-  if (full.info() != Eigen::Success) {
+  const Eigen::VectorXcd full = Eigenvalues(monodromy);
+  if (full.size() != n) {
     res.status = FloquetStatus::kEigenFailed;
     res.message = "EigenSolver failed on the monodromy matrix";
     return res;
   }
-  for (int i = 0; i < n; ++i) res.multipliers.push_back(full.eigenvalues()(i));
+  for (int i = 0; i < n; ++i) res.multipliers.push_back(full(i));
   std::sort(res.multipliers.begin(), res.multipliers.end(), [](const auto& a, const auto& b) {
     const double da = std::abs(a - 1.0), db = std::abs(b - 1.0);
     return da != db ? da < db : a.imag() > b.imag();
@@ -162,24 +162,24 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
     const Matrix Qc = Eigen::HouseholderQR<Matrix>(c).householderQ();
     const Matrix B = Q1 * Qc.rightCols(reduced_dim);
     const Matrix M = B.transpose() * monodromy * B;
-    Eigen::EigenSolver<Matrix> reduced(M, false);
-    if (reduced.info() != Eigen::Success) {
+    const Eigen::VectorXcd reduced = Eigenvalues(M);
+    if (reduced.size() != reduced_dim) {
       res.status = FloquetStatus::kEigenFailed;
       res.message = "EigenSolver failed on the deflated monodromy";
       return res;
     }
-    for (int i = 0; i < reduced_dim; ++i) res.nontrivial.push_back(reduced.eigenvalues()(i));
+    for (int i = 0; i < reduced_dim; ++i) res.nontrivial.push_back(reduced(i));
     if (inverse != nullptr && inverse->allFinite()) {
       // The multipliers inside the unit circle as reciprocals of B^T Phi_T^{-1} B's outside it, when both
       // count the same number there (they do, but for multipliers on the circle within rounding).
-      Eigen::EigenSolver<Matrix> dual(Matrix(B.transpose() * *inverse * B), false);
-      if (dual.info() == Eigen::Success) {
+      const Eigen::VectorXcd dual = Eigenvalues(B.transpose() * *inverse * B);
+      if (dual.size() == reduced_dim) {
         std::vector<std::complex<double>> outside, inside;
         for (const auto& mu : res.nontrivial) {
           if (std::abs(mu) >= 1.0) outside.push_back(mu);
         }
         for (int i = 0; i < reduced_dim; ++i) {
-          const std::complex<double> nu = dual.eigenvalues()(i);
+          const std::complex<double> nu = dual(i);
           if (std::abs(nu) > 1.0) inside.push_back(1.0 / nu);
         }
         if (outside.size() + inside.size() == static_cast<std::size_t>(reduced_dim)) {
