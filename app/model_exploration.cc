@@ -1,5 +1,7 @@
 #include "model_exploration.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <mutex>
 #include <stdexcept>
@@ -10,6 +12,7 @@
 #include "hybridcont/observable_test_functions.h"
 #include "hybridcont/internal/enum_names.h"
 #include "hybridcont/period_doubling.h"
+#include "hybridcont/start_check.h"
 
 namespace hybridcont::app {
 
@@ -309,10 +312,81 @@ void ModelExploration::ToModelUnits(BifurcationDiagram* diagram) const {
   }
 }
 
+bool ModelExploration::PrepareStart(std::string* why) {
+  start_prepared_ = true;
+  prepared_start_ = scenario_.start;
+  start_report_.clear();
+  const StartSpec& spec = model_.setup().start;
+  if (spec.kind == StartSpec::Kind::kSimulation) return true;  // a non-conservative model's (FindOrbitStarts)
+  const StartResidual residual = ExplainStartResidual(model_, spec, integrator_);
+  if (spec.kind == StartSpec::Kind::kSingular) {
+    const double tolerance = SingularStartTolerance(residual.u);
+    if (residual.max_residual <= tolerance) return true;
+    const std::string size = residual.evaluated ? fmt::format("max |r| = {:.3g}", residual.max_residual)
+                                                : std::string("r cannot be evaluated");
+    *why = fmt::format("the start (kind = \"singular\") is not a periodic orbit: {} (an exact zero of r is needed, to "
+                       "{:.1e}); give the unknowns that do not close, or kind = \"guess\" for an approximate orbit "
+                       "that Newton corrects:\n{}",
+                       size, tolerance, residual.Explain(tolerance));
+    while (!why->empty() && why->back() == '\n') why->pop_back();
+    return false;
+  }
+  if (state_) return true;  // a guess: corrected by the time-based exploration that finds the state start
+  // An approximate orbit (StartSpec::kGuess): Newton at the guess's level H; the exploration starts from the
+  // corrected orbit, a regular point of its family.
+  Vector start = scenario_.start;
+  if (shooting_.layout().num_observables() > 0) start = shooting_.CompleteUnknowns(start);
+  Corrector corrector(scaled_.get());
+  const Vector guess = scaled_->ToScaled(start);
+  const int h = scaled_->UnknownIndex("H");
+  Vector corrected;
+  const CorrectorResult result = corrector.CorrectFixedComponent(guess, h, guess(h), &corrected);
+  if (!result.converged()) {
+    *why = fmt::format("the start guess does not converge to an orbit at H = {:.10g} ({}); at the guess, max |r| = "
+                       "{:.3g}:\n{}",
+                       start(shooting_.layout().H_index()), result.message, residual.max_residual,
+                       residual.Explain(SingularStartTolerance(residual.u)));
+    while (!why->empty() && why->back() == '\n') why->pop_back();
+    return false;
+  }
+  prepared_start_ = scaled_->FromScaled(corrected);
+  // How far Newton moved the guess, in the unknowns' scales: beyond a thousandth of a scale it is said,
+  // with the largest changes by name.
+  const Vector change = (corrected - guess).cwiseAbs();
+  constexpr double kReportedChange = 1e-3;
+  if (change.maxCoeff() > kReportedChange) {
+    std::vector<int> order(change.size());
+    for (int i = 0; i < change.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return change(a) > change(b); });
+    const std::vector<std::string> names = shooting_.layout().unknown_names();
+    std::string moved;
+    for (int k = 0; k < 4 && k < change.size() && change(order[k]) > kReportedChange; ++k) {
+      const int i = order[k];
+      moved += fmt::format("{}{} {:.6g} -> {:.6g}", moved.empty() ? "" : ", ", names[i], start(i),
+                           prepared_start_(i));
+    }
+    start_report_ = fmt::format("start: the guess is not an orbit (max |r| = {:.3g}); Newton moved it at H = {:.10g} "
+                                "in {} iterations: {}\n",
+                                residual.max_residual, start(shooting_.layout().H_index()), result.iterations, moved);
+  }
+  return true;
+}
+
 BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {
   ExplorationOptions options = EngineOptions(on_point);
-  Vector start = scenario_.start;
-  if (!state_ && shooting_.layout().num_observables() > 0) start = shooting_.CompleteUnknowns(start);
+  if (!start_prepared_) {
+    std::string why;
+    if (!PrepareStart(&why)) {
+      BifurcationDiagram failed;
+      failed.status = ExplorationStatus::kStartFailed;
+      failed.message = why;
+      return failed;
+    }
+  }
+  Vector start = prepared_start_;
+  if (!state_ && shooting_.layout().num_observables() > 0 && start.size() != shooting_.num_unknowns()) {
+    start = shooting_.CompleteUnknowns(start);
+  }
   if (state_) {
     std::string why;
     const Vector physical = FindPhysicalStart(&why);
@@ -323,23 +397,6 @@ BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {
       return failed;
     }
     start = state_->FromTimeBased(physical);
-  }
-  if (!state_ && model_.setup().start.kind == StartSpec::Kind::kGuess) {
-    // An approximate orbit (StartSpec::kGuess): Newton at the guess's level H, then explore from the
-    // corrected orbit, a regular point of its family.
-    Corrector corrector(scaled_.get());
-    const Vector guess = scaled_->ToScaled(start);
-    const int h = scaled_->UnknownIndex("H");
-    Vector corrected;
-    const CorrectorResult result = corrector.CorrectFixedComponent(guess, h, guess(h), &corrected);
-    if (!result.converged()) {
-      BifurcationDiagram failed;
-      failed.status = ExplorationStatus::kStartFailed;
-      failed.message = "the start guess does not converge to an orbit at H = " +
-                       std::to_string(start(shooting_.layout().H_index())) + ": " + result.message;
-      return failed;
-    }
-    start = scaled_->FromScaled(corrected);
   }
   BifurcationDiagram diagram = Explore(scaled_.get(), scaled_->ToScaled(start), options);
   ToModelUnits(&diagram);

@@ -66,6 +66,14 @@ class ModelExploration {
   // status is kStartFailed with the corrector's message.
   BifurcationDiagram Run(const PointCallback& on_point = PointCallback());
 
+  // The start of Run, checked before anything runs (Run does it when it was not called): a singular start
+  // must be an orbit (r = 0 to SingularStartTolerance), a guess must converge under Newton at its level H.
+  // False with the reason in *why, which names every part of the cycle that does not close and the unknowns
+  // the start leaves unset (start_check.h). start_report() then says how far Newton moved a guess ("" when
+  // it did not move it beyond the corrector's tolerance).
+  bool PrepareStart(std::string* why);
+  const std::string& start_report() const { return start_report_; }
+
   // Explores from each of `starts` (regular points, model units) in turn, one diagram: a start that lies on
   // a branch traced (or mapped) from an earlier one, or whose image under one of the problem's symmetries
   // does (with use_symmetries), is skipped (counted in *skipped): its families are already in the diagram,
@@ -119,6 +127,9 @@ class ModelExploration {
   ExplorationOptions options_;  // in scaled units
   ExplorationOptions time_options_;  // the time-based scenario's (model units), to find a state start
   std::shared_ptr<TestWorkSink> test_work_;
+  bool start_prepared_ = false;
+  Vector prepared_start_;        // the time-based start (model units), a guess corrected
+  std::string start_report_;
 };
 
 }  // namespace hybridcont::app

@@ -71,7 +71,9 @@ void SetFreeParameters(const ShootingLayout& layout, const Vector& u, HybridMode
 void AnalyzePhysicalOrbit(const HybridModel& model, TimeBasedShooting& floquet_map, const ReplayOptions& replay_options,
                           const Vector& u, PointRecord* record) {
   const double nan = std::nan("");
-  const int nontrivial = std::max(model.phase(0).dim() - 2, 0);
+  // Trivial multipliers (floquet.h): the flow direction, and with a first integral its level as well.
+  const int trivial = model.num_first_integrals() > 0 ? 2 : 1;
+  const int nontrivial = std::max(model.phase(0).dim() - trivial, 0);
   record->extra = {{"replay_error", nan}, {"stable", nan},        {"normal", nan}, {"num_unit", nan},
                    {"max_multiplier", nan}, {"bp_test", nan},     {"pd_test", nan}};
   for (int j = 0; j < nontrivial; ++j) {

@@ -4,6 +4,8 @@
 
 #include <Eigen/LU>
 
+#include <algorithm>
+
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/simulation_start.h"
 #include "hybridcont/timebased_shooting.h"
@@ -12,20 +14,32 @@ namespace hybridcont::app {
 namespace {
 
 // Newton on the square system of an orbit at fixed parameters; the residual's max-norm is returned.
+// A step never takes a positive duration below half its value: a phase variable (a forcing phase s, an
+// angle) makes every orbit recur with durations shifted by whole periods, and full Newton steps from a rough
+// guess may land on such an alias with a negative duration (the same states, traversed backwards in time).
+// Damped this way Newton stays on the orbit whose durations have the guess's signs; near the solution the
+// steps are whole and the convergence quadratic.
 bool RefineAtFixedParameters(TimeBasedShooting& shooting, Vector* u, double* residual, int* iterations) {
+  const ShootingLayout& layout = shooting.layout();
   Vector r;
   Matrix dr;
-  for (*iterations = 0; *iterations < 30; ++*iterations) {
+  constexpr int kMaxIterations = 60;
+  for (*iterations = 0; *iterations < kMaxIterations; ++*iterations) {
     if (!shooting.Evaluate(*u, &r, &dr).ok) return false;
     *residual = r.lpNorm<Eigen::Infinity>();
     if (*residual <= 1e-11) return true;
     const Eigen::PartialPivLU<Matrix> lu(dr);
-    *u -= lu.solve(r);
+    const Vector step = -lu.solve(r);
+    double lambda = 1.0;
+    for (int i = 0; i < layout.num_segments(); ++i) {
+      const double t = (*u)(layout.time_index(i)), dt = step(layout.time_index(i));
+      if (t > 0 && t + dt < 0.5 * t) lambda = std::min(lambda, 0.5 * t / -dt);
+    }
+    *u += lambda * step;
     if (!u->allFinite()) return false;
   }
   return shooting.Evaluate(*u, &r, nullptr).ok && (*residual = r.lpNorm<Eigen::Infinity>()) <= 1e-11;
 }
-
 
 // One start: simulated or declared, then refined; false (and why in *report) if it fails.
 bool OneStart(const HybridModel& model, const RunSetup& setup, const StartSpec& spec, Vector* u,

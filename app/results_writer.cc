@@ -92,7 +92,7 @@ nlohmann::json PresentationJson(const HybridModel& model, const OrbitPresentatio
 
 ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::json options,
                              const FreeParameters& free)
-    : dir_(std::move(dir)), model_(model), free_(free), layout_(model, free), presentation_(model) {
+    : dir_(std::move(dir)), model_(model), free_(free), layout_(model, free), presentation_(model, free) {
   summary_["model"] = model.name();
   summary_["version"] = HYBRIDCONT_VERSION;
   summary_["description"] = model.description();
@@ -151,7 +151,7 @@ bool ResultsWriter::WriteFailed(const fs::path& file) {
 void ResultsWriter::SetBranchModel(int branch_id, const HybridModel& model) {
   // The run's free parameters are the other model's too (a doubled model's columns: its unknowns and p).
   branch_models_.insert_or_assign(branch_id,
-                                  BranchModel{ShootingLayout(model, free_), OrbitPresentation(model), model.WordModeNames()});
+                                  BranchModel{ShootingLayout(model, free_), OrbitPresentation(model, free_), model.WordModeNames()});
 }
 
 int ResultsWriter::next_branch_id() const {
@@ -214,7 +214,7 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
     if (std::isfinite(value)) f << fmt::format(",{:.10g}", value);
     else f << ",";  // not defined for this point (e.g. Floquet data of a non-physical orbit)
   }
-  for (const double value : presentation.Quantities(u.head(layout.num_orbit_unknowns()))) {
+  for (const double value : presentation.Quantities(u)) {
     if (std::isfinite(value)) f << fmt::format(",{:.17g}", value);
     else f << ",";
   }

@@ -204,12 +204,15 @@ int KeyframePoint(const Branch& b, const std::vector<bool>& physical, const Scen
   return best;
 }
 
-// The traced key-frame orbits, one per branch for the first scenario.max_keyframe_orbits branches that
-// have a physical point.
+// The traced key-frame orbits, one per family (as the model names them): the key point of the first branch
+// with a physical point of each family, for the first scenario.max_keyframe_orbits families (two halves of
+// one family from a start would otherwise fill the frames with one gait twice).
 void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log, const HybridModel& model,
                          const RunSetup& setup, const ShootingLayout& layout, ResultsWriter& writer) {
   const Scenario& sc = setup.scenario;
   const std::vector<bool> none;
+  std::vector<std::string> drawn;
+  std::vector<Vector> drawn_points;
   int orbits = 0;
   for (const Branch& b : diagram.branches) {
     if (orbits >= sc.max_keyframe_orbits) continue;
@@ -217,11 +220,20 @@ void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log,
     const int best = KeyframePoint(b, flags == log.physical.end() ? none : flags->second, sc, layout);
     if (best < 0) continue;
     const Vector& u = b.points[best].u;
+    const std::string family = sc.describe(u);
+    const bool named = family != kUnnamedFamily;
+    if (named && std::find(drawn.begin(), drawn.end(), family) != drawn.end()) continue;
+    if (std::any_of(drawn_points.begin(), drawn_points.end(),
+                    [&](const Vector& v) { return (v - u).lpNorm<Eigen::Infinity>() <= 1e-9 * (1 + u.norm()); })) {
+      continue;  // the same orbit, the start of two half-branches
+    }
+    drawn.push_back(family);
+    drawn_points.push_back(u);
     HybridModel at_point = model.Clone();
     SetFreeParameters(layout, u, &at_point);
     const OrbitTrace trace(at_point, OrbitPart(layout, u), setup.integrator);
     writer.AddOrbit(trace, b.id, best, layout.has_level() ? u(layout.H_index()) : std::nan(""), layout.Period(u),
-                    sc.describe(u));
+                    family);
     ++orbits;
   }
 }
@@ -286,8 +298,12 @@ int FinishAndDraw(const RunArguments& args, const BifurcationDiagram& diagram, R
     return 1;
   }
   out << fmt::format("results written to {}/ (summary.json, branch-*.csv, orbit-*.csv)\n", dir.string());
+  if (diagram.status == ExplorationStatus::kStartFailed) {
+    err << "error: no family was traced: " << diagram.message << "\n";
+    return 1;  // nothing to draw
+  }
   if (!args.no_plots && DrawFigures(dir, err, false) == 0) out << fmt::format("figures written to {}/\n", dir.string());
-  return diagram.status == ExplorationStatus::kStartFailed ? 1 : 0;
+  return 0;
 }
 
 // ---- 2. compute, streaming every accepted point; 3. summary, key-frame orbits, report, figures
@@ -301,6 +317,8 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   std::string starts_report;
   BifurcationDiagram diagram;
   if (setup.free.empty()) {
+    starts_report = exploration.start_report();
+    if (!args.quiet) out << starts_report;  // how far Newton moved a guess
     diagram = exploration.Run(on_point);
   } else if (model.num_first_integrals() == 0) {  // the family in the parameter from the model's start
     const OrbitStarts starts = FindOrbitStarts(model, setup, layout);
@@ -430,6 +448,16 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
         throw std::invalid_argument("transition " + transitions + ", which a change of the phase sequence may take " +
                                     "(checked on the word " + automaton.WordName(word) + "): " + e.what());
       }
+    }
+  }
+  // The ordinary run's start, checked (a guess corrected) before anything is written: a start that is not an
+  // orbit is an error of the model's input, said per part of the cycle that does not close.
+  if (setup.free.empty() && model.num_first_integrals() > 0) {
+    std::string why;
+    if (!exploration->PrepareStart(&why)) {
+      SourceLocation where = model.setup().start.where;
+      if (where.field.empty()) where.field = "start";
+      throw ModelInputError(where, why);
     }
   }
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / model.name() : fs::path(args.out_dir);

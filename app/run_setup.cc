@@ -6,6 +6,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "hybridcont/setup_evaluation.h"
 #include "model_exploration.h"
 #include "model_options.h"
 
@@ -260,6 +261,10 @@ RunSetup MakeRunSetup(const RunArguments& given, const HybridModel& model) {
   ApplyExplorationLimits(args, &setup.exploration);
   ApplyFreeParameter(args, model, &setup);
   ApplyObservables(args, model, &setup);
+  // Family names read the points of this run's layout: with its free parameters at their values in u.
+  setup.scenario.describe = [presentation = OrbitPresentation(model, setup.free)](const Vector& u) {
+    return presentation.Family(u);
+  };
   ApplyTargetsAndBounds(args, model, &setup.exploration.continuation);
   WidenBoundsToTargets(args, &setup.exploration.continuation);
   return setup;

@@ -61,6 +61,8 @@ struct StartSpec {
   // A hybrid automaton's start in another word than the model's (hybrid_automaton.h: transition indices);
   // its values name that word's unknowns. Empty: the model's own word.
   std::vector<int> word;
+  // Where the start was declared (a model file's [start] table), for messages about it.
+  SourceLocation where;
 };
 
 struct BoundSpec {

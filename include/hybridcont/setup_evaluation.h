@@ -45,22 +45,32 @@ Vector StartPoint(const HybridModel& model);
 // The same for one of the model's starts (ModelSetup::start or an entry of more_starts).
 Vector StartPoint(const HybridModel& model, const StartSpec& start);
 
+// The name of an orbit that no family rule names.
+inline constexpr const char* kUnnamedFamily = "periodic orbit";
+
 // How the orbits of one model are presented: per-point quantities, family names and the key-frame
 // drawing, every expression parsed once at construction. Keeps a reference to the model (which must
-// outlive it) and evaluates at the model's current parameters.
+// outlive it).
+//
+// A point u is given in the time-based layout with the free parameters `free` (shooting_layout.h): its
+// orbit unknowns, then the free parameters and observables. Quantities and family rules see the orbit
+// unknowns, T = the sum of the durations, and the parameters at the point: a free parameter (a non-
+// conservative model's family parameter, `--free k`) at its value in u, every other parameter at the
+// model's current value. A u of only the orbit unknowns is read at the model's current parameters.
 class OrbitPresentation {
  public:
   // Throws ModelInputError naming the field (e.g. "families[1].when") for an expression that does not
   // parse, and for a drawing of a phase the model lacks, a line or mass naming no point of its drawing, or
-  // two drawings of one phase (for different segments) with different points, lines or masses.
-  explicit OrbitPresentation(const HybridModel& model);
+  // two drawings of one phase (for different segments) with different points, lines or masses; throws
+  // std::invalid_argument for free parameters the model does not have (ShootingLayout).
+  explicit OrbitPresentation(const HybridModel& model, const FreeParameters& free = {});
 
   const std::vector<std::string>& quantity_names() const { return quantity_names_; }
   std::vector<std::string> family_names() const;
 
-  // The declared quantities at u (time-based layout), in the order of setup().quantities.
+  // The declared quantities at u, in the order of setup().quantities.
   std::vector<double> Quantities(const Vector& u) const;
-  // The name of the first family rule whose condition is nonzero at u; "periodic orbit" if none is.
+  // The name of the first family rule whose condition is nonzero at u; kUnnamedFamily if none is.
   std::string Family(const Vector& u) const;
 
   // ---- drawing
@@ -84,10 +94,13 @@ class OrbitPresentation {
     std::vector<int> columns;    // point i of this drawing -> column in point_names()
   };
   std::vector<double> ParameterValues() const;
+  // The orbit program's inputs at u (orbit unknowns, then T) and the parameters at u.
+  void OrbitInputs(const Vector& u, std::vector<double>* x, std::vector<double>* p) const;
   const CompiledDrawing* DrawingOf(int segment) const;
 
   const HybridModel* model_;
-  ShootingLayout layout_;
+  ShootingLayout layout_;        // the orbit unknowns alone: the orbit program's inputs
+  ShootingLayout point_layout_;  // with the free parameters: the layout of the points given
   std::vector<std::string> quantity_names_;
   // Inputs: u, then T. Quantities first, then one output per family rule.
   ExpressionProgram orbit_program_;

@@ -257,7 +257,8 @@ Vector StartPoint(const HybridModel& model, const StartSpec& start) {
   return u;
 }
 
-OrbitPresentation::OrbitPresentation(const HybridModel& model) : model_(&model), layout_(model) {
+OrbitPresentation::OrbitPresentation(const HybridModel& model, const FreeParameters& free)
+    : model_(&model), layout_(model), point_layout_(model, free) {
   GlobalSymbols global(model);
   orbit_program_ = CompileOrbitProgram(model.setup(), layout_, global, &quantity_names_, &family_names_);
   for (const DrawingSpec::PhaseDrawing& pd : model.setup().drawing.phases) {
@@ -270,10 +271,21 @@ std::vector<std::string> OrbitPresentation::family_names() const { return family
 
 std::vector<double> OrbitPresentation::ParameterValues() const { return ParameterValuesOf(*model_); }
 
+void OrbitPresentation::OrbitInputs(const Vector& u, std::vector<double>* x, std::vector<double>* p) const {
+  const int n = layout_.num_unknowns();
+  HYBRIDCONT_DEMAND(u.size() == n || u.size() == point_layout_.num_unknowns());
+  x->assign(u.data(), u.data() + n);
+  x->push_back(layout_.Period(u.head(n)));
+  *p = ParameterValues();
+  if (u.size() == n) return;
+  for (int j = 0; j < point_layout_.num_free_parameters(); ++j) {
+    (*p)[point_layout_.parameter_model_index(j)] = u(point_layout_.parameter_index(j));
+  }
+}
+
 std::vector<double> OrbitPresentation::Quantities(const Vector& u) const {
-  std::vector<double> x(u.data(), u.data() + u.size());
-  x.push_back(layout_.Period(u));
-  const std::vector<double> p = ParameterValues();
+  std::vector<double> x, p;
+  OrbitInputs(u, &x, &p);
   std::vector<double> values;
   for (std::size_t i = 0; i < quantity_names_.size(); ++i) {
     values.push_back(orbit_program_.EvaluateScalar(x.data(), p.data(), static_cast<int>(i)));
@@ -282,15 +294,14 @@ std::vector<double> OrbitPresentation::Quantities(const Vector& u) const {
 }
 
 std::string OrbitPresentation::Family(const Vector& u) const {
-  std::vector<double> x(u.data(), u.data() + u.size());
-  x.push_back(layout_.Period(u));
-  const std::vector<double> p = ParameterValues();
+  std::vector<double> x, p;
+  OrbitInputs(u, &x, &p);
   const int first = static_cast<int>(quantity_names_.size());
   for (std::size_t i = 0; i < family_names_.size(); ++i) {
     const double when = orbit_program_.EvaluateScalar(x.data(), p.data(), first + static_cast<int>(i));
     if (when != 0.0 && !std::isnan(when)) return family_names_[i];
   }
-  return "periodic orbit";
+  return kUnnamedFamily;
 }
 
 const OrbitPresentation::CompiledDrawing* OrbitPresentation::DrawingOf(int segment) const {

@@ -177,6 +177,7 @@ StartSpec Reader::ReadStartTable(const toml::table& st, const std::string& field
   const toml::table* t = &st;
   StartSpec start;
   start.word = word;
+  start.where = At(t, field);
   if (!transition_tables_.empty()) CheckKeys(*t, field, {"kind", "values", "conditions", "cycles", "word"});
   else CheckKeys(*t, field, {"kind", "values", "conditions", "cycles"});
   const std::string kind = OptionalString(*t, "kind", field, "singular");
