@@ -1,8 +1,11 @@
 #include "hybridcont/replay.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+
+#include <Eigen/QR>
 
 #include "hybridcont/shooting_layout.h"
 
@@ -19,6 +22,62 @@ constexpr internal::EnumName<ReplayStatus> kReplayStatusNames[] = {
     {ReplayStatus::kEventFailed, "event failed"},
 };
 
+// The finest integration tolerance the examination asks for: below it a double's rounding over the phases
+// is no longer small against the requested error.
+constexpr double kFinestTolerance = 1e-14;
+
+// The examination of a replay that does not close (replay.h): Newton with minimum-norm steps on the replayed
+// map from x̄_1, holding the first integrals at their values at x̄_1 (the rows dH δ = H(x̄_1) − H(x) fix
+// the step along the family, where P − I is singular). True when it finds a fixed point within
+// options.tolerance of x̄_1, or when P(x̄_1) itself returns within it (res then holds the return and the
+// distance); *error is the last |P(x) − x|.
+bool FixedPointNear(const Phase& first, PoincareMap& map, const Vector& x1, const Vector& xi,
+                    const ReplayOptions& options, ReplayResult* res, double* error) {
+  const int n = static_cast<int>(x1.size()), k = first.num_first_integrals();
+  Vector H1, H;
+  Matrix dH;
+  if (k > 0) first.FirstIntegrals(x1, &H1, nullptr, nullptr);
+  Vector x = x1;
+  PoincareResult pr;
+  if (map.Evaluate(x, xi, /*with_jacobian=*/false, &pr) != PoincareStatus::kSuccess) return false;
+  res->counters += pr.counters;
+  *error = (pr.x - x).norm();
+  if (*error <= options.tolerance) {
+    res->x_end = pr.x;
+    res->period = pr.period;
+    res->event_times = pr.durations;
+    return true;
+  }
+  for (int step = 0; step < options.fixed_point_iterations; ++step) {
+    if (map.Evaluate(x, xi, /*with_jacobian=*/true, &pr) != PoincareStatus::kSuccess) return false;
+    res->counters += pr.counters;
+    Matrix A(n + k, n);
+    Vector b(n + k);
+    A.topRows(n) = pr.dP_dx0 - Matrix::Identity(n, n);
+    b.head(n) = pr.x - x;
+    if (k > 0) {
+      first.FirstIntegrals(x, &H, &dH, nullptr);
+      A.bottomRows(k) = dH;
+      b.tail(k) = H - H1;
+    }
+    const Eigen::CompleteOrthogonalDecomposition<Matrix> cod(A);
+    x -= cod.solve(b);
+    res->fixed_point_steps = step + 1;
+    res->fixed_point_distance = (x - x1).norm();
+    if (!x.allFinite() || !(res->fixed_point_distance <= options.tolerance)) return false;
+    if (map.Evaluate(x, xi, /*with_jacobian=*/false, &pr) != PoincareStatus::kSuccess) return false;
+    res->counters += pr.counters;
+    *error = (pr.x - x).norm();
+    if (*error <= options.tolerance) {
+      res->x_end = pr.x;
+      res->period = pr.period;
+      res->event_times = pr.durations;
+      return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 std::string ReplayOptions::Validate() const {
@@ -27,6 +86,7 @@ std::string ReplayOptions::Validate() const {
       .Require(poincare.section == PoincareSection::kAnchor, "poincare.section", ToString(poincare.section),
                "must be 'anchor' (a time-based orbit ends at the anchor)")
       .Positive("tolerance", tolerance)
+      .AtLeast("fixed_point_iterations", fixed_point_iterations, 0)
       .message();
 }
 
@@ -71,13 +131,35 @@ ReplayResult ReplayOrbit(const HybridModel& model, const Vector& u, const Replay
     res.event_time_errors.push_back(std::abs(pr.durations[i] - u(layout.time_index(i))) / scale);
     res.max_event_time_error = std::max(res.max_event_time_error, res.event_time_errors.back());
   }
-  if (!(res.error <= options.tolerance)) {
+  if (res.error <= options.tolerance) return res;
+  // The examination (replay.h): the same replay at refined tolerances, then Newton on that map.
+  PoincareOptions refined = options.poincare;
+  IntegratorOptions& integrator = refined.event.integrator;
+  integrator.rtol = std::max(integrator.rtol * options.refined_tolerance_factor, kFinestTolerance);
+  integrator.atol = std::max(integrator.atol * options.refined_tolerance_factor, kFinestTolerance);
+  PoincareMap fine(model, refined);
+  double refined_error = res.error;
+  if (FixedPointNear(model.phase(0), fine, x1, xi, options, &res, &refined_error)) {
     std::ostringstream os;
-    os << "replay from x̄_1 ends at distance " << res.error << " > tolerance " << options.tolerance
-       << " (period " << pr.period << " vs " << T << ")";
-    res.status = ReplayStatus::kNotClosed;
+    os << "the replay from x̄_1 ends at distance " << res.error << " at rtol " << options.poincare.event.integrator.rtol
+       << ", within " << refined_error << " at rtol " << integrator.rtol;
+    if (res.fixed_point_steps > 0) {
+      os << " from the replayed map's fixed point, " << res.fixed_point_distance << " from x̄_1 ("
+         << res.fixed_point_steps << " Newton steps)";
+    }
+    os << ": an ill-conditioned orbit";
     res.message = os.str();
+    return res;
   }
+  std::ostringstream os;
+  os << "replay from x̄_1 ends at distance " << res.error << " > tolerance " << options.tolerance << " (period "
+     << pr.period << " vs " << T << "); at rtol " << integrator.rtol << " " << refined_error;
+  if (res.fixed_point_steps > 0) {
+    os << " after " << res.fixed_point_steps << " Newton steps on the replayed map, at distance "
+       << res.fixed_point_distance << " from x̄_1";
+  }
+  res.status = ReplayStatus::kNotClosed;
+  res.message = os.str();
   return res;
 }
 

@@ -242,12 +242,32 @@ EventFlowStatus EventFlow::Integrate(const Eigen::Ref<const Vector>& x0, const E
     // back inside it (two crossings within one step: found at the local minimum, where g_dot = 0).
     bool crossing = g_prev > 0.0 && g_new <= 0.0;
     double t_low = t_new, g_low = g_new;
+    auto g_dot_at = [&](double t) {
+      dense.calc_state(t, w.z_at);
+      double g = 0.0;
+      return w.GuardRate(guard, w.z_at.head(n), &g);
+    };
+    // g rises above 0 and falls back inside one step (a guard that begins on 0 moving up: a short flight's
+    // landing guard starts where the lift-off left the body, at the touch-down height): the downward crossing
+    // lies after the local maximum, where g_dot = 0. A maximum within touch_tolerance of 0 cannot be told from
+    // a tangency: grazing, as for a dip.
+    if (!crossing && g_prev <= 0.0 && g_new <= 0.0 && g_dot_prev > 0.0 && g_dot_new < 0.0) {
+      const double t_max = LocateRoot(g_dot_at, t_prev, t_new, g_dot_prev, g_dot_new);
+      dense.calc_state(t_max, w.z_at);
+      double g_max = 0.0;
+      const double g_dot_max = w.GuardRate(guard, w.z_at.head(n), &g_max);
+      if (g_max > options_.touch_tolerance) {
+        crossing = true;
+        t_prev = t_max;
+        g_prev = g_max;
+      } else if (g_max > 0.0) {
+        std::ostringstream os;
+        os << at(t_max) << "the trajectory rises above the guard by only " << g_max << " <= touch_tolerance "
+           << options_.touch_tolerance << " and falls back: grazing";
+        return finish(EventFlowStatus::kGrazing, os.str(), t_max, w.z_at, g_max, g_dot_max);
+      }
+    }
     if (!crossing && g_prev > 0.0 && g_new > 0.0 && g_dot_prev < 0.0 && g_dot_new > 0.0) {
-      auto g_dot_at = [&](double t) {
-        dense.calc_state(t, w.z_at);
-        double g = 0.0;
-        return w.GuardRate(guard, w.z_at.head(n), &g);
-      };
       const double t_min = LocateRoot(g_dot_at, t_prev, t_new, g_dot_prev, g_dot_new);
       dense.calc_state(t_min, w.z_at);
       double g_min = 0.0;
