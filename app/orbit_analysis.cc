@@ -101,7 +101,9 @@ void AnalyzePhysicalOrbit(const HybridModel& model, TimeBasedShooting& floquet_m
       return;
     }
   }
-  const FloquetResult floquet = ComputeFloquet(floquet_map, u);
+  FloquetOptions floquet_options;
+  floquet_options.at_branch_point = record->at_branch_point;
+  const FloquetResult floquet = ComputeFloquet(floquet_map, u, floquet_options);
   if (!floquet.ok()) return;
   record->stability = floquet.stability.ToString();
   record->extra[1].second = floquet.stable ? 1 : 0;

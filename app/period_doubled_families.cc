@@ -86,18 +86,18 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
       SetFreeParameters(layout, u, &at_point);
       AnalyzePoint(at_point, setup.integrator, floquet_map, replay, &record);
       log.stable[id].push_back(record.extra[1].second);
-      log.H[id].push_back(u(layout.level_index()));
+      log.H[id].push_back(u(layout.continued_index()));
       writer.AddPoint(id, record);
       if (!quiet) {
         out << fmt::format("  b{:<3} #{:<4} {} = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {} (period-doubled)\n",
-                           id, info.point_index, layout.level_name(), u(layout.level_index()), layout.Period(u),
+                           id, info.point_index, layout.continued_name(), u(layout.continued_index()), layout.Period(u),
                            info.step, info.newton_iterations,
                            ToString(record.classification.reason));
       }
     });
     const FloquetResult at_pd = ComputeFloquet(parent_map, u_pd);
     report += fmt::format("  from PD #{} at {} = {:.12f} (parent period {:.12f}, multipliers {}):\n", pd_id,
-                          parent.level_name(), u_pd(parent.level_index()), parent.Period(u_pd),
+                          parent.continued_name(), u_pd(parent.continued_index()), parent.Period(u_pd),
                           at_pd.ok() ? Multipliers(at_pd) : "-");
     if (d.status == ExplorationStatus::kStartFailed) {
       report += "    not started: " + d.message + "\n";
@@ -118,7 +118,7 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
       for (size_t i = 0; i < stable.size(); ++i) {
         if (!std::isfinite(stable[i])) continue;
         if (std::isfinite(previous) && stable[i] != previous) {
-          changes.push_back({{"after_point", i - 1}, {layout.level_name(), log.H[b.id][i]}, {"stable", stable[i] == 1}});
+          changes.push_back({{"after_point", i - 1}, {layout.continued_name(), log.H[b.id][i]}, {"stable", stable[i] == 1}});
         }
         previous = stable[i];
       }
@@ -130,8 +130,8 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
       const FloquetResult f = b.points.empty() ? FloquetResult{} : ComputeFloquet(floquet_map, start);
       std::string flips;
       for (const nlohmann::json& c : changes) {
-        flips += fmt::format("{}{} = {:.10f} ({})", flips.empty() ? "" : ", ", layout.level_name(),
-                             c[layout.level_name()].get<double>(), c["stable"].get<bool>() ? "stable" : "unstable");
+        flips += fmt::format("{}{} = {:.10f} ({})", flips.empty() ? "" : ", ", layout.continued_name(),
+                             c[layout.continued_name()].get<double>(), c["stable"].get<bool>() ? "stable" : "unstable");
       }
       report += fmt::format("    branch {}: {} points, {}; start T = {:.12f} (2x parent {:.12f}), multipliers {}; "
                             "stability changes: {}\n",

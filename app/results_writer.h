@@ -54,6 +54,9 @@ struct PointRecord {
   double residual = 0.0;
   int newton_iterations = 0;
   double step = 0.0;
+  // The point is a branch's start at a singular point (ProgressInfo::at_singular_point): its multipliers
+  // are classified as at a located branch point (FloquetOptions::at_branch_point).
+  bool at_branch_point = false;
   // Extra named columns appended after the fixed ones (e.g. Floquet data); same names for every row.
   std::vector<std::pair<std::string, double>> extra;
   // The model's observables and constraints at the point (observable.h), written after the quantities; NaN
@@ -69,6 +72,7 @@ inline PointRecord RecordOf(const ProgressInfo& info, const Vector& u) {
   record.u = u;
   record.newton_iterations = info.newton_iterations;
   record.step = info.step;
+  record.at_branch_point = info.at_singular_point;
   return record;
 }
 

@@ -138,7 +138,7 @@ class PointStream {
       out_ << fmt::format("branch {}\n", info.branch_id);
       current_branch_ = info.branch_id;
     }
-    const int x = layout.num_free_parameters() > 0 ? layout.parameter_index(0) : layout.H_index();
+    const int x = layout.continued_index();
     out_ << fmt::format("  b{:<3} #{:<4} {} = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {}\n", info.branch_id,
                         info.point_index, layout.unknown_names()[x], record.u(x), layout.Period(record.u), info.step,
                         info.newton_iterations, ToString(record.classification.reason));
@@ -256,7 +256,7 @@ std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayou
       if (sp.type != type || sp.u.size() == 0) continue;
       const double precision = sp.interval_width.size() ? sp.interval_width.norm() : sp.precision();
       report += fmt::format("  {} on branch {} after point {}: {} = {:.12f}, T = {:.12f} ({}, precision {:.1e}){}\n", code,
-                            sp.branch_id, sp.index, layout.level_name(), sp.u(layout.level_index()),
+                            sp.branch_id, sp.index, layout.continued_name(), sp.u(layout.continued_index()),
                             layout.Period(sp.u), ToString(sp.status), precision,
                             sp.message.empty() ? "" : " " + sp.message);
       ++count;

@@ -116,6 +116,9 @@ struct ProgressInfo {
   double next_step = 0;         // step the controller proposes next
   int newton_iterations = 0;
   int rejected_steps = 0;       // on this branch so far
+  // The point is the branch's start at a singular point of r (a branch switched at an SB point, a singular
+  // start): multipliers collide at +1 there (floquet.h, FloquetOptions::at_branch_point).
+  bool at_singular_point = false;
 };
 
 struct ContinuationOptions {

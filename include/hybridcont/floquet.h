@@ -104,6 +104,15 @@ struct FloquetOptions {
   double min_transversality = 1e-8;  // saltation refused below this crossing sine
   // The multipliers inside the unit circle from the inverse product where every factor is invertible.
   bool product_inverse = true;
+  // The orbit is a located branch point (an SB point, where a switched half-branch starts): multipliers
+  // collide at +1 there. A pair colliding at +1 is a Jordan block, which an error ε of Phi_T splits by
+  // √ε, so its members lie ~1e-3 from 1 while the product of their distances, the factor of bp_test that
+  // vanishes at the point, is at the noise level. Then the nontrivial multipliers within
+  // branch_point_radius of +1 whose distances multiply to at most branch_point_product count as unit
+  // multipliers (on the unit circle: neutral, not unstable).
+  bool at_branch_point = false;
+  double branch_point_radius = 1e-2;
+  double branch_point_product = 1e-6;
 
   std::string Validate() const;
 };
@@ -145,7 +154,9 @@ struct FloquetResult {
   // The n1 - 2 nontrivial multipliers from the deflated matrix, sorted by modulus descending, then by
   // descending imaginary part (a conjugate pair: + first).
   std::vector<std::complex<double>> nontrivial;
-  int num_unit = 0;        // 2 (the trivial pair) + nontrivial multipliers within unit_tolerance of +1
+  // 2 (the trivial pair) + nontrivial multipliers within unit_tolerance of +1 (at a branch point: those of
+  // the colliding cluster, FloquetOptions::at_branch_point)
+  int num_unit = 0;
   bool normal = false;     // num_unit == 2: exactly two multipliers equal 1 (paper: normal conservative orbit)
   bool stable = false;     // all nontrivial multipliers on (or inside) the unit circle within tolerance
   // All nontrivial multipliers inside the unit circle by more than the tolerance: perturbations decay

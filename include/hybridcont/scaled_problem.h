@@ -33,6 +33,9 @@ class ScaledProblem : public ZeroProblem {
   // A scaled clone of the wrapped problem (nullptr if that has none), which the clone owns.
   // Diagonal scaling commutes with sign changes: the same signs act on v.
   std::vector<Symmetry> symmetries() const override { return problem_->symmetries(); }
+  // Forwarded: scaling renames nothing, so the family is followed in the wrapped problem's parameter (a free
+  // model parameter has turning points in it, folds, like H̄).
+  std::string family_parameter() const override { return problem_->family_parameter(); }
   std::unique_ptr<ZeroProblem> Clone() const override;
   // A scaled refined copy of the wrapped problem (nullptr if that has none), which the copy owns.
   std::unique_ptr<ZeroProblem> Refined(double factor) const override;

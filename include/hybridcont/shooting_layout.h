@@ -88,6 +88,10 @@ class ShootingLayout {
   // The coordinate a family is followed in: H̄, or (no first integral) the first free parameter.
   int level_index() const { return H_index_ >= 0 ? H_index_ : parameter_index(0); }
   const std::string& level_name() const { return names_[level_index()]; }
+  // The coordinate the continuation follows the family in: the first free parameter when there is one (`--free
+  // k --fix H=1.5` follows k at fixed H̄), else level_index(). Reports name a point by it.
+  int continued_index() const { return num_free_parameters() > 0 ? parameter_index(0) : level_index(); }
+  const std::string& continued_name() const { return names_[continued_index()]; }
 
   // Free parameters: their number q, the index in u of the i-th and its index among the model's parameters.
   int num_free_parameters() const { return static_cast<int>(parameter_model_index_.size()); }

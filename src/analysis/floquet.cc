@@ -33,6 +33,8 @@ std::string FloquetOptions::Validate() const {
       .Positive("unit_tolerance", unit_tolerance)
       .Positive("circle_tolerance", circle_tolerance)
       .Positive("min_transversality", min_transversality)
+      .Positive("branch_point_radius", branch_point_radius)
+      .Positive("branch_point_product", branch_point_product)
       .message();
 }
 
@@ -200,9 +202,26 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
   res.max_modulus = 1.0;
   res.stable = true;
   res.asymptotically_stable = !conservative;
-  for (const auto& mu : res.nontrivial) {
+  // At a located branch point: the cluster colliding at +1 (FloquetOptions::at_branch_point).
+  std::vector<bool> colliding(res.nontrivial.size(), false);
+  if (options.at_branch_point) {
+    double product = 1.0;
+    bool any = false;
+    for (std::size_t i = 0; i < res.nontrivial.size(); ++i) {
+      const double distance = std::abs(res.nontrivial[i] - 1.0);
+      if (distance <= options.branch_point_radius) colliding[i] = any = true, product *= distance;
+    }
+    if (!any || !(product <= options.branch_point_product)) colliding.assign(colliding.size(), false);
+  }
+  for (std::size_t i = 0; i < res.nontrivial.size(); ++i) {
+    const std::complex<double>& mu = res.nontrivial[i];
     bp *= mu - 1.0;
     pd *= mu + 1.0;
+    if (colliding[i]) {  // on the unit circle, at +1
+      ++res.num_unit;
+      res.asymptotically_stable = false;
+      continue;
+    }
     if (std::abs(mu - 1.0) <= options.unit_tolerance) ++res.num_unit;
     if (std::abs(mu) > 1.0 + options.circle_tolerance) {
       res.stable = false;
@@ -217,7 +236,7 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
   }
   res.stability.on_level = conservative;
   res.stability.asymptotically_stable =
-      !res.nontrivial.empty() &&
+      !res.nontrivial.empty() && std::none_of(colliding.begin(), colliding.end(), [](bool c) { return c; }) &&
       std::all_of(res.nontrivial.begin(), res.nontrivial.end(),
                   [&](const std::complex<double>& mu) { return std::abs(mu) < 1.0 - options.circle_tolerance; });
   res.stability.neutrally_stable = res.stable && !res.stability.asymptotically_stable;

@@ -257,6 +257,10 @@ void Explorer::Trace(HalfBranch* half, int parent, int depth) {
     registry_.AddRay(parent, -branch.points.back().tangent);  // it returns to the point from this side
   }
   branches_.push_back(std::move(branch));
+  // A half-branch with a parent starts at that special point, singular (also where it is a mapped image).
+  if (parent >= 0 && !half->progress.empty() && half->progress.front().point_index == 0) {
+    half->progress.front().at_singular_point = true;
+  }
   for (const ProgressInfo& info : half->progress) options_.continuation.progress(info);
   if (pool_) {
     CancelKnownRays();

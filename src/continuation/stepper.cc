@@ -322,9 +322,11 @@ class ContinuationStepper::Impl {
 
   void Report() const {
     if (!options_.progress) return;
-    options_.progress(internal::PointProgress(branch_.points.back(), branch_.id,
-                                              static_cast<int>(branch_.points.size()) - 1, progress_,
-                                              controller_.h(), branch_.rejected_steps));
+    ProgressInfo info = internal::PointProgress(branch_.points.back(), branch_.id,
+                                                static_cast<int>(branch_.points.size()) - 1, progress_,
+                                                controller_.h(), branch_.rejected_steps);
+    info.at_singular_point = start_singular_ && branch_.points.size() == 1;
+    options_.progress(info);
   }
 
   ZeroProblem* problem_;
