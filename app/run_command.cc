@@ -189,52 +189,54 @@ void ConvertToTimeBased(ModelExploration& exploration, const ShootingLayout& lay
   diagram->unknown_names = layout.unknown_names();
 }
 
-// The physical point of branch b closest to the scenario's key-frame target (classified during the run);
-// -1 if the branch has none.
-int KeyframePoint(const Branch& b, const std::vector<bool>& physical, const Scenario& sc, const ShootingLayout& layout) {
-  int best = -1;
-  double best_distance = 1e300;
-  for (int i = 0; i < static_cast<int>(b.points.size()) && i < static_cast<int>(physical.size()); ++i) {
-    if (!physical[i]) continue;
-    const Vector& u = b.points[i].u;
-    const double value = sc.keyframes.component == "T" ? layout.Period(u) : u(layout.level_index());
-    const double distance = std::abs(value - sc.keyframes.value);
-    if (distance < best_distance) best = i, best_distance = distance;
-  }
-  return best;
-}
-
-// The traced key-frame orbits, one per family (as the model names them): the key point of the first branch
-// with a physical point of each family, for the first scenario.max_keyframe_orbits families (two halves of
-// one family from a start would otherwise fill the frames with one gait twice).
+// The key-frame orbits: per family, as the model names its physical orbits, the physical point closest to
+// the scenario's key-frame target (two halves of one family from a start would otherwise fill the frames
+// with one gait twice); orbits no family rule names, per branch. In the order of their branches, the first
+// scenario.max_keyframe_orbits of them, each traced and written.
 void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log, const HybridModel& model,
                          const RunSetup& setup, const ShootingLayout& layout, ResultsWriter& writer) {
   const Scenario& sc = setup.scenario;
-  const std::vector<bool> none;
-  std::vector<std::string> drawn;
-  std::vector<Vector> drawn_points;
-  int orbits = 0;
+  struct Candidate {
+    int branch = -1, point = -1;
+    double distance = 1e300;
+    std::string family;
+  };
+  std::vector<Candidate> candidates;  // one per named family, one per branch of unnamed orbits
   for (const Branch& b : diagram.branches) {
-    if (orbits >= sc.max_keyframe_orbits) continue;
     const auto flags = log.physical.find(b.id);
-    const int best = KeyframePoint(b, flags == log.physical.end() ? none : flags->second, sc, layout);
-    if (best < 0) continue;
-    const Vector& u = b.points[best].u;
-    const std::string family = sc.describe(u);
-    const bool named = family != kUnnamedFamily;
-    if (named && std::find(drawn.begin(), drawn.end(), family) != drawn.end()) continue;
-    if (std::any_of(drawn_points.begin(), drawn_points.end(),
+    if (flags == log.physical.end()) continue;
+    for (int i = 0; i < static_cast<int>(b.points.size()) && i < static_cast<int>(flags->second.size()); ++i) {
+      if (!flags->second[i]) continue;
+      const Vector& u = b.points[i].u;
+      const double value = sc.keyframes.component == "T" ? layout.Period(u) : u(layout.continued_index());
+      const double distance = std::abs(value - sc.keyframes.value);
+      const std::string family = sc.describe(u);
+      const bool named = family != kUnnamedFamily;
+      auto it = std::find_if(candidates.begin(), candidates.end(), [&](const Candidate& c) {
+        return c.family == family && (named || c.branch == b.id);
+      });
+      if (it == candidates.end()) it = candidates.insert(candidates.end(), Candidate{b.id, i, distance, family});
+      if (distance < it->distance) *it = Candidate{b.id, i, distance, family};
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.branch < b.branch; });
+  std::vector<Vector> drawn;
+  for (const Candidate& c : candidates) {
+    if (static_cast<int>(drawn.size()) >= sc.max_keyframe_orbits) break;
+    const auto branch = std::find_if(diagram.branches.begin(), diagram.branches.end(),
+                                     [&](const Branch& b) { return b.id == c.branch; });
+    const Vector& u = branch->points[c.point].u;
+    if (std::any_of(drawn.begin(), drawn.end(),
                     [&](const Vector& v) { return (v - u).lpNorm<Eigen::Infinity>() <= 1e-9 * (1 + u.norm()); })) {
       continue;  // the same orbit, the start of two half-branches
     }
-    drawn.push_back(family);
-    drawn_points.push_back(u);
+    drawn.push_back(u);
     HybridModel at_point = model.Clone();
     SetFreeParameters(layout, u, &at_point);
     const OrbitTrace trace(at_point, OrbitPart(layout, u), setup.integrator);
-    writer.AddOrbit(trace, b.id, best, layout.has_level() ? u(layout.H_index()) : std::nan(""), layout.Period(u),
-                    family);
-    ++orbits;
+    writer.AddOrbit(trace, c.branch, c.point, layout.has_level() ? u(layout.H_index()) : std::nan(""),
+                    layout.Period(u), c.family);
   }
 }
 

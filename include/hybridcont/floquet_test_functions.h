@@ -34,6 +34,7 @@
 #include <memory>
 #include <vector>
 
+#include "hybridcont/classification.h"
 #include "hybridcont/floquet.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/test_function.h"
@@ -57,10 +58,11 @@ double PeriodDoublingTest(const Matrix& dr, const ShootingLayout& layout);
 // the multipliers do not come in reciprocal pairs (the map is not symplectic); its zeros are kept where two
 // pairs meet on the unit circle (two real pairs meeting off it are no Krein collision).
 //
-// A model without first integral adds one kGrazing function per event, the normalized crossing speed
-// de_i·f_i / (|de_i| |f_i|) at the end of segment i (negative on a physical orbit, zero where the event is
-// met tangentially), defined on both sides of the grazing point. (Conservative models do not locate grazing
-// yet, so that their diagrams stay as they were.)
+// Then one kGrazing function per event, the normalized crossing speed de_i·f_i / (|de_i| |f_i|) at the end
+// of segment i (negative on a physical orbit, zero where the event is met tangentially), defined on both
+// sides of the grazing point. A model without first integral keeps every zero; a conservative model keeps
+// those where a physical family ends (the orbit there is physical but for the tangency: class grazing), not
+// the many where the crossing speed changes sign on orbits that are no motion of the system.
 class FloquetTestFunctions : public TestFunctions {
  public:
   // Keeps a reference to model (it must outlive this object and its clones). With free parameters
@@ -85,11 +87,20 @@ class FloquetTestFunctions : public TestFunctions {
 
   // Whether the orbit at u is physical and replays (what a branch point is checked for).
   bool Physical(const Vector& u) const;
+  // Whether the orbit at u is physical or fails only by a tangential event (a conservative model's grazing
+  // zeros are kept there).
+  bool GrazingEndsPhysicalFamily(const Vector& u) const;
   // The map the multipliers and PeriodDoublingTest are computed with: its counters are this object's work
   // (the classification and replay of branch points not included).
   const TimeBasedShooting& shooting() const { return shooting_; }
 
  private:
+  // The model at u's free-parameter values (nullptr outside a parameter's range).
+  const HybridModel* ModelAt(const Vector& u_free) const;
+  Classification Classify(const HybridModel& model, const Vector& u) const;
+  // The event-driven replay of u (the model's own layout) returns (replay.h).
+  bool Replays(const HybridModel& model, const Vector& u) const;
+
   const HybridModel* model_;
   IntegratorOptions integrator_;
   bool physical_only_;

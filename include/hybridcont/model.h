@@ -201,6 +201,11 @@ struct ModelSymmetry {
   bool reverses_time = false;
 };
 
+// Whether `name` is, or could be, an unknown of the time-based layout (shooting_layout.h): t<digits>,
+// x<digits>_<state>, xi, xi<digits>, H; or T, the period every observable expression knows. Observables
+// (and the guard constraints "<transition>_guard" of an automaton) may not be named so.
+bool IsLayoutName(const std::string& name);
+
 // A hybrid model: phases, anchor and parameters. Move-only (phases refer to the parameter block it owns).
 class HybridModel {
  public:

@@ -57,46 +57,74 @@ FloquetTestFunctions::FloquetTestFunctions(const HybridModel& model, const Integ
 
 std::vector<SpecialPointType> FloquetTestFunctions::types() const {
   std::vector<SpecialPointType> types = {SpecialPointType::kFloquetBranchPoint, SpecialPointType::kPeriodDoubling};
-  if (model_->num_first_integrals() == 0) types.insert(types.end(), model_->num_phases(), SpecialPointType::kGrazing);
+  types.insert(types.end(), model_->num_phases(), SpecialPointType::kGrazing);
   types.push_back(SpecialPointType::kNeimarkSacker);
   if (model_->num_first_integrals() > 0) types.push_back(SpecialPointType::kKreinCollision);
   return types;
 }
 
-bool FloquetTestFunctions::Physical(const Vector& u_free) const {
-  const HybridModel* model = model_;
-  if (point_model_) {
-    const ShootingLayout& layout = shooting_.layout();
-    for (int i = 0; i < layout.num_free_parameters(); ++i) {
-      try {
-        point_model_->SetParameterValue(layout.parameter_model_index(i), u_free(layout.parameter_index(i)));
-      } catch (const std::invalid_argument&) {
-        return false;  // outside the parameter's range: no orbit of the model
-      }
+const HybridModel* FloquetTestFunctions::ModelAt(const Vector& u_free) const {
+  if (!point_model_) return model_;
+  const ShootingLayout& layout = shooting_.layout();
+  for (int i = 0; i < layout.num_free_parameters(); ++i) {
+    try {
+      point_model_->SetParameterValue(layout.parameter_model_index(i), u_free(layout.parameter_index(i)));
+    } catch (const std::invalid_argument&) {
+      return nullptr;  // outside the parameter's range: no orbit of the model
     }
-    model = point_model_.get();
   }
-  const Vector u = u_free.head(base_unknowns_);
+  return point_model_.get();
+}
+
+Classification FloquetTestFunctions::Classify(const HybridModel& model, const Vector& u) const {
   Classification c;
-  if (!ClassifyByUnknowns(*model, u, ClassificationOptions{}, &c)) {
-    const OrbitTrace trace(*model, u, integrator_);
-    c = ClassifyOrbit(*model, u, trace, ClassificationOptions{});
+  if (!ClassifyByUnknowns(model, u, ClassificationOptions{}, &c)) {
+    const OrbitTrace trace(model, u, integrator_);
+    c = ClassifyOrbit(model, u, trace, ClassificationOptions{});
   }
-  if (!c.physical) return false;
+  return c;
+}
+
+bool FloquetTestFunctions::Physical(const Vector& u_free) const {
+  const HybridModel* model = ModelAt(u_free);
+  if (model == nullptr) return false;
+  const Vector u = u_free.head(base_unknowns_);
+  return Classify(*model, u).physical && Replays(*model, u);
+}
+
+bool FloquetTestFunctions::Replays(const HybridModel& model, const Vector& u) const {
   ReplayOptions replay;
   replay.poincare.event.integrator.rtol = integrator_.rtol;
   replay.poincare.event.integrator.atol = integrator_.atol;
-  return ReplayOrbit(*model, u, replay).physical();
+  return ReplayOrbit(model, u, replay).physical();
+}
+
+bool FloquetTestFunctions::GrazingEndsPhysicalFamily(const Vector& u_free) const {
+  const HybridModel* model = ModelAt(u_free);
+  if (model == nullptr) return false;
+  const Classification c = Classify(*model, u_free.head(base_unknowns_));
+  return c.physical || c.reason == OrbitClass::kGrazing;
 }
 
 void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* values) {
   const int m = model_->num_phases();
-  const bool grazing = model_->num_first_integrals() == 0;
-  const int ns = 2 + (grazing ? m : 0);  // the Neimark–Sacker function, then (conservative) the Krein one
-  const bool krein = !grazing;
+  const int ns = 2 + m;  // the Neimark–Sacker function, then (conservative) the Krein one
+  const bool krein = model_->num_first_integrals() > 0;
   *values = Vector::Constant(ns + 1 + (krein ? 1 : 0), std::numeric_limits<double>::quiet_NaN());
   const bool evaluated = shooting_.Evaluate(u, nullptr, &dr_).ok;
-  if (grazing && evaluated) {  // every orbit, physical or not: the crossing speed changes sign at grazing
+  // A branch point's class: it decides whether the Floquet functions are defined there (physical_only) and,
+  // for a conservative model, whether the crossing speeds are (see below).
+  const HybridModel* model_at_u = branch_point ? ModelAt(u) : model_;
+  Classification c;
+  if (branch_point && model_at_u != nullptr) c = Classify(*model_at_u, u.head(base_unknowns_));
+  // The crossing speeds of every orbit of a model without first integral; of a conservative model, at
+  // branch points that are physical or fail only by an event's direction (wrong-direction, grazing): where
+  // a physical family ends at grazing its next point is of that class, and the zeros elsewhere, on orbits
+  // that are no motion of the system, would be located for nothing (they are not kept, Keep).
+  const bool speeds = !krein || !branch_point ||
+                      (model_at_u != nullptr && (c.physical || c.reason == OrbitClass::kWrongDirection ||
+                                                 c.reason == OrbitClass::kGrazing));
+  if (evaluated && speeds) {  // the crossing speed changes sign at grazing
     const HybridModel& model = shooting_.model();  // at u's parameter values
     for (int i = 0; i < m; ++i) {
       const Vector& x = shooting_.segment_flow(i).x;
@@ -107,7 +135,10 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
       (*values)(2 + i) = de.dot(f) / std::max(de.norm() * f.norm(), 1e-300);
     }
   }
-  if (branch_point && physical_only_ && !Physical(u)) return;
+  if (branch_point && physical_only_ &&
+      !(model_at_u != nullptr && c.physical && Replays(*model_at_u, u.head(base_unknowns_)))) {
+    return;
+  }
   const FloquetResult floquet = ComputeFloquet(shooting_, u);
   if (!floquet.ok()) return;
   (*values)(0) = floquet.bp_test;
@@ -121,6 +152,13 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
 
 bool FloquetTestFunctions::Keep(int function, const Vector& u, std::string* note) {
   const SpecialPointType type = types()[function];
+  if (type == SpecialPointType::kGrazing) {
+    // A conservative model's grazing is kept where a physical family ends: the orbit there is physical
+    // but for the tangency (its class is grazing). Elsewhere the crossing speed changes sign on orbits that
+    // are no motion of the system, which a conservative diagram has many of.
+    if (model_->num_first_integrals() == 0) return true;
+    return GrazingEndsPhysicalFamily(u);
+  }
   if (type != SpecialPointType::kNeimarkSacker && type != SpecialPointType::kKreinCollision) return true;
   const FloquetResult floquet = ComputeFloquet(shooting_, u);
   if (!floquet.ok()) return true;

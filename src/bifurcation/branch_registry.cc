@@ -53,6 +53,18 @@ bool WithinPrecisions(const SpecialPoint& a, const SpecialPoint& b, double toler
 
 std::string KnownBranchMessage(int other) { return "runs along branch " + std::to_string(other) + " (already traced)"; }
 
+void BranchRegistry::DropBranchPointsAtFolds(const std::string& family_parameter, Branch* branch) const {
+  std::vector<SpecialPoint>& points = branch->special_points;
+  const auto at_fold = [&](const SpecialPoint& bp) {
+    if (bp.type != SpecialPointType::kFloquetBranchPoint || bp.u.size() == 0) return false;
+    return std::any_of(points.begin(), points.end(), [&](const SpecialPoint& tp) {
+      return tp.type == SpecialPointType::kTurningPoint && tp.component == family_parameter &&
+             tp.u.size() == bp.u.size() && WithinPrecisions(bp, tp, same_point_tolerance_);
+    });
+  };
+  points.erase(std::remove_if(points.begin(), points.end(), at_fold), points.end());
+}
+
 bool BranchRegistry::Register(SpecialPoint* point, int depth) {
   for (const SpecialPoint& known : points_) {
     const bool comparable = point->type == known.type || (point->type == SpecialPointType::kSimpleBifurcation &&

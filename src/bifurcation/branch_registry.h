@@ -51,6 +51,12 @@ class BranchRegistry {
   // Records the smallest angle between branch lines through special point `id`.
   void NoteLines(int id, const std::vector<Vector>& lines);
 
+  // Removes from `branch` the zeros of the Floquet BP test function (a multiplier at +1) that are one of its
+  // turning points in `family_parameter` within the points' precisions (as Register compares points): a
+  // family folds in its parameter (or a conservative family in H̄, a saddle-centre) where a multiplier is
+  // +1, and that point is reported once, as the fold.
+  void DropBranchPointsAtFolds(const std::string& family_parameter, Branch* branch) const;
+
   // A unique point within same_point_tolerance of u.
   bool Contains(const Vector& u) const;
   const SpecialPoint& point(int id) const;

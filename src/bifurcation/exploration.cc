@@ -248,6 +248,7 @@ void Explorer::Trace(HalfBranch* half, int parent, int depth) {
   branch.parent_special_point = parent;
   branch.depth = depth;
   branch.direction = half->d;
+  registry_.DropBranchPointsAtFolds(evaluator_->family_parameter(), &branch);
   for (SpecialPoint& point : branch.special_points) {  // step 2
     if (registry_.Register(&point, depth) && point.type == SpecialPointType::kSimpleBifurcation) {
       queue_.push_back(point.id);

@@ -98,9 +98,6 @@ int HybridModel::FindObservable(const std::string& name) const {
   return -1;
 }
 
-namespace {
-// Whether `name` is, or could be, an unknown of the time-based layout (shooting_layout.h): t<digits>,
-// x<digits>_<state>, xi, xi<digits>, H; or T, the period every observable expression knows.
 bool IsLayoutName(const std::string& name) {
   const auto digits_from = [&](std::size_t i) {
     std::size_t j = i;
@@ -116,7 +113,6 @@ bool IsLayoutName(const std::string& name) {
   }
   return false;
 }
-}  // namespace
 
 void HybridModel::AddObservable(Observable observable) {
   const std::string where = "model '" + name_ + "', observable '" + observable.name + "'";

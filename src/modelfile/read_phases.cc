@@ -163,6 +163,12 @@ void Reader::ReadAutomatonHeaders() {
     Header h{{}, &t};
     h.transition.name = RequiredString(t, "name", field);
     CheckName(t.get("name"), field + ".name", h.transition.name);
+    if (IsLayoutName(HybridAutomaton::GuardConstraintName(h.transition))) {
+      Fail(t.get("name"), field + ".name",
+           "transition name '" + h.transition.name + "': its guard constraint '" +
+               HybridAutomaton::GuardConstraintName(h.transition) +
+               "' would be named like an unknown of the orbit (t<i>, x<i>_<state>, xi, H, T)");
+    }
     if (!transition_names.insert(h.transition.name).second) {
       Fail(t.get("name"), field + ".name", "transition name '" + h.transition.name + "' is used twice");
     }

@@ -1,0 +1,252 @@
+// What the tool tells a person about its numbers, checked against values that do not come from the
+// shooting code:
+//   - the vibrating table's fold, a turning point in the amplitude at the closed form A_sn = (1 − e) g π /
+//     ((1 + e) w²), reported once (as the fold, not also as a Floquet BP), and its impact phase against the
+//     closed form cos(th_i) = A_sn / A at every physical point, the two halves named by that phase;
+//   - the forced impact oscillator's family: every physical point has positive durations and a positive
+//     impact speed, and its orbit is confirmed by a simulation written here (odeint, events by bisection);
+//   - family names and the period: the walkers' key frames are named by the rule on T;
+//   - a branch switched at an SB point starts neutrally stable (its colliding multipliers are unit), the
+//     Lagrangian rod as the built-in one;
+//   - starts that are not orbits are refused before anything is written, saying which part of the cycle
+//     does not close; a guess Newton moves is reported.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <boost/numeric/odeint.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <set>
+#include <string>
+
+#include "cli_runner.h"
+#include "csv_columns.h"
+
+namespace hybridcont::app {
+namespace {
+
+namespace fs = std::filesystem;
+namespace odeint = boost::numeric::odeint;
+
+std::string ModelPath(const std::string& name) { return std::string(HYBRIDCONT_SOURCE_DIR) + "/models/" + name; }
+
+nlohmann::json RunQuietly(const std::vector<std::string>& model_and_options, const fs::path& dir) {
+  std::vector<std::string> args = {"run"};
+  args.insert(args.end(), model_and_options.begin(), model_and_options.end());
+  for (const char* a : {"--quiet", "--no-plots", "--overwrite"}) args.push_back(a);
+  args.push_back("--out");
+  args.push_back(dir.string());
+  const CliResult r = RunTool(args);
+  EXPECT_EQ(r.code, 0) << r.err;
+  std::ifstream in(dir / "summary.json");
+  return nlohmann::json::parse(in);
+}
+
+// Writes models/<name> with its one occurrence of `from` replaced by `to` to `path`, in a fresh folder.
+void WriteEditedModel(const std::string& name, const std::string& from, const std::string& to, const fs::path& path) {
+  fs::remove_all(path.parent_path());
+  fs::create_directories(path.parent_path());
+  std::ifstream in(ModelPath(name));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_NE(text.find(from), std::string::npos) << from;
+  text.replace(text.find(from), from.size(), to);
+  std::ofstream(path) << text;
+}
+
+TEST(VibratingTable, FoldIsOneTurningPointAtTheClosedFormAndImpactPhasesAreExact) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_true_table";
+  const nlohmann::json summary = RunQuietly({ModelPath("vibrating-table.toml")}, dir);
+  const double e = 0.5, A_sn = (1 - e) * std::numbers::pi / (1 + e);
+  int folds = 0, bps_at_fold = 0;
+  for (const nlohmann::json& sp : summary["special_points"]) {
+    const double A = sp["A"].get<double>();
+    if (sp["type"] == "TP") {
+      ++folds;
+      EXPECT_EQ(sp["status"], "located");
+      EXPECT_NEAR(A, A_sn, 1e-10);
+      EXPECT_LT(sp["precision"].get<double>(), 1e-8);
+    }
+    if (sp["type"] == "BP" && std::abs(A - A_sn) < 1e-6) ++bps_at_fold;
+  }
+  EXPECT_EQ(folds, 1);
+  EXPECT_EQ(bps_at_fold, 0);  // the fold's multiplier +1 is the fold itself
+  int physical = 0;
+  for (const nlohmann::json& b : summary["branches"]) {
+    auto c = ReadColumns(dir / b["file"].get<std::string>());
+    for (std::size_t i = 0; i < c["A"].size(); ++i) {
+      if (c["physical"][i] != 1) continue;
+      ++physical;
+      const double exact = std::acos(A_sn / c["A"][i]);
+      EXPECT_NEAR(std::abs(c["impact_phase"][i]), exact, 1e-9) << "A = " << c["A"][i];
+      EXPECT_NEAR(c["T"][i], 2 * std::numbers::pi, 1e-9);
+    }
+  }
+  EXPECT_GT(physical, 50);
+  // The two key frames: one orbit of each half of the fold, named by the sign of the impact phase.
+  std::set<std::string> labels;
+  for (const nlohmann::json& o : summary["orbits"]) labels.insert(o["label"].get<std::string>());
+  EXPECT_EQ(labels, (std::set<std::string>{"period one, late impact", "period one, early impact"}));
+  fs::remove_all(dir);
+}
+
+// The forced impact oscillator (models/forced-impact-oscillator.toml) simulated here: the approach from x1
+// until x reaches d (bisection on the dense output), v -> -e v, the rebound until the forcing phase
+// reaches pi (wrapped by 2 pi), the approach until v crosses 0 upward. Returns the state back at the section.
+struct Oscillator {
+  double k = 1, c = 0.1, A = 0.3, w, d = 1, e = 0.8;
+  using State = std::array<double, 3>;
+  void operator()(const State& s, State& ds, double) const {
+    ds = {s[1], -k * s[0] - c * s[1] + A * std::cos(s[2]), w};
+  }
+  // Runs from s until g crosses from > 0 to <= 0; false if it does not within 50 time units.
+  template <class G>
+  bool Until(State* s, double* t, G g) const {
+    auto stepper = odeint::make_dense_output(1e-13, 1e-13, odeint::runge_kutta_dopri5<State>());
+    stepper.initialize(*s, 0.0, 1e-3);
+    double g_prev = g(*s);
+    while (stepper.current_time() < 50) {
+      stepper.do_step(*this);
+      const double g_now = g(stepper.current_state());
+      if (g_prev > 0 && g_now <= 0) {
+        double a = stepper.previous_time(), b = stepper.current_time();
+        for (int i = 0; i < 200 && b - a > 1e-15; ++i) {
+          const double mid = 0.5 * (a + b);
+          State x;
+          stepper.calc_state(mid, x);
+          (g(x) > 0 ? a : b) = mid;
+        }
+        stepper.calc_state(b, *s);
+        *t = b;
+        return true;
+      }
+      g_prev = g_now;
+    }
+    return false;
+  }
+};
+
+TEST(ForcedImpactOscillator, PhysicalPointsHavePositiveDurationsAndAreConfirmedBySimulation) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_true_oscillator";
+  const nlohmann::json summary = RunQuietly({ModelPath("forced-impact-oscillator.toml")}, dir);
+  int physical = 0, simulated = 0;
+  for (const nlohmann::json& b : summary["branches"]) {
+    auto c = ReadColumns(dir / b["file"].get<std::string>());
+    for (std::size_t i = 0; i < c["w"].size(); ++i) {
+      if (c["physical"][i] != 1) {
+        // Not physical: the impact is met from the wrong side or the orbit crosses the stop before it.
+        continue;
+      }
+      ++physical;
+      for (const char* t : {"t1", "t2", "t3"}) EXPECT_GT(c[t][i], 0) << t << " at w = " << c["w"][i];
+      EXPECT_GT(c["impact_speed"][i], 0) << "w = " << c["w"][i];
+      if (i % 5 != 0) continue;
+      Oscillator o;
+      o.w = c["w"][i];
+      Oscillator::State s = {c["x1_x"][i], c["x1_v"][i], c["x1_s"][i]};
+      const Oscillator::State x1 = s;
+      double t1 = 0, t2 = 0, t3 = 0;
+      ASSERT_TRUE(o.Until(&s, &t1, [&](const Oscillator::State& x) { return o.d - x[0]; }));
+      s[1] = -o.e * s[1];
+      ASSERT_TRUE(o.Until(&s, &t2, [](const Oscillator::State& x) { return std::numbers::pi - x[2]; }));
+      s[2] -= 2 * std::numbers::pi;
+      ASSERT_TRUE(o.Until(&s, &t3, [](const Oscillator::State& x) { return -x[1]; }));
+      EXPECT_NEAR(t1, c["t1"][i], 1e-8);
+      EXPECT_NEAR(t2, c["t2"][i], 1e-8);
+      EXPECT_NEAR(t3, c["t3"][i], 1e-8);
+      for (int j = 0; j < 3; ++j) EXPECT_NEAR(s[j], x1[j], 1e-8) << "w = " << o.w;
+      ++simulated;
+    }
+  }
+  EXPECT_GT(physical, 40);
+  EXPECT_GT(simulated, 8);
+  std::printf("%d physical points, %d of them simulated\n", physical, simulated);
+  fs::remove_all(dir);
+}
+
+TEST(FamilyNames, WalkersAreNamedByTheirPeriod) {
+  for (const auto& [model, names] :
+       std::vector<std::pair<std::string, std::set<std::string>>>{
+           {"simplest-walker.toml", {"long-period gait", "short-period gait"}},
+           {"compass-gait.toml", {"long-step gait", "short-step gait"}}}) {
+    const fs::path dir = fs::temp_directory_path() / ("hybridcont_true_names_" + model);
+    const nlohmann::json summary = RunQuietly({ModelPath(model)}, dir);
+    std::set<std::string> labels;
+    for (const nlohmann::json& o : summary["orbits"]) {
+      labels.insert(o["label"].get<std::string>());
+      // The rules: the long-period walker gait has T > 3.2, the long-step compass gait T > 0.8.
+      const double threshold = model == "simplest-walker.toml" ? 3.2 : 0.8;
+      const bool long_gait = o["label"].get<std::string>().rfind("long", 0) == 0;
+      EXPECT_EQ(long_gait, o["T"].get<double>() > threshold) << model << " " << o.dump();
+    }
+    EXPECT_EQ(labels, names) << model;
+    // Every nontrivial multiplier of a model without first integral (4 states: 3) has its columns.
+    const auto c = ReadColumns(dir / "branch-0.csv");
+    for (const char* col : {"mu1_re", "mu2_re", "mu3_re", "mu3_im"}) EXPECT_EQ(c.count(col), 1u) << model << " " << col;
+    fs::remove_all(dir);
+  }
+}
+
+TEST(BranchPointStability, SwitchedBranchesStartNeutralInBothRodModels) {
+  for (const std::string model : {"bouncing-rod.toml", "bouncing-rod-lagrangian.toml"}) {
+    const fs::path dir = fs::temp_directory_path() / ("hybridcont_true_sb_" + model);
+    const nlohmann::json summary = RunQuietly({ModelPath(model)}, dir);
+    int checked = 0;
+    for (const nlohmann::json& b : summary["branches"]) {
+      if (b["parent"].get<int>() < 0 || b["depth"].get<int>() < 2) continue;  // switched at an SB point
+      std::ifstream csv(dir / b["file"].get<std::string>());
+      std::string header, first;
+      std::getline(csv, header);
+      std::getline(csv, first);
+      if (first.find(",1,physical,") == std::string::npos) continue;
+      EXPECT_NE(first.find("neutrally stable"), std::string::npos) << model << " branch " << b["id"] << ": " << first;
+      ++checked;
+    }
+    EXPECT_GE(checked, 2) << model;
+    fs::remove_all(dir);
+  }
+}
+
+TEST(Starts, ASingularStartThatIsNoOrbitIsRefusedPerSegmentBeforeAnythingIsWritten) {
+  const fs::path file = fs::temp_directory_path() / "hybridcont_true_start" / "slip.toml";
+  WriteEditedModel("slip.toml", "x3_l = \"l0\", H = \"m*g*l0\"", "x3_l = \"l0\", H = \"m*g*l0 + 0.05\"", file);
+  const fs::path out = file.parent_path() / "out";
+  const CliResult r = RunTool({"run", file.string(), "--out", out.string(), "--quiet", "--no-plots"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("slip.toml:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("is not a periodic orbit: max |r| = 0.05"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the first integral at x1 differs from the level H by -0.05"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(r.out.find("figures written"), std::string::npos);
+}
+
+TEST(Starts, UnsetStatesAreNamedWhenTheCycleCannotBeIntegrated) {
+  const fs::path file = fs::temp_directory_path() / "hybridcont_true_unset" / "slip.toml";
+  WriteEditedModel("slip.toml", ", x2_y = \"l0\", x3_l = \"l0\"", "", file);
+  const fs::path out = file.parent_path() / "out";
+  const CliResult r = RunTool({"run", file.string(), "--out", out.string(), "--quiet", "--no-plots"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("the cycle cannot be integrated from it"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("not given (taken as 0): x3_alpha, x3_l,"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Starts, AGuessNewtonMovesIsReported) {
+  const fs::path file = fs::temp_directory_path() / "hybridcont_true_guess" / "ball-ceiling.toml";
+  WriteEditedModel("ball-ceiling.toml", "values = { H = 0.5,", "values = { H = 0.55,", file);
+  const fs::path out = file.parent_path() / "out";
+  const CliResult r = RunTool({"run", file.string(), "--out", out.string(), "--no-plots", "--one-word"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  // At H = 0.55 the ball passes the section (y = 1/4) at speed sqrt(2 (0.55 - 0.25)) = 0.774597.
+  EXPECT_NE(r.out.find("start: the guess is not an orbit (max |r| = 0.05); Newton moved it at H = 0.55"),
+            std::string::npos)
+      << r.out.substr(0, 600);
+  EXPECT_NE(r.out.find("x1_v -0.707107 -> -0.774597"), std::string::npos) << r.out.substr(0, 600);
+  fs::remove_all(file.parent_path());
+}
+
+}  // namespace
+}  // namespace hybridcont::app
