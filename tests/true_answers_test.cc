@@ -25,6 +25,7 @@
 
 #include "cli_runner.h"
 #include "csv_columns.h"
+#include "edited_model.h"
 
 namespace hybridcont::app {
 namespace {
@@ -44,17 +45,6 @@ nlohmann::json RunQuietly(const std::vector<std::string>& model_and_options, con
   EXPECT_EQ(r.code, 0) << r.err;
   std::ifstream in(dir / "summary.json");
   return nlohmann::json::parse(in);
-}
-
-// Writes models/<name> with its one occurrence of `from` replaced by `to` to `path`, in a fresh folder.
-void WriteEditedModel(const std::string& name, const std::string& from, const std::string& to, const fs::path& path) {
-  fs::remove_all(path.parent_path());
-  fs::create_directories(path.parent_path());
-  std::ifstream in(ModelPath(name));
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  ASSERT_NE(text.find(from), std::string::npos) << from;
-  text.replace(text.find(from), from.size(), to);
-  std::ofstream(path) << text;
 }
 
 TEST(VibratingTable, FoldIsOneTurningPointAtTheClosedFormAndImpactPhasesAreExact) {
@@ -212,7 +202,7 @@ TEST(BranchPointStability, SwitchedBranchesStartNeutralInBothRodModels) {
 
 TEST(Starts, ASingularStartThatIsNoOrbitIsRefusedPerSegmentBeforeAnythingIsWritten) {
   const fs::path file = fs::temp_directory_path() / "hybridcont_true_start" / "slip.toml";
-  WriteEditedModel("slip.toml", "x3_l = \"l0\", H = \"m*g*l0\"", "x3_l = \"l0\", H = \"m*g*l0 + 0.05\"", file);
+  ASSERT_TRUE(WriteEditedModel("slip.toml", "x3_l = \"l0\", H = \"m*g*l0\"", "x3_l = \"l0\", H = \"m*g*l0 + 0.05\"", file));
   const fs::path out = file.parent_path() / "out";
   const CliResult r = RunTool({"run", file.string(), "--out", out.string(), "--quiet", "--no-plots"});
   EXPECT_EQ(r.code, 2);
@@ -225,7 +215,7 @@ TEST(Starts, ASingularStartThatIsNoOrbitIsRefusedPerSegmentBeforeAnythingIsWritt
 
 TEST(Starts, UnsetStatesAreNamedWhenTheCycleCannotBeIntegrated) {
   const fs::path file = fs::temp_directory_path() / "hybridcont_true_unset" / "slip.toml";
-  WriteEditedModel("slip.toml", ", x2_y = \"l0\", x3_l = \"l0\"", "", file);
+  ASSERT_TRUE(WriteEditedModel("slip.toml", ", x2_y = \"l0\", x3_l = \"l0\"", "", file));
   const fs::path out = file.parent_path() / "out";
   const CliResult r = RunTool({"run", file.string(), "--out", out.string(), "--quiet", "--no-plots"});
   EXPECT_EQ(r.code, 2);
@@ -236,7 +226,7 @@ TEST(Starts, UnsetStatesAreNamedWhenTheCycleCannotBeIntegrated) {
 
 TEST(Starts, AGuessNewtonMovesIsReported) {
   const fs::path file = fs::temp_directory_path() / "hybridcont_true_guess" / "ball-ceiling.toml";
-  WriteEditedModel("ball-ceiling.toml", "values = { H = 0.5,", "values = { H = 0.55,", file);
+  ASSERT_TRUE(WriteEditedModel("ball-ceiling.toml", "values = { H = 0.5,", "values = { H = 0.55,", file));
   const fs::path out = file.parent_path() / "out";
   const CliResult r = RunTool({"run", file.string(), "--out", out.string(), "--no-plots", "--one-word"});
   EXPECT_EQ(r.code, 0) << r.err;

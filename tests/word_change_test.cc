@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
+#include "edited_model.h"
 #include "csv_columns.h"
 #include "hybridcont/model_builder.h"
 #include "hybridcont/model_file.h"
@@ -34,19 +35,6 @@ nlohmann::json RunModel(const std::string& file, const fs::path& dir) {
   EXPECT_EQ(r.code, 0) << r.err;
   std::ifstream in(dir / "summary.json");
   return nlohmann::json::parse(in);
-}
-
-// Writes models/<name> with its one occurrence of `from` replaced by `to` to `path`, in a fresh folder;
-// false when `from` does not occur.
-bool WriteEditedModel(const std::string& name, const std::string& from, const std::string& to, const fs::path& path) {
-  fs::remove_all(path.parent_path());
-  fs::create_directories(path.parent_path());
-  std::ifstream in(std::string(HYBRIDCONT_SOURCE_DIR) + "/models/" + name);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (text.find(from) == std::string::npos) return false;
-  text.replace(text.find(from), from.size(), to);
-  std::ofstream(path) << text;
-  return true;
 }
 
 // A start in another word is checked for energy conservation like the file's word: the bipedal model's
