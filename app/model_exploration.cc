@@ -12,6 +12,7 @@
 #include "hybridcont/observable_test_functions.h"
 #include "hybridcont/internal/enum_names.h"
 #include "hybridcont/period_doubling.h"
+#include "hybridcont/simulation_start.h"
 #include "hybridcont/start_check.h"
 
 namespace hybridcont::app {
@@ -317,8 +318,27 @@ bool ModelExploration::PrepareStart(std::string* why) {
   prepared_start_ = scenario_.start;
   start_report_.clear();
   const StartSpec& spec = model_.setup().start;
-  if (spec.kind == StartSpec::Kind::kSimulation) return true;  // a non-conservative model's (FindOrbitStarts)
-  const StartResidual residual = ExplainStartResidual(model_, spec, integrator_);
+  Vector simulated;  // a simulation start's cycle: the states and durations filled in from x1
+  if (spec.kind == StartSpec::Kind::kSimulation) {
+    if (model_.num_first_integrals() == 0) return true;  // its starts are FindOrbitStarts' (orbit_start.h)
+    // A conservative model's: one cycle (or `cycles`) of the event-driven simulation from the given x1 is a
+    // guess at the level H(x1), which Newton corrects as any guess.
+    SimulationStartOptions options;
+    options.integrator.integrator = integrator_;
+    if (spec.cycles > 0) options.max_cycles = spec.cycles, options.require_convergence = false;
+    const ShootingLayout base(model_);
+    const SimulationStartResult s =
+        SimulateToOrbit(model_, scenario_.start.segment(base.state_offset(0), base.dim(0)), options);
+    if (!s.converged) {
+      *why = "the start (kind = \"simulation\"): the event-driven simulation from the given state did not give a "
+             "cycle: " + s.message;
+      return false;
+    }
+    simulated = s.u;
+    prepared_start_ = simulated;
+  }
+  const StartResidual residual =
+      ExplainStartResidual(model_, spec, integrator_, simulated.size() ? &simulated : nullptr);
   if (spec.kind == StartSpec::Kind::kSingular) {
     const double tolerance = SingularStartTolerance(residual.u);
     if (residual.max_residual <= tolerance) return true;
@@ -332,19 +352,20 @@ bool ModelExploration::PrepareStart(std::string* why) {
     return false;
   }
   if (state_) return true;  // a guess: corrected by the time-based exploration that finds the state start
-  // An approximate orbit (StartSpec::kGuess): Newton at the guess's level H; the exploration starts from the
-  // corrected orbit, a regular point of its family.
-  Vector start = scenario_.start;
+  // An approximate orbit (StartSpec::kGuess, or a simulated cycle): Newton at the guess's level H; the
+  // exploration starts from the corrected orbit, a regular point of its family.
+  Vector start = simulated.size() ? simulated : scenario_.start;
   if (shooting_.layout().num_observables() > 0) start = shooting_.CompleteUnknowns(start);
   Corrector corrector(scaled_.get());
   const Vector guess = scaled_->ToScaled(start);
   const int h = scaled_->UnknownIndex("H");
   Vector corrected;
   const CorrectorResult result = corrector.CorrectFixedComponent(guess, h, guess(h), &corrected);
+  const char* what = simulated.size() ? "the simulated cycle" : "the guess";
   if (!result.converged()) {
-    *why = fmt::format("the start guess does not converge to an orbit at H = {:.10g} ({}); at the guess, max |r| = "
+    *why = fmt::format("the start: {} does not converge to an orbit at H = {:.10g} ({}); there, max |r| = "
                        "{:.3g}:\n{}",
-                       start(shooting_.layout().H_index()), result.message, residual.max_residual,
+                       what, start(shooting_.layout().H_index()), result.message, residual.max_residual,
                        residual.Explain(SingularStartTolerance(residual.u)));
     while (!why->empty() && why->back() == '\n') why->pop_back();
     return false;
@@ -365,9 +386,9 @@ bool ModelExploration::PrepareStart(std::string* why) {
       moved += fmt::format("{}{} {:.6g} -> {:.6g}", moved.empty() ? "" : ", ", names[i], start(i),
                            prepared_start_(i));
     }
-    start_report_ = fmt::format("start: the guess is not an orbit (max |r| = {:.3g}); Newton moved it at H = {:.10g} "
+    start_report_ = fmt::format("start: {} is not an orbit (max |r| = {:.3g}); Newton moved it at H = {:.10g} "
                                 "in {} iterations: {}\n",
-                                residual.max_residual, start(shooting_.layout().H_index()), result.iterations, moved);
+                                what, residual.max_residual, start(shooting_.layout().H_index()), result.iterations, moved);
   }
   return true;
 }

@@ -35,14 +35,15 @@ def first_crossing(rhs, x0, watched, horizon=20.0, chunk=0.5, grid=400):
     raise AssertionError("no guard crossed")
 
 
-def replay(modes, anchor, mode, x1, legs):
+def replay(modes, anchor, mode, x1, legs, horizon=20.0):
     """Simulates from the section state x1 in `mode`: the transitions taken, the time to the section (the
-    anchor's crossing, watched after `legs` transitions) and the state there."""
+    anchor's crossing, watched after `legs` transitions) and the state there. A leg longer than `horizon`
+    raises AssertionError."""
     x, t, taken = list(x1), 0.0, []
     for leg in range(legs + 1):
         rhs, out = modes[mode]
         watched = list(out) + ([anchor] if leg == legs else [])
-        j, dt, x_end = first_crossing(rhs, x, watched)
+        j, dt, x_end = first_crossing(rhs, x, watched, horizon=horizon)
         t += dt
         name, _, target, reset = watched[j]
         if name == "anchor" or leg == legs:

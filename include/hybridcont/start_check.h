@@ -39,15 +39,17 @@ struct StartResidual {
   std::string Explain(double tolerance) const;
 
  private:
-  friend StartResidual ExplainStartResidual(const HybridModel&, const StartSpec&, const IntegratorOptions&);
+  friend StartResidual ExplainStartResidual(const HybridModel&, const StartSpec&, const IntegratorOptions&,
+                                            const Vector*);
   std::vector<std::string> block_lines_;  // per block: its description
   std::vector<std::vector<std::pair<std::string, double>>> block_entries_;  // per block: named entries
 };
 
-// r at the start, block by block (see the header comment). Throws ModelInputError for a start value that
-// does not evaluate or names no unknown (StartPoint).
+// r at the start, block by block (see the header comment); at `at` instead of StartPoint(start) when given
+// (a start whose states a simulation filled in). Throws ModelInputError for a start value that does not
+// evaluate or names no unknown (StartPoint).
 StartResidual ExplainStartResidual(const HybridModel& model, const StartSpec& start,
-                                   const IntegratorOptions& integrator);
+                                   const IntegratorOptions& integrator, const Vector* at = nullptr);
 
 // The tolerance below which a singular start counts as an exact zero of r: rounding of the start's
 // expressions and of one evaluation, relative to the size of u.

@@ -22,9 +22,9 @@ constexpr int kNamedEntries = 4;
 double SingularStartTolerance(const Vector& u) { return 1e-8 * (1.0 + (u.size() ? u.lpNorm<Eigen::Infinity>() : 0.0)); }
 
 StartResidual ExplainStartResidual(const HybridModel& model, const StartSpec& start,
-                                   const IntegratorOptions& integrator) {
+                                   const IntegratorOptions& integrator, const Vector* at) {
   StartResidual out;
-  out.u = StartPoint(model, start);
+  out.u = at != nullptr ? *at : StartPoint(model, start);
   const ShootingLayout layout(model);
   const std::vector<std::string>& names = layout.unknown_names();
   for (int i = 0; i < layout.num_unknowns(); ++i) {
@@ -32,7 +32,7 @@ StartResidual ExplainStartResidual(const HybridModel& model, const StartSpec& st
     if (i >= layout.xi_index(0) && i < layout.xi_index(0) + layout.num_first_integrals()) continue;  // 0 on orbits
     const bool given = std::any_of(start.values.begin(), start.values.end(),
                                    [&](const auto& v) { return v.first == name; });
-    if (!given) out.unset.push_back(name);
+    if (!given && at == nullptr) out.unset.push_back(name);
   }
   TimeBasedShooting shooting(model, integrator);
   shooting.set_threads(1);
