@@ -6,6 +6,7 @@
 #include <map>
 #include <vector>
 
+#include "hybridcont/family_ranges.h"
 #include "hybridcont/floquet.h"
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/timebased_shooting.h"
@@ -112,13 +113,32 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
     }
     for (const Branch& b : d.branches) {
       writer.EndBranch(b);
+      // Where the stability changes: at the special point located between the two points (family_ranges.h),
+      // else between them, not located (the later point's value).
       nlohmann::json changes = nlohmann::json::array();
       const std::vector<double>& stable = log.stable[b.id];
+      std::vector<bool> physical(stable.size()), is_stable(stable.size()), boundary(stable.size(), false);
+      for (size_t i = 0; i < stable.size(); ++i) physical[i] = std::isfinite(stable[i]), is_stable[i] = stable[i] == 1;
+      const BranchRanges ranges = physical.size() == b.points.size()
+                                      ? RangesOnBranch(b, physical, is_stable, boundary, layout.continued_index())
+                                      : BranchRanges{};
       double previous = std::nan("");
       for (size_t i = 0; i < stable.size(); ++i) {
         if (!std::isfinite(stable[i])) continue;
         if (std::isfinite(previous) && stable[i] != previous) {
-          changes.push_back({{"after_point", i - 1}, {layout.continued_name(), log.H[b.id][i]}, {"stable", stable[i] == 1}});
+          nlohmann::json change = {{"after_point", i - 1}, {layout.continued_name(), log.H[b.id][i]},
+                                   {"stable", stable[i] == 1}, {"located", false}};
+          for (const Range& r : ranges.stable) {  // a stable stretch that begins at point i or ends before it
+            const RangeEnd* end = r.first_point == static_cast<int>(i)      ? &r.from
+                                  : r.last_point + 1 == static_cast<int>(i) ? &r.to
+                                                                            : nullptr;
+            if (end == nullptr || end->special_point < 0) continue;
+            change[layout.continued_name()] = end->value;
+            change["located"] = end->located;
+            change["special_point"] = end->special_point;
+            change["how"] = end->how;
+          }
+          changes.push_back(change);
         }
         previous = stable[i];
       }
@@ -130,8 +150,9 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
       const FloquetResult f = b.points.empty() ? FloquetResult{} : ComputeFloquet(floquet_map, start);
       std::string flips;
       for (const nlohmann::json& c : changes) {
-        flips += fmt::format("{}{} = {:.10f} ({})", flips.empty() ? "" : ", ", layout.continued_name(),
-                             c[layout.continued_name()].get<double>(), c["stable"].get<bool>() ? "stable" : "unstable");
+        flips += fmt::format("{}{} = {:.10f} ({}{})", flips.empty() ? "" : ", ", layout.continued_name(),
+                             c[layout.continued_name()].get<double>(), c["stable"].get<bool>() ? "stable" : "unstable",
+                             c.contains("how") ? ", " + c["how"].get<std::string>() : ", between two points, not located");
       }
       report += fmt::format("    branch {}: {} points, {}; start T = {:.12f} (2x parent {:.12f}), multipliers {}; "
                             "stability changes: {}\n",

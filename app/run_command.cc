@@ -24,6 +24,7 @@
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/conservation_check.h"
 #include "hybridcont/exploration.h"
+#include "hybridcont/family_ranges.h"
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/timebased_shooting.h"
@@ -100,6 +101,9 @@ namespace {
 // could not be converted to the time-based layout).
 struct PointLog {
   std::map<int, std::vector<bool>> physical;
+  std::map<int, std::vector<bool>> stable;  // Floquet-stable (asymptotically or neutrally), physical points only
+  // Not physical only by lying on the boundary of the physical orbits: a zero duration, a tangential event.
+  std::map<int, std::vector<bool>> boundary;
 };
 
 // The exploration's point callback: converts each accepted point to the time-based layout (which every
@@ -117,6 +121,8 @@ class PointStream {
     Vector u;
     if (!exploration_.ToTimeBased(u_problem, &u).ok) {
       log_.physical[info.branch_id].push_back(false);  // keep per-point alignment
+      log_.stable[info.branch_id].push_back(false);
+      log_.boundary[info.branch_id].push_back(false);
       return;
     }
     PointRecord record = RecordOf(info, u);
@@ -124,6 +130,10 @@ class PointStream {
     AnalyzePoint(point_model_ ? *point_model_ : model_, setup_.integrator, floquet_map_, replay_options_, &record);
     writer_.AddPoint(info.branch_id, record);
     log_.physical[info.branch_id].push_back(record.classification.physical);
+    log_.stable[info.branch_id].push_back(record.classification.physical && record.extra.size() > 1 &&
+                                          record.extra[1].second == 1);
+    const OrbitClass reason = record.classification.reason;
+    log_.boundary[info.branch_id].push_back(reason == OrbitClass::kZeroDuration || reason == OrbitClass::kGrazing);
     if (!args_.quiet) PrintProgress(info, record);
   }
 
@@ -238,6 +248,49 @@ void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log,
     writer.AddOrbit(trace, c.branch, c.point, layout.has_level() ? u(layout.H_index()) : std::nan(""),
                     layout.Period(u), c.family);
   }
+}
+
+// Per branch with physical orbits: its family's name, where its orbits are physical and where stable, in the
+// continued coordinate, each end from the special point located there (family_ranges.h); the same into each
+// branch's summary.json entry ("physical_ranges", "stable_ranges").
+std::string RangesReport(const BifurcationDiagram& diagram, const PointLog& log, const Scenario& sc,
+                         const ShootingLayout& layout, ResultsWriter& writer) {
+  const int x = layout.continued_index();
+  const std::string& name = layout.continued_name();
+  std::string report = fmt::format("Physical families (where their orbits are physical and where stable, in {}):\n", name);
+  const auto json_of = [](const std::vector<Range>& ranges) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const Range& r : ranges) {
+      a.push_back({{"from", r.from.value}, {"to", r.to.value}, {"from_how", r.from.how}, {"to_how", r.to.how},
+                   {"from_special_point", r.from.special_point}, {"to_special_point", r.to.special_point},
+                   {"first_point", r.first_point}, {"last_point", r.last_point}});
+    }
+    return a;
+  };
+  int count = 0;
+  for (const Branch& b : diagram.branches) {
+    const auto physical = log.physical.find(b.id), stable = log.stable.find(b.id), boundary = log.boundary.find(b.id);
+    if (physical == log.physical.end() || stable == log.stable.end() || boundary == log.boundary.end()) continue;
+    if (std::none_of(physical->second.begin(), physical->second.end(), [](bool p) { return p; })) continue;
+    if (physical->second.size() != b.points.size()) continue;  // points not all classified (a failed conversion)
+    const BranchRanges ranges = RangesOnBranch(b, physical->second, stable->second, boundary->second, x);
+    writer.AnnotateBranch(b.id, {{"physical_ranges", json_of(ranges.physical)}, {"stable_ranges", json_of(ranges.stable)}});
+    // Named at the middle of its first physical stretch: its ends may be shared with another family (an SB
+    // point where hopping in place and forward hopping meet).
+    const Range& first = ranges.physical.front();
+    report += fmt::format("  branch {} ({}{}):\n", b.id, sc.describe(b.points[(first.first_point + first.last_point + 1) / 2].u),
+                          b.image_of >= 0 ? fmt::format(", image of branch {}", b.image_of) : "");
+    for (const Range& r : ranges.physical) {
+      report += fmt::format("    physical from {} = {} to {}\n", name, ToString(r.from), ToString(r.to));
+    }
+    if (ranges.stable.empty()) report += "    stable nowhere\n";
+    for (const Range& r : ranges.stable) {
+      report += fmt::format("    stable   from {} = {} to {}\n", name, ToString(r.from), ToString(r.to));
+    }
+    ++count;
+  }
+  if (count == 0) report += "  none\n";
+  return report;
 }
 
 // The Floquet crossings among the diagram's special points (located by the exploration as test functions,
@@ -356,9 +409,10 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   }
   writer.SetSpecialPoints(special_points);
   WriteKeyframeOrbits(diagram, stream.log(), model, setup, layout, writer);
+  const std::string ranges = RangesReport(diagram, stream.log(), setup.scenario, layout, writer);
   const std::string report =
-      RunReport(diagram, starts_report + floquet_report + period_doubled + words + curves_report, start_time, exploration,
-                stream.floquet_map());
+      RunReport(diagram, starts_report + floquet_report + ranges + period_doubled + words + curves_report, start_time,
+                exploration, stream.floquet_map());
   writer.SetReport(report);
   out << report;
   return FinishAndDraw(args, diagram, writer, out, err);

@@ -11,23 +11,6 @@ namespace hybridcont::app {
 
 namespace {
 
-std::string SpecialPointTypeCode(SpecialPointType type) {
-  switch (type) {
-    case SpecialPointType::kSimpleBifurcation: return "SB";
-    case SpecialPointType::kTurningPoint: return "TP";
-    case SpecialPointType::kSingularStart: return "start";
-    case SpecialPointType::kFloquetBranchPoint: return "BP";
-    case SpecialPointType::kPeriodDoubling: return "PD";
-    case SpecialPointType::kUserTestFunction: return "test";
-    case SpecialPointType::kGrazing: return "GR";
-    case SpecialPointType::kNeimarkSacker: return "NS";
-    case SpecialPointType::kObservableValue: return "UZ";
-    case SpecialPointType::kConstraintBoundary: return "CB";
-    case SpecialPointType::kKreinCollision: return "KC";
-  }
-  return "?";
-}
-
 nlohmann::json BoundsJson(const ContinuationOptions& c) {
   nlohmann::json bounds = nlohmann::json::array();
   for (const auto& b : c.bounds) bounds.push_back({{"component", b.component}, {"lower", b.lower}, {"upper", b.upper}});
@@ -92,7 +75,7 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
         sp.interval_width.size() ? sp.interval_width.array().isNaN().select(0.0, sp.interval_width.array()).matrix().norm()
                                  : sp.precision();
     nlohmann::json j = {{"id", sp.id},
-                        {"type", SpecialPointTypeCode(sp.type)},
+                        {"type", Code(sp.type)},
                         {"branch", sp.branch_id},
                         {"index", sp.index},
                         {"H", H},

@@ -76,6 +76,23 @@ TEST(VibratingTable, FoldIsOneTurningPointAtTheClosedFormAndImpactPhasesAreExact
     }
   }
   EXPECT_GT(physical, 50);
+  // Stable (late impact) from the fold, where it meets the saddle of early impact, to a period doubling: both
+  // ends the located points, in summary.json's stable ranges.
+  std::set<std::string> stable_ends;
+  for (const nlohmann::json& b : summary["branches"]) {
+    if (!b.contains("stable_ranges")) continue;
+    for (const nlohmann::json& r : b["stable_ranges"]) {
+      for (const char* end : {"from", "to"}) {
+        const std::string how = r[std::string(end) + "_how"].get<std::string>();
+        if (how.rfind("TP #", 0) == 0) {
+          EXPECT_NEAR(r[end].get<double>(), A_sn, 1e-10);
+          stable_ends.insert("TP");
+        }
+        if (how.rfind("PD #", 0) == 0) stable_ends.insert("PD");
+      }
+    }
+  }
+  EXPECT_EQ(stable_ends, (std::set<std::string>{"TP", "PD"}));
   // The two key frames: one orbit of each half of the fold, named by the sign of the impact phase.
   std::set<std::string> labels;
   for (const nlohmann::json& o : summary["orbits"]) labels.insert(o["label"].get<std::string>());

@@ -52,6 +52,9 @@ enum class SpecialPointType {
   kKreinCollision,      // two pairs of multipliers of a symplectic map collide on the unit circle (KC; floquet.h)
 };
 std::string ToString(SpecialPointType type);
+// The short code of reports and summary.json: "SB", "TP", "start", "BP", "PD", "test", "GR", "NS", "UZ", "CB",
+// "KC".
+std::string Code(SpecialPointType type);
 
 enum class LocationStatus {
   kLocated,    // bracket narrower than the location tolerance

@@ -31,6 +31,23 @@ constexpr internal::EnumName<LocationStatus> kLocationStatusNames[] = {
 
 std::string ToString(SpecialPointType type) { return internal::EnumToString(kSpecialPointTypeNames, type); }
 
+std::string Code(SpecialPointType type) {
+  switch (type) {
+    case SpecialPointType::kSimpleBifurcation: return "SB";
+    case SpecialPointType::kTurningPoint: return "TP";
+    case SpecialPointType::kSingularStart: return "start";
+    case SpecialPointType::kFloquetBranchPoint: return "BP";
+    case SpecialPointType::kPeriodDoubling: return "PD";
+    case SpecialPointType::kUserTestFunction: return "test";
+    case SpecialPointType::kGrazing: return "GR";
+    case SpecialPointType::kNeimarkSacker: return "NS";
+    case SpecialPointType::kObservableValue: return "UZ";
+    case SpecialPointType::kConstraintBoundary: return "CB";
+    case SpecialPointType::kKreinCollision: return "KC";
+  }
+  return "?";
+}
+
 std::string ToString(LocationStatus status) { return internal::EnumToString(kLocationStatusNames, status); }
 
 std::string SpecialPoint::BriefReport(const std::vector<std::string>& names) const {

@@ -1,0 +1,59 @@
+// Where a branch's orbits are physical and where they are stable, in the coordinate the family is followed in,
+// each end taken from the special point located there.
+//
+// A run classifies every accepted point (classification.h) and the Floquet multipliers of the physical ones
+// (floquet.h). A class changes between two points; what a person needs is where, to the precision the tool
+// can give: the special point the exploration located between those two points that explains the change —
+// a grazing point (GR), a constraint boundary (CB) or a turning point (TP) for an end of the physical
+// stretch, a multiplier crossing (BP, PD, NS, KC) or a turning point or SB point for a change of stability.
+// Without such a point the end is said to lie between the two points, not located.
+//
+//   std::vector<bool> physical = ..., stable = ...;   // per point of branch b
+//   BranchRanges r = RangesOnBranch(b, physical, stable, layout.continued_index());
+//   for (const Range& p : r.physical) p.from.value, p.from.how ("GR #3, located to 1.8e-10"), p.to ...
+#ifndef HYBRIDCONT_FAMILY_RANGES_H_
+#define HYBRIDCONT_FAMILY_RANGES_H_
+
+#include <string>
+#include <vector>
+
+#include "hybridcont/continuation.h"
+
+namespace hybridcont {
+
+struct RangeEnd {
+  double value = 0;        // the coordinate at the end
+  bool located = false;    // a located special point, or a point of the branch (its first or last)
+  double precision = 0;    // of the special point in the coordinate (0 at a branch point); NaN unknown
+  int special_point = -1;  // its id, −1 for none
+  // "GR #3, located to 1.8e-10", "start of the branch", "end of the branch, bound-reached", "point 0,
+  // zero duration", "between points 4 and 5, not located".
+  std::string how;
+};
+
+struct Range {
+  RangeEnd from, to;       // in the order of the branch's points
+  int first_point = 0, last_point = 0;
+};
+
+struct BranchRanges {
+  int branch = -1;
+  std::vector<Range> physical;  // maximal runs of physical points
+  std::vector<Range> stable;    // maximal runs of stable physical points
+};
+
+// The ranges of branch b (special points from b.special_points). physical[i] and stable[i] are the classes
+// of b.points[i] (stable only counts where physical); boundary[i] marks a point that is not physical only
+// because it lies on the boundary of the physical orbits (a phase of zero duration, a tangential event): a
+// physical stretch next to it ends at it, exactly. `coordinate` indexes u. A stable stretch of the branch's
+// start point alone, where the branch leaves a special point (the bifurcation itself, neutral there), is no
+// stretch and is left out.
+BranchRanges RangesOnBranch(const Branch& b, const std::vector<bool>& physical, const std::vector<bool>& stable,
+                            const std::vector<bool>& boundary, int coordinate);
+
+// "1.2467401100 (BP #1, located, precision 1.8e-10)" for a report line.
+std::string ToString(const RangeEnd& end);
+
+}  // namespace hybridcont
+
+#endif  // HYBRIDCONT_FAMILY_RANGES_H_
