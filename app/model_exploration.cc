@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "hybridcont/classification.h"
+#include "hybridcont/branch_switching.h"
 #include "hybridcont/corrector.h"
 #include "hybridcont/floquet_test_functions.h"
 #include "hybridcont/observable_test_functions.h"
@@ -341,7 +342,7 @@ bool ModelExploration::PrepareStart(std::string* why) {
       ExplainStartResidual(model_, spec, integrator_, simulated.size() ? &simulated : nullptr);
   if (spec.kind == StartSpec::Kind::kSingular) {
     const double tolerance = SingularStartTolerance(residual.u);
-    if (residual.max_residual <= tolerance) return true;
+    if (residual.max_residual <= tolerance) return state_ || SingularStartHasDirections(why);
     const std::string size = residual.evaluated ? fmt::format("max |r| = {:.3g}", residual.max_residual)
                                                 : std::string("r cannot be evaluated");
     *why = fmt::format("the start (kind = \"singular\") is not a periodic orbit: {} (an exact zero of r is needed, to "
@@ -391,6 +392,37 @@ bool ModelExploration::PrepareStart(std::string* why) {
                                 what, residual.max_residual, start(shooting_.layout().H_index()), result.iterations, moved);
   }
   return true;
+}
+
+bool ModelExploration::SingularStartHasDirections(std::string* why) {
+  Vector start = scenario_.start;
+  if (shooting_.layout().num_observables() > 0) start = shooting_.CompleteUnknowns(start);
+  StartOptions options;
+  options.switching = options_.switching;
+  options.conditions = options_.start_conditions;
+  const BranchDirections d = AnalyzeSingularPoint(scaled_.get(), scaled_->ToScaled(start), options);
+  if (d.status == BranchSwitchStatus::kRegular || !d.directions.empty()) return true;
+  // No branch direction: name the kernel of dr, each basis vector in model units by its largest components,
+  // so that the conditions that select the families (linear conditions on the direction) can be written.
+  const std::vector<std::string> names = shooting_.layout().unknown_names();
+  std::string kernel;
+  for (Eigen::Index c = 0; c < d.kernel.cols(); ++c) {
+    const Vector v = (d.kernel.col(c).cwiseProduct(scaled_->scales())).normalized();
+    std::vector<int> order(v.size());
+    for (int i = 0; i < v.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return std::abs(v(a)) > std::abs(v(b)); });
+    std::string terms;
+    for (int k = 0; k < v.size() && std::abs(v(order[k])) >= 0.05; ++k) {
+      terms += fmt::format("{}{} {:+.3f}", terms.empty() ? "" : ", ", names[order[k]], v(order[k]));
+    }
+    kernel += fmt::format("    direction {}: {}\n", c + 1, terms.empty() ? "(no component above 0.05)" : terms);
+  }
+  *why = fmt::format("the start (kind = \"singular\") is an orbit, but no family through it can be chosen: {}; the "
+                     "kernel of dr there (the directions families may leave in, components of at least 0.05, in the "
+                     "unknowns' units) is spanned by\n{}  give [start] conditions (Σ coefficient · direction[unknown] = 0) "
+                     "that leave one or two of them",
+                     d.BriefReport(), kernel);
+  return false;
 }
 
 BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {

@@ -114,6 +114,9 @@ class ModelExploration {
   ExplorationOptions EngineOptions(const PointCallback& on_point, int branch_offset = 0);
   // The diagram's points and special points from scaled to model units.
   void ToModelUnits(BifurcationDiagram* diagram) const;
+  // Whether the singular start (an orbit) has branch directions under the start conditions; if not, false with
+  // the kernel of dr there in *why.
+  bool SingularStartHasDirections(std::string* why);
   // The first physical point of the time-based scenario, or an empty vector (message in *why).
   Vector FindPhysicalStart(std::string* why);
 

@@ -309,7 +309,14 @@ std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayou
                                    std::pair{SpecialPointType::kObservableValue, "UZ"}}) {
     for (const SpecialPoint& sp : diagram.special_points) {
       if (sp.type != type || sp.u.size() == 0) continue;
-      const double precision = sp.interval_width.size() ? sp.interval_width.norm() : sp.precision();
+      // Over the components the point's layout has (a state-based point converted to the time-based layout
+      // has no widths for the durations and the later segments' states: NaN there).
+      double precision = 0;
+      bool widths = false;
+      for (Eigen::Index i = 0; i < sp.interval_width.size(); ++i) {
+        if (std::isfinite(sp.interval_width(i))) precision += sp.interval_width(i) * sp.interval_width(i), widths = true;
+      }
+      precision = widths ? std::sqrt(precision) : sp.precision();
       report += fmt::format("  {} on branch {} after point {}: {} = {:.12f}, T = {:.12f} ({}, precision {:.1e}){}\n", code,
                             sp.branch_id, sp.index, layout.continued_name(), sp.u(layout.continued_index()),
                             layout.Period(sp.u), ToString(sp.status), precision,

@@ -255,5 +255,26 @@ TEST(Starts, AGuessNewtonMovesIsReported) {
   fs::remove_all(file.parent_path());
 }
 
+// The rod's start (at rest on both ends) has a kernel of dimension 3 without its file's condition t2 = t1 + t3;
+// one of its directions is the ξ axis, into the rest states of the unfolding, which the tool excludes itself:
+// the same diagram as with the condition.
+TEST(Starts, TheXiAxisOfASingularStartIsExcludedByTheToolItself) {
+  const fs::path file = fs::temp_directory_path() / "hybridcont_true_rod" / "bouncing-rod.toml";
+  ASSERT_TRUE(WriteEditedModel("bouncing-rod.toml",
+                               "conditions = [{ terms = { t2 = 1, t1 = -1, t3 = -1 }, description = \"t2 = t1 + t3\" }]",
+                               "", file));
+  const fs::path out = file.parent_path() / "out";
+  const CliResult r = RunTool({"run", file.string(), "--out", out.string(), "--no-plots", "--quiet"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("the condition direction[xi] = 0 added"), std::string::npos) << r.out.substr(0, 2000);
+  std::ifstream in(out / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  EXPECT_EQ(summary["branches"].size(), 8u);
+  int sb = 0;
+  for (const nlohmann::json& sp : summary["special_points"]) sb += sp["type"] == "SB" && sp["duplicate_of"] == -1;
+  EXPECT_EQ(sb, 2);
+  fs::remove_all(file.parent_path());
+}
+
 }  // namespace
 }  // namespace hybridcont::app

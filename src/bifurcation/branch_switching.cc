@@ -291,6 +291,21 @@ BranchDirections AnalyzeSingularPoint(ZeroProblem* problem, const Vector& u0, co
     return out;
   }
   if (basis.cols() > 2) {
+    // ξ = 0 on every periodic orbit of a conservative model: where the ξ axis lies in the restricted kernel
+    // (it leads into the rest states of the dissipative unfolding, not into a family of orbits), the
+    // condition direction[ξ] = 0 is added and the analysis repeated.
+    const int xi = problem->UnknownIndex("xi");
+    const bool has_xi_condition = std::any_of(options.conditions.begin(), options.conditions.end(), [](const auto& c) {
+      return c.coefficients.size() == 1 && c.coefficients.front().first == "xi";
+    });
+    if (xi >= 0 && !has_xi_condition && (basis.transpose().col(xi)).norm() >= 1 - 1e-8) {
+      StartOptions with_xi = options;
+      with_xi.conditions.push_back(LinearCondition{{{"xi", 1.0}}});
+      BranchDirections again = AnalyzeSingularPoint(problem, u0, with_xi);
+      again.message = "the condition direction[xi] = 0 added (the xi axis leads into rest states, not orbits)" +
+                      (again.message.empty() ? std::string() : "; " + again.message);
+      return again;
+    }
     out.status = BranchSwitchStatus::kUnderdetermined;
     out.message = "kernel dimension " + std::to_string(out.kernel_dimension) + " restricted to " +
                   std::to_string(basis.cols()) + " by the conditions; give " + std::to_string(basis.cols() - 2) +
