@@ -357,11 +357,17 @@ bool ModelExploration::PrepareStart(std::string* why) {
   // exploration starts from the corrected orbit, a regular point of its family.
   Vector start = simulated.size() ? simulated : scenario_.start;
   if (shooting_.layout().num_observables() > 0) start = shooting_.CompleteUnknowns(start);
-  Corrector corrector(scaled_.get());
+  // On a clone of the problem, whose work is added to it afterwards: the exploration then starts from the
+  // corrected point with the problem's cache empty, as a worker thread's copy does, so that the run is the
+  // same bits whatever the number of threads.
+  const std::unique_ptr<ZeroProblem> clone = scaled_->Clone();
+  ZeroProblem* problem = clone ? clone.get() : scaled_.get();
+  Corrector corrector(problem);
   const Vector guess = scaled_->ToScaled(start);
   const int h = scaled_->UnknownIndex("H");
   Vector corrected;
   const CorrectorResult result = corrector.CorrectFixedComponent(guess, h, guess(h), &corrected);
+  if (clone) scaled_->AddWorkOf(*clone);
   const char* what = simulated.size() ? "the simulated cycle" : "the guess";
   if (!result.converged()) {
     *why = fmt::format("the start: {} does not converge to an orbit at H = {:.10g} ({}); there, max |r| = "

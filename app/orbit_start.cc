@@ -54,13 +54,32 @@ bool OneStart(const HybridModel& model, const RunSetup& setup, const StartSpec& 
       options.require_convergence = false;
     }
     const Vector x1 = u->segment(base.state_offset(0), base.dim(0));
-    const SimulationStartResult s = SimulateToOrbit(model, x1, options);
+    SimulationStartResult s = SimulateToOrbit(model, x1, options);
+    if (!s.converged && options.require_convergence && s.cycles >= 1) {
+      // The simulation does not settle (the walker falls: the orbit it passed near is unstable, or the start
+      // lies outside its basin): the cycle that changed least, closest to a periodic orbit, is Newton's guess
+      // instead, as with `cycles`.
+      const std::string why = s.message;
+      const int cycles = s.cycles;
+      options.require_convergence = false;
+      SimulationStartResult best;
+      for (int k = 1; k <= cycles; ++k) {
+        options.max_cycles = k;
+        const SimulationStartResult cycle = SimulateToOrbit(model, x1, options);
+        if (cycle.converged && (!best.converged || cycle.change < best.change)) best = cycle;
+      }
+      s = best;
+      if (s.converged) {
+        *report += fmt::format("event-driven simulation did not settle ({}): cycle {}, which changed least ({:.2g}), "
+                               "is the guess; ", why, s.cycles, s.change);
+      }
+    }
     if (!s.converged) {
       *report += "event-driven simulation did not settle on an orbit: " + s.message;
       return false;
     }
     *u = s.u;
-    *report += "event-driven simulation from the declared state, " + s.message + "; ";
+    if (report->empty()) *report += "event-driven simulation from the declared state, " + s.message + "; ";
   } else {
     *report += "the declared orbit; ";
   }

@@ -255,6 +255,26 @@ TEST(Starts, AGuessNewtonMovesIsReported) {
   fs::remove_all(file.parent_path());
 }
 
+// A guess start (the bipedal model's walking) is corrected the same way whatever the number of threads: the
+// branch files of one and two threads are the same bytes.
+TEST(Threads, AGuessStartGivesTheSameBitsOnOneAndTwoThreads) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_true_threads";
+  std::string files[2];
+  for (const int threads : {1, 2}) {
+    const fs::path out = dir / std::to_string(threads);
+    const CliResult r = RunTool({"run", ModelPath("bipedal-slip.toml"), "--one-word", "--max-branches", "2", "--threads",
+                                 std::to_string(threads), "--out", out.string(), "--quiet", "--no-plots", "--overwrite"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const char* name : {"branch-0.csv", "branch-1.csv"}) {
+      std::ifstream in(out / name);
+      files[threads - 1] += std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    }
+  }
+  EXPECT_GT(files[0].size(), 1000u);
+  EXPECT_TRUE(files[0] == files[1]);
+  fs::remove_all(dir);
+}
+
 // The rod's start (at rest on both ends) has a kernel of dimension 3 without its file's condition t2 = t1 + t3;
 // one of its directions is the ξ axis, into the rest states of the unfolding, which the tool excludes itself:
 // the same diagram as with the condition.

@@ -11,6 +11,7 @@
 
 #include "continuation/bordered_solver.h"
 #include "continuation/branch_geometry.h"
+#include "continuation/jacobian_tolerance_scope.h"
 #include "continuation/linear_stop.h"
 #include "continuation/predictor.h"
 #include "continuation/progress_report.h"
@@ -63,6 +64,10 @@ class ContinuationStepper::Impl {
     Vector u = u0;
     Matrix dr;
     if (options_.correct_start_point) {
+      // With the exact Jacobian: an exploration analyses its start's kernel with it first (branch_switching.h),
+      // which leaves it in the problem's cache, while a worker thread's copy of the problem starts from none;
+      // both then correct the start the same way, to the bit.
+      const internal::JacobianToleranceScope exact(problem_, 0.0, internal::JacobianToleranceScope::Mode::kExactly);
       if (const EvaluationStatus status = problem_->Evaluate(u0, nullptr, &dr); !status.ok) {
         return Finish(TerminationReason::kStartFailed, "evaluation at the start point failed: " + status.message);
       }
