@@ -258,12 +258,17 @@ std::string RangesReport(const BifurcationDiagram& diagram, const PointLog& log,
   const int x = layout.continued_index();
   const std::string& name = layout.continued_name();
   std::string report = fmt::format("Physical families (where their orbits are physical and where stable, in {}):\n", name);
-  const auto json_of = [](const std::vector<Range>& ranges) {
+  // A stretch is named at its middle point: its ends may be shared with another family (an SB point where
+  // hopping in place and forward hopping meet, a fold where two families of a forced system meet).
+  const auto family_of = [&](const Branch& b, const Range& r) {
+    return sc.describe(b.points[(r.first_point + r.last_point + 1) / 2].u);
+  };
+  const auto json_of = [&](const Branch& b, const std::vector<Range>& ranges) {
     nlohmann::json a = nlohmann::json::array();
     for (const Range& r : ranges) {
       a.push_back({{"from", r.from.value}, {"to", r.to.value}, {"from_how", r.from.how}, {"to_how", r.to.how},
                    {"from_special_point", r.from.special_point}, {"to_special_point", r.to.special_point},
-                   {"first_point", r.first_point}, {"last_point", r.last_point}});
+                   {"first_point", r.first_point}, {"last_point", r.last_point}, {"family", family_of(b, r)}});
     }
     return a;
   };
@@ -274,18 +279,22 @@ std::string RangesReport(const BifurcationDiagram& diagram, const PointLog& log,
     if (std::none_of(physical->second.begin(), physical->second.end(), [](bool p) { return p; })) continue;
     if (physical->second.size() != b.points.size()) continue;  // points not all classified (a failed conversion)
     const BranchRanges ranges = RangesOnBranch(b, physical->second, stable->second, boundary->second, x);
-    writer.AnnotateBranch(b.id, {{"physical_ranges", json_of(ranges.physical)}, {"stable_ranges", json_of(ranges.stable)}});
-    // Named at the middle of its first physical stretch: its ends may be shared with another family (an SB
-    // point where hopping in place and forward hopping meet).
-    const Range& first = ranges.physical.front();
-    report += fmt::format("  branch {} ({}{}):\n", b.id, sc.describe(b.points[(first.first_point + first.last_point + 1) / 2].u),
+    const std::string family = family_of(b, ranges.physical.front());
+    writer.AnnotateBranch(b.id, {{"family", family},
+                                 {"physical_ranges", json_of(b, ranges.physical)},
+                                 {"stable_ranges", json_of(b, ranges.stable)}});
+    report += fmt::format("  branch {} ({}{}):\n", b.id, family,
                           b.image_of >= 0 ? fmt::format(", image of branch {}", b.image_of) : "");
+    const auto other_family = [&](const Range& r) {
+      const std::string f = family_of(b, r);
+      return f == family ? std::string() : " (" + f + ")";
+    };
     for (const Range& r : ranges.physical) {
-      report += fmt::format("    physical from {} = {} to {}\n", name, ToString(r.from), ToString(r.to));
+      report += fmt::format("    physical from {} = {} to {}{}\n", name, ToString(r.from), ToString(r.to), other_family(r));
     }
     if (ranges.stable.empty()) report += "    stable nowhere\n";
     for (const Range& r : ranges.stable) {
-      report += fmt::format("    stable   from {} = {} to {}\n", name, ToString(r.from), ToString(r.to));
+      report += fmt::format("    stable   from {} = {} to {}{}\n", name, ToString(r.from), ToString(r.to), other_family(r));
     }
     ++count;
   }

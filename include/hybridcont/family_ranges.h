@@ -38,8 +38,10 @@ struct Range {
 
 struct BranchRanges {
   int branch = -1;
-  std::vector<Range> physical;  // maximal runs of physical points
-  std::vector<Range> stable;    // maximal runs of stable physical points
+  // Maximal runs of physical points, split at the turning points of the coordinate (folds) inside them:
+  // each runs one way in the coordinate, from its `from` to its `to`.
+  std::vector<Range> physical;
+  std::vector<Range> stable;    // the same of the stable physical points
 };
 
 // The ranges of branch b (special points from b.special_points). physical[i] and stable[i] are the classes

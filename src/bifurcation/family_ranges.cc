@@ -89,6 +89,20 @@ std::vector<Range> Runs(const Branch& b, const std::vector<bool>& in, int coordi
     r.from = i == 0 ? AtPoint(b, 0, coordinate, true) : Between(b, i - 1, coordinate, types, boundary, i - 1);
     r.to = j + 1 == static_cast<int>(b.points.size()) ? AtPoint(b, j, coordinate, false)
                                                        : Between(b, j, coordinate, types, boundary, j + 1);
+    // Split at the folds of the coordinate inside the run: each stretch runs one way in it, from end to end.
+    for (const SpecialPoint& sp : b.special_points) {
+      if (sp.type != SpecialPointType::kTurningPoint || sp.component_index != coordinate || sp.u.size() == 0 ||
+          sp.index < r.first_point || sp.index >= r.last_point) {
+        continue;
+      }
+      const SpecialPointType fold[] = {SpecialPointType::kTurningPoint};
+      Range before = r;
+      before.last_point = sp.index;
+      before.to = Between(b, sp.index, coordinate, fold, {}, 0);
+      r.first_point = sp.index + 1;
+      r.from = before.to;
+      runs.push_back(std::move(before));
+    }
     runs.push_back(std::move(r));
     i = j + 1;
   }
