@@ -174,7 +174,9 @@ const std::vector<ResultsWriter::ClassifiedPoint>& ResultsWriter::ClassifiedPoin
 }
 
 void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
-  classified_[branch_id].push_back({p.index, p.u, p.classification});
+  const bool stable = p.classification.physical && p.extra.size() > 1 && p.extra[1].first == "stable" &&
+                      p.extra[1].second == 1;
+  classified_[branch_id].push_back({p.index, p.u, p.classification, stable});
   if (!write_error_.empty()) return;  // a full disk: keep what is there, write nothing more
   const auto other = branch_models_.find(branch_id);
   const ShootingLayout& layout = other == branch_models_.end() ? layout_ : other->second.layout;

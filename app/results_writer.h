@@ -103,6 +103,7 @@ class ResultsWriter {
     int index = 0;
     Vector u;
     Classification classification;
+    bool stable = false;  // a physical orbit whose Floquet class is stable (asymptotically or neutrally)
   };
   const std::vector<ClassifiedPoint>& ClassifiedPoints(int branch_id) const;
   // Adds `fields` to the summary entry of branch `branch_id` (after EndBranch) and rewrites summary.json.

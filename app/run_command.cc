@@ -20,11 +20,11 @@
 #include <stdexcept>
 
 #include "commands.h"
+#include "family_report.h"
 #include "figure_script.h"
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/conservation_check.h"
 #include "hybridcont/exploration.h"
-#include "hybridcont/family_ranges.h"
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/timebased_shooting.h"
@@ -101,9 +101,6 @@ namespace {
 // could not be converted to the time-based layout).
 struct PointLog {
   std::map<int, std::vector<bool>> physical;
-  std::map<int, std::vector<bool>> stable;  // Floquet-stable (asymptotically or neutrally), physical points only
-  // Not physical only by lying on the boundary of the physical orbits: a zero duration, a tangential event.
-  std::map<int, std::vector<bool>> boundary;
 };
 
 // The exploration's point callback: converts each accepted point to the time-based layout (which every
@@ -121,8 +118,7 @@ class PointStream {
     Vector u;
     if (!exploration_.ToTimeBased(u_problem, &u).ok) {
       log_.physical[info.branch_id].push_back(false);  // keep per-point alignment
-      log_.stable[info.branch_id].push_back(false);
-      log_.boundary[info.branch_id].push_back(false);
+
       return;
     }
     PointRecord record = RecordOf(info, u);
@@ -130,10 +126,7 @@ class PointStream {
     AnalyzePoint(point_model_ ? *point_model_ : model_, setup_.integrator, floquet_map_, replay_options_, &record);
     writer_.AddPoint(info.branch_id, record);
     log_.physical[info.branch_id].push_back(record.classification.physical);
-    log_.stable[info.branch_id].push_back(record.classification.physical && record.extra.size() > 1 &&
-                                          record.extra[1].second == 1);
-    const OrbitClass reason = record.classification.reason;
-    log_.boundary[info.branch_id].push_back(reason == OrbitClass::kZeroDuration || reason == OrbitClass::kGrazing);
+
     if (!args_.quiet) PrintProgress(info, record);
   }
 
@@ -250,56 +243,15 @@ void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log,
   }
 }
 
-// Per branch with physical orbits: its family's name, where its orbits are physical and where stable, in the
-// continued coordinate, each end from the special point located there (family_ranges.h); the same into each
-// branch's summary.json entry ("physical_ranges", "stable_ranges").
-std::string RangesReport(const BifurcationDiagram& diagram, const PointLog& log, const Scenario& sc,
-                         const ShootingLayout& layout, ResultsWriter& writer) {
-  const int x = layout.continued_index();
-  const std::string& name = layout.continued_name();
-  std::string report = fmt::format("Physical families (where their orbits are physical and where stable, in {}):\n", name);
-  // A stretch is named at its middle point: its ends may be shared with another family (an SB point where
-  // hopping in place and forward hopping meet, a fold where two families of a forced system meet).
-  const auto family_of = [&](const Branch& b, const Range& r) {
-    return sc.describe(b.points[(r.first_point + r.last_point + 1) / 2].u);
-  };
-  const auto json_of = [&](const Branch& b, const std::vector<Range>& ranges) {
-    nlohmann::json a = nlohmann::json::array();
-    for (const Range& r : ranges) {
-      a.push_back({{"from", r.from.value}, {"to", r.to.value}, {"from_how", r.from.how}, {"to_how", r.to.how},
-                   {"from_special_point", r.from.special_point}, {"to_special_point", r.to.special_point},
-                   {"first_point", r.first_point}, {"last_point", r.last_point}, {"family", family_of(b, r)}});
-    }
-    return a;
-  };
-  int count = 0;
-  for (const Branch& b : diagram.branches) {
-    const auto physical = log.physical.find(b.id), stable = log.stable.find(b.id), boundary = log.boundary.find(b.id);
-    if (physical == log.physical.end() || stable == log.stable.end() || boundary == log.boundary.end()) continue;
-    if (std::none_of(physical->second.begin(), physical->second.end(), [](bool p) { return p; })) continue;
-    if (physical->second.size() != b.points.size()) continue;  // points not all classified (a failed conversion)
-    const BranchRanges ranges = RangesOnBranch(b, physical->second, stable->second, boundary->second, x);
-    const std::string family = family_of(b, ranges.physical.front());
-    writer.AnnotateBranch(b.id, {{"family", family},
-                                 {"physical_ranges", json_of(b, ranges.physical)},
-                                 {"stable_ranges", json_of(b, ranges.stable)}});
-    report += fmt::format("  branch {} ({}{}):\n", b.id, family,
-                          b.image_of >= 0 ? fmt::format(", image of branch {}", b.image_of) : "");
-    const auto other_family = [&](const Range& r) {
-      const std::string f = family_of(b, r);
-      return f == family ? std::string() : " (" + f + ")";
-    };
-    for (const Range& r : ranges.physical) {
-      report += fmt::format("    physical from {} = {} to {}{}\n", name, ToString(r.from), ToString(r.to), other_family(r));
-    }
-    if (ranges.stable.empty()) report += "    stable nowhere\n";
-    for (const Range& r : ranges.stable) {
-      report += fmt::format("    stable   from {} = {} to {}{}\n", name, ToString(r.from), ToString(r.to), other_family(r));
-    }
-    ++count;
-  }
-  if (count == 0) report += "  none\n";
-  return report;
+// Per branch with physical orbits: its family, where its orbits are physical and where stable, in the
+// continued coordinate, each end from the special point located there (family_report.h).
+std::string RangesReport(const BifurcationDiagram& diagram, const Scenario& sc, const ShootingLayout& layout,
+                         ResultsWriter& writer) {
+  std::string report = fmt::format("Physical families (where their orbits are physical and where stable, in {}):\n",
+                                   layout.continued_name());
+  std::string families;
+  for (const Branch& b : diagram.branches) families += BranchRangesReport(b, layout, sc.describe, writer);
+  return report + (families.empty() ? "  none\n" : families);
 }
 
 // The Floquet crossings among the diagram's special points (located by the exploration as test functions,
@@ -425,7 +377,7 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   }
   writer.SetSpecialPoints(special_points);
   WriteKeyframeOrbits(diagram, stream.log(), model, setup, layout, writer);
-  const std::string ranges = RangesReport(diagram, stream.log(), setup.scenario, layout, writer);
+  const std::string ranges = RangesReport(diagram, setup.scenario, layout, writer);
   const std::string report =
       RunReport(diagram, starts_report + floquet_report + ranges + period_doubled + words + curves_report, start_time,
                 exploration, stream.floquet_map());

@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "family_report.h"
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/corrector.h"
 #include "hybridcont/orbit_observables.h"
@@ -207,6 +208,7 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
   if (!model.automaton()) return "";
   const HybridAutomaton& automaton = *model.automaton();
   std::string report = "Phase-sequence changes (words of the automaton):\n";
+  std::string word_ranges;  // the answer per family of the other words (family_report.h)
   if (!setup.free.empty()) return report + "  not followed in a run with free parameters\n";
   if (!setup.free.observables.empty()) {
     return report + "  not followed in a run with observables among the unknowns (--until, --bound or --fix on an "
@@ -282,6 +284,9 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
     for (const Branch& b : d.branches) {
       writer.EndBranch(b);
       w.branches.branches.push_back(b);
+      // Its families named by their word: the [[families]] rules are written for the file's word.
+      const std::string word_name = automaton.WordName(w.word);
+      word_ranges += BranchRangesReport(b, word_layout, [&](const Vector&) { return word_name; }, writer);
     }
     return d;
   };
@@ -443,6 +448,10 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
   writer.Annotate("words", words_json);
   writer.Annotate("word_changes", changes);
   if (changes.empty()) report += "  none (no physical family reaches a zero duration or a competing guard)\n";
+  if (!word_ranges.empty()) {
+    report += "Physical families of the other words (where their orbits are physical and where stable, in H):\n" +
+              word_ranges;
+  }
   return report;
 }
 
