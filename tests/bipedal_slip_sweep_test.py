@@ -237,6 +237,12 @@ def test_every_classification_is_the_simulation_s(tmp_path, k, beta, walk, run):
     physical, refused = check_every_classification(biped, out, summary)
     print(f"k = {k}, beta = {beta}: {physical} physical orbits confirmed, {refused} non-physical ones refused")
     assert physical >= 10 and refused >= 5
+    if (k, beta) == (22.0, 0.33):
+        # A stable stretch of walking next to the lift-off guard's boundary: from a located Neimark-Sacker
+        # point to the located constraint boundary (H = 1.00712 to 1.01159), both named in the ranges.
+        ends = {(r["from_how"].split(" #")[0], r["to_how"].split(" #")[0])
+                for b in summary["branches"] for r in b.get("stable_ranges", [])}
+        assert ("NS", "CB") in ends, ends
 
 
 @pytest.fixture(scope="module")

@@ -135,8 +135,13 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
       (*values)(2 + i) = de.dot(f) / std::max(de.norm() * f.norm(), 1e-300);
     }
   }
+  // Defined on physical orbits, and on those beyond a constraint boundary that are otherwise physical (a
+  // competing guard touched: the family goes on as orbits of the same phase sequence), so that a multiplier
+  // crossing between a family's last physical point and a boundary the next step jumped over is bracketed;
+  // its zero is kept only where the orbit is physical (Keep).
+  const bool defined = c.physical || c.reason == OrbitClass::kConstraintViolated;
   if (branch_point && physical_only_ &&
-      !(model_at_u != nullptr && c.physical && Replays(*model_at_u, u.head(base_unknowns_)))) {
+      !(model_at_u != nullptr && defined && Replays(*model_at_u, u.head(base_unknowns_)))) {
     return;
   }
   const FloquetResult floquet = ComputeFloquet(shooting_, u);
@@ -152,6 +157,13 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
 
 bool FloquetTestFunctions::Keep(int function, const Vector& u, std::string* note) {
   const SpecialPointType type = types()[function];
+  if (physical_only_ && type != SpecialPointType::kGrazing) {
+    // A Floquet zero beyond a constraint boundary (see Evaluate) is no bifurcation of the mechanical system.
+    const HybridModel* model = ModelAt(u);
+    if (model != nullptr && Classify(*model, u.head(base_unknowns_)).reason == OrbitClass::kConstraintViolated) {
+      return false;
+    }
+  }
   if (type == SpecialPointType::kGrazing) {
     // A conservative model's grazing is kept where a physical family ends: the orbit there is physical
     // but for the tangency (its class is grazing). Elsewhere the crossing speed changes sign on orbits that
