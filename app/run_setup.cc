@@ -146,6 +146,18 @@ void ApplyFreeParameter(const RunArguments& args, const HybridModel& model, RunS
                                               model.name()));
     }
     setup->free = FreeParameters{{parameter}, {}, {}};
+    const std::string& declared = model.setup().run.parameter;
+    if (parameter != declared) {
+      // --free another parameter: the file's run.parameter is held at its value, so its bounds and scale,
+      // set up for following it, have nothing to bound; the key frames are taken at the new one's value.
+      const auto on_declared = [&](const auto& entry) { return entry.component == declared; };
+      std::erase_if(setup->scenario.bounds, on_declared);
+      std::erase_if(setup->exploration.continuation.bounds, on_declared);
+      std::erase_if(setup->scenario.unknown_scales, [&](const auto& s) { return s.first == declared; });
+      if (setup->scenario.keyframes.component == declared) {
+        setup->scenario.keyframes = {parameter, model.parameter(parameter)};
+      }
+    }
     const double v = model.parameter(parameter);
     setup->scenario.unknown_scales.push_back({parameter, v != 0 ? std::abs(v) : 1.0});
     const bool bounded = std::any_of(setup->exploration.continuation.bounds.begin(),

@@ -275,6 +275,22 @@ TEST(Threads, AGuessStartGivesTheSameBitsOnOneAndTwoThreads) {
   fs::remove_all(dir);
 }
 
+// A model without first integral continued in another parameter than its file's (`--free I`): the file's
+// bound on its own parameter (gamma) no longer stops the run. The compass gait's two gaits reach point-mass
+// legs (I -> 0), both physical there.
+TEST(FreeParameter, AnotherParameterOfAModelWithoutFirstIntegral) {
+  const fs::path out = fs::temp_directory_path() / "hybridcont_true_free_I";
+  const nlohmann::json summary = RunQuietly({ModelPath("compass-gait.toml"), "--free", "I", "--bound", "I=0:0.5"}, out);
+  int near_zero = 0;
+  for (const nlohmann::json& b : summary["branches"]) {
+    for (const nlohmann::json& r : b.value("physical_ranges", nlohmann::json::array())) {
+      near_zero += std::min(r["from"].get<double>(), r["to"].get<double>()) < 1e-3;
+    }
+  }
+  EXPECT_EQ(near_zero, 2) << summary["report"];
+  fs::remove_all(out);
+}
+
 // The rod's start (at rest on both ends) has a kernel of dimension 3 without its file's condition t2 = t1 + t3;
 // one of its directions is the ξ axis, into the rest states of the unfolding, which the tool excludes itself:
 // the same diagram as with the condition.
