@@ -19,6 +19,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from automaton_reference import check_periods_at_three_energies
+from bipedal_slip_model import Biped
 
 BIN = os.environ.get("HYBRIDCONT_BIN", "build/hybridcont")
 MODELS = os.environ.get("HYBRIDCONT_MODELS", "models")
@@ -28,38 +29,9 @@ K, BETA, G = 20.0, 0.36, 1.0
 S, C = math.sin(BETA), math.cos(BETA)
 
 
-def stance(t, s):
-    x, y, dx, dy = s
-    f = K * (1 / math.hypot(x, y) - 1)
-    return [dx, dy, f * x, f * y - G]
-
-
-def double(t, s):
-    x, y, dx, dy, d = s
-    f1 = K * (1 / math.hypot(x, y) - 1)
-    f2 = K * (1 / math.hypot(x - d, y) - 1)
-    return [dx, dy, f1 * x + f2 * (x - d), (f1 + f2) * y - G, 0.0]
-
-
-def flight(t, s):
-    return [s[2], 0.0, -G]
-
-
-# Per mode: vector field, and the transitions out of it: (name, guard, target mode, reset).
-MODES = {
-    "stance": (stance, [
-        ("touchdown", lambda s: s[1] - C, "double", lambda s: [s[0], s[1], s[2], s[3], s[0] + S]),
-        ("liftoff", lambda s: 1 - math.hypot(s[0], s[1]), "flight", lambda s: [s[1], s[2], s[3]]),
-    ]),
-    "double": (double, [
-        ("rear_off", lambda s: 1 - math.hypot(s[0], s[1]), "stance", lambda s: [s[0] - s[4], s[1], s[2], s[3]]),
-        ("front_off", lambda s: 1 - math.hypot(s[0] - s[4], s[1]), "stance", lambda s: list(s[:4])),
-    ]),
-    "flight": (flight, [
-        ("landing", lambda s: s[0] - C, "stance", lambda s: [-S, s[0], s[1], s[2]]),
-    ]),
-}
-ANCHOR = ("anchor", lambda s: -s[0], None, None)  # mid-stance: x crosses 0 upward
+BIPED = Biped(K, BETA)
+stance, MODES = BIPED.stance, BIPED.modes
+ANCHOR = BIPED.anchor  # mid-stance: x crosses 0 upward
 
 
 # The shipped file with a softer leg and a steeper touch-down angle, where running loses its flight inside the

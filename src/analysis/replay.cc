@@ -39,18 +39,21 @@ bool FixedPointNear(const Phase& first, PoincareMap& map, const Vector& x1, cons
   if (k > 0) first.FirstIntegrals(x1, &H1, nullptr, nullptr);
   Vector x = x1;
   PoincareResult pr;
-  if (map.Evaluate(x, xi, /*with_jacobian=*/false, &pr) != PoincareStatus::kSuccess) return false;
-  res->counters += pr.counters;
-  *error = (pr.x - x).norm();
-  if (*error <= options.tolerance) {
-    res->x_end = pr.x;
-    res->period = pr.period;
-    res->event_times = pr.durations;
-    return true;
-  }
-  for (int step = 0; step < options.fixed_point_iterations; ++step) {
-    if (map.Evaluate(x, xi, /*with_jacobian=*/true, &pr) != PoincareStatus::kSuccess) return false;
+  // One evaluation per iterate: its return decides, and (but after the last step) its Jacobian steps.
+  for (int step = 0;; ++step) {
+    const bool last = step == options.fixed_point_iterations;
+    if (map.Evaluate(x, xi, /*with_jacobian=*/step > 0 && !last, &pr) != PoincareStatus::kSuccess) return false;
     res->counters += pr.counters;
+    *error = (pr.x - x).norm();
+    if (*error <= options.tolerance) {
+      res->x_end = pr.x;
+      res->period = pr.period;
+      res->event_times = pr.durations;
+      return true;
+    }
+    if (last) return false;
+    if (step == 0 && map.Evaluate(x, xi, /*with_jacobian=*/true, &pr) != PoincareStatus::kSuccess) return false;
+    if (step == 0) res->counters += pr.counters;
     Matrix A(n + k, n);
     Vector b(n + k);
     A.topRows(n) = pr.dP_dx0 - Matrix::Identity(n, n);
@@ -65,17 +68,7 @@ bool FixedPointNear(const Phase& first, PoincareMap& map, const Vector& x1, cons
     res->fixed_point_steps = step + 1;
     res->fixed_point_distance = (x - x1).norm();
     if (!x.allFinite() || !(res->fixed_point_distance <= options.tolerance)) return false;
-    if (map.Evaluate(x, xi, /*with_jacobian=*/false, &pr) != PoincareStatus::kSuccess) return false;
-    res->counters += pr.counters;
-    *error = (pr.x - x).norm();
-    if (*error <= options.tolerance) {
-      res->x_end = pr.x;
-      res->period = pr.period;
-      res->event_times = pr.durations;
-      return true;
-    }
   }
-  return false;
 }
 
 }  // namespace
