@@ -38,7 +38,7 @@ TEST(PeriodDoublingCli, SlipFamilyFromThePdPointOfHoppingInPlace) {
     // Stable from the PD point to the family's fold, unstable beyond it.
     ASSERT_EQ(b["stability_changes"].size(), 1u) << b.dump();
     EXPECT_EQ(b["stability_changes"][0]["stable"], false);
-    // At the family's fold, located (before, the first continuation point beyond it, 9e-6 further).
+    // At the family's fold, located (not at a continuation point beside it).
     EXPECT_NEAR(b["stability_changes"][0]["H"].get<double>(), 1.282699642918, 1e-9);
     EXPECT_EQ(b["stability_changes"][0]["located"], true);
     std::ifstream csv(dir / b["file"].get<std::string>());
