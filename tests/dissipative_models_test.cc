@@ -505,19 +505,26 @@ TEST(CompassGait, DerivedHeelStrikeIsTheAngularMomentumLaw) {
   std::printf("compass gait: derived heel strike vs angular-momentum law, worst relative difference %.1e\n", worst);
 }
 
-TEST(CompassGait, GaitsMultipliersAndPeriodDoublingAgreeWithAnIndependentRootSolve) {
-  const HybridModel model = Load("compass-gait");
+// With the file's uniform-bar legs and with Goswami's point-mass legs (I = 0), from the same shipped starts.
+class CompassGaitLegs : public ::testing::TestWithParam<double> {};
+
+TEST_P(CompassGaitLegs, GaitsMultipliersAndPeriodDoublingAgreeWithAnIndependentRootSolve) {
+  HybridModel model = Load("compass-gait");
+  model.SetParameter("I", GetParam());
   const ParameterRun run = Explore(model);
   ASSERT_EQ(run.diagram.status, ExplorationStatus::kCompleted) << run.diagram.message;
   const ShootingLayout& layout = run.exploration->shooting().layout();
   const int p = layout.parameter_index(0);
   CompassGait hand;
+  hand.I = GetParam();
   // Both gaits at gamma = 0.03: the first point of each start's branch.
   int checked = 0;
   for (const Branch& b : run.diagram.branches) {
     if (b.points.empty() || b.direction != 1) continue;
     const Vector& u = b.points.front().u;
-    ASSERT_NEAR(u(p), 0.03, 1e-14);
+    // The start's gamma, up to the rounding of the corrector's last step along the curve (|r| ~ 1e-15 times
+    // the condition of dr: 7e-15 for the bars' legs, 6e-14 for point masses).
+    ASSERT_NEAR(u(p), 0.03, 1e-13);
     const Eigen::Vector3d tool = AfterHeelStrike(layout, u, 1);
     const Eigen::Vector3d z = hand.FixedPoint(tool + Eigen::Vector3d(1e-3, -2e-3, 2e-3));
     double T;
@@ -538,9 +545,9 @@ TEST(CompassGait, GaitsMultipliersAndPeriodDoublingAgreeWithAnIndependentRootSol
       ++matched;
     }
     EXPECT_EQ(matched, 3);
-    std::printf("compass gait at gamma = 0.03: alpha = %.12f, period %.12f (tool - root solve %.1e, %.1e), "
+    std::printf("compass gait (I = %g) at gamma = 0.03: alpha = %.12f, period %.12f (tool - root solve %.1e, %.1e), "
                 "multipliers |mu| max %.9f (root solve %.9f)\n",
-                z(0), T, (tool - z).lpNorm<Eigen::Infinity>(), layout.Period(u) - T, f.max_modulus,
+                hand.I, z(0), T, (tool - z).lpNorm<Eigen::Infinity>(), layout.Period(u) - T, f.max_modulus,
                 mu.cwiseAbs().maxCoeff());
     ++checked;
   }
@@ -561,7 +568,7 @@ TEST(CompassGait, GaitsMultipliersAndPeriodDoublingAgreeWithAnIndependentRootSol
     return v;
   };
   Eigen::Vector3d z = AfterHeelStrike(layout, pd->u, 1);
-  double g0 = 0.038, g1 = 0.040;
+  double g0 = pd->u(p) - 1e-3, g1 = pd->u(p) + 1e-3;
   double f0 = most_negative(g0, &z) + 1, f1 = most_negative(g1, &z) + 1;
   for (int it = 0; it < 8 && std::abs(g1 - g0) > 1e-12; ++it) {
     const double g2 = g1 - f1 * (g1 - g0) / (f1 - f0);
@@ -569,8 +576,8 @@ TEST(CompassGait, GaitsMultipliersAndPeriodDoublingAgreeWithAnIndependentRootSol
     g1 = g2, f1 = most_negative(g1, &z) + 1;
   }
   EXPECT_NEAR(pd->u(p), g1, 1e-7);
-  std::printf("compass gait: first PD at gamma = %.12f (precision %.1e); root solve's multiplier -1 at %.12f\n",
-              pd->u(p), pd->precision(), g1);
+  std::printf("compass gait (I = %g): first PD at gamma = %.12f (precision %.1e); root solve's multiplier -1 at %.12f\n",
+              hand.I, pd->u(p), pd->precision(), g1);
 
   // The period-doubled gait beyond it: two different steps, each the root solve's stride of the other.
   DoubledRun doubled = ExplorePeriodDoubled(model, run, *pd, 8);
@@ -591,6 +598,8 @@ TEST(CompassGait, GaitsMultipliersAndPeriodDoublingAgreeWithAnIndependentRootSol
   std::printf("compass gait: period-doubled gait at gamma = %.6f, steps alpha = %.9f and %.9f, period %.12f "
               "(root solve %.12f)\n", hand.gamma, z1(0), z2(0), layout2.Period(u2), T1 + T2);
 }
+
+INSTANTIATE_TEST_SUITE_P(BarAndPointMassLegs, CompassGaitLegs, ::testing::Values(5.0 / 12.0, 0.0));
 
 // The compiled entry points with the parameters as jets (runs in a parameter) are the interpreter's
 // EvaluateWithParameterJets: r and dr, the parameter column included, agree at random points.

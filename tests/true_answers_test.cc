@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <set>
@@ -174,25 +175,47 @@ TEST(ForcedImpactOscillator, PhysicalPointsHavePositiveDurationsAndAreConfirmedB
   fs::remove_all(dir);
 }
 
-TEST(FamilyNames, WalkersAreNamedByTheirPeriod) {
-  for (const auto& [model, names] :
-       std::vector<std::pair<std::string, std::set<std::string>>>{
-           {"simplest-walker.toml", {"long-period gait", "short-period gait"}},
-           {"compass-gait.toml", {"long-step gait", "short-step gait"}}}) {
-    const fs::path dir = fs::temp_directory_path() / ("hybridcont_true_names_" + model);
-    const nlohmann::json summary = RunQuietly({ModelPath(model)}, dir);
-    std::set<std::string> labels;
-    for (const nlohmann::json& o : summary["orbits"]) {
-      labels.insert(o["label"].get<std::string>());
-      // The rules: the long-period walker gait has T > 3.2, the long-step compass gait T > 0.8.
-      const double threshold = model == "simplest-walker.toml" ? 3.2 : 0.8;
-      const bool long_gait = o["label"].get<std::string>().rfind("long", 0) == 0;
-      EXPECT_EQ(long_gait, o["T"].get<double>() > threshold) << model << " " << o.dump();
+TEST(FamilyNames, TheSimplestWalkersGaitsAreNamedByTheirPeriod) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_true_names_walker";
+  const nlohmann::json summary = RunQuietly({ModelPath("simplest-walker.toml")}, dir);
+  std::set<std::string> labels;
+  for (const nlohmann::json& o : summary["orbits"]) {
+    labels.insert(o["label"].get<std::string>());
+    // The file's rule: the long-period gait has T > 3.2 (its period, not its last phase's duration).
+    const bool long_gait = o["label"].get<std::string>().rfind("long", 0) == 0;
+    EXPECT_EQ(long_gait, o["T"].get<double>() > 3.2) << o.dump();
+  }
+  EXPECT_EQ(labels, (std::set<std::string>{"long-period gait", "short-period gait"}));
+  fs::remove_all(dir);
+}
+
+// The compass gait's two gaits, with the file's uniform-bar legs and with Goswami's point-mass legs
+// (--set I=0, where the long-step gait is faster than the bars' threshold of the period): both are found
+// from the shipped starts, and at gamma = 0.03, where each branch starts, the one named "long-step" has the
+// longer step (half inter-leg angle at heel strike, |x2_th_st|) and is the stable one. No branch changes
+// its name along the way.
+TEST(FamilyNames, TheCompassGaitsAreNamedByTheirStepWithBarAndPointMassLegs) {
+  for (const char* inertia : {"0.4166666666666667", "0"}) {
+    const fs::path dir = fs::temp_directory_path() / (std::string("hybridcont_true_names_compass_") + inertia);
+    const nlohmann::json summary = RunQuietly({ModelPath("compass-gait.toml"), "--set", std::string("I=") + inertia}, dir);
+    std::map<std::string, double> step;  // name -> |x2_th_st| at gamma = 0.03
+    std::map<std::string, bool> stable;
+    for (const nlohmann::json& b : summary["branches"]) {
+      const auto c = ReadColumns(dir / b["file"].get<std::string>());
+      ASSERT_NEAR(c.at("gamma").front(), 0.03, 1e-12);
+      const std::string name = b["family"].get<std::string>();
+      for (const nlohmann::json& r : b["physical_ranges"]) EXPECT_EQ(r["family"], name) << b.dump();
+      step[name] = std::abs(c.at("x2_th_st").front());
+      stable[name] = c.at("stable").front() == 1;
+      // Every nontrivial multiplier of a model without first integral (4 states: 3) has its columns.
+      for (const char* col : {"mu1_re", "mu2_re", "mu3_re", "mu3_im"}) EXPECT_EQ(c.count(col), 1u) << col;
     }
-    EXPECT_EQ(labels, names) << model;
-    // Every nontrivial multiplier of a model without first integral (4 states: 3) has its columns.
-    const auto c = ReadColumns(dir / "branch-0.csv");
-    for (const char* col : {"mu1_re", "mu2_re", "mu3_re", "mu3_im"}) EXPECT_EQ(c.count(col), 1u) << model << " " << col;
+    ASSERT_EQ(step.size(), 2u) << inertia << " " << summary["report"];
+    EXPECT_GT(step.at("long-step gait"), step.at("short-step gait") + 0.01) << inertia;
+    EXPECT_TRUE(stable.at("long-step gait")) << inertia;
+    EXPECT_FALSE(stable.at("short-step gait")) << inertia;
+    std::printf("compass gait, I = %s: steps |x2_th_st| long %.6f, short %.6f at gamma = 0.03\n", inertia,
+                step.at("long-step gait"), step.at("short-step gait"));
     fs::remove_all(dir);
   }
 }
