@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include "hybridcont/classification.h"
+#include "hybridcont/expression_model.h"
+#include "hybridcont/model_file.h"
 #include "hybridcont/models.h"
 #include "known_orbits.h"
 
@@ -95,6 +97,57 @@ TEST(Classification, PhaseStartingBeyondItsGuardIsNotPhysical) {
   const Classification c = Classify(ball, u);
   EXPECT_EQ(c.reason, OrbitClass::kMissedEvent) << c.detail;
   EXPECT_NE(c.detail.find("t = 0 "), std::string::npos) << c.detail;
+}
+
+}  // namespace
+}  // namespace hybridcont
+
+namespace hybridcont {
+namespace {
+
+// The return segment runs in phase 1 up to the section; phase 1's own event crossed there from above is a
+// missed event too. A ball with a clock s: its section is s = 1/2 (half-way through a flight that starts at
+// each bounce with s = 0). Segment 2 starts 0.05 above the floor falling at speed 1, so it passes through the
+// floor at t = sqrt(1.1) - 1 = 0.0488 before its section at t = 1/2; every segment's end is a transversal crossing.
+TEST(Classification, PhaseOnesEventCrossedBeforeTheSectionIsAMissedEvent) {
+  const char* text = R"toml(
+hybridcont = 1
+name = "clocked-ball"
+conservative = false
+
+[parameters]
+g = 1.0
+
+[[phases]]
+name = "flight"
+states = ["s", "y", "v"]
+typical = [0.5, 0.5, -1]
+ode = { s = "1", y = "v", v = "-g" }
+event = "y"
+anchor = "0.5 - s"
+reset = { s = "0", y = "y", v = "-v" }
+
+[start]
+kind = "guess"
+values = { t1 = 1, t2 = 0.5, x1_s = 0.5, x1_y = 0.5, x1_v = 0 }
+
+[run]
+parameter = "g"
+)toml";
+  const HybridModel model = BuildExpressionModel(ParseModelText(text, "clocked-ball.toml"));
+  const ShootingLayout layout(model);
+  Vector u = Vector::Zero(layout.num_unknowns());
+  u(layout.time_index(0)) = 1.0;  // from the section (y = 1/2, at rest) to the floor
+  u.segment(layout.state_offset(0), 3) << 0.5, 0.5, 0.0;
+  u(layout.time_index(1)) = 0.5;  // from s = 0 to the section
+  u.segment(layout.state_offset(1), 3) << 0.0, 0.05, -1.0;
+  const Classification c = Classify(model, u);
+  EXPECT_EQ(c.reason, OrbitClass::kMissedEvent) << c.detail;
+  EXPECT_NE(c.detail.find("before the section) at t = 0.04"), std::string::npos) << c.detail;
+  // Rising from the floor instead, the same segment is admissible.
+  u.segment(layout.state_offset(1), 3) << 0.0, 0.0, 1.0;
+  const Classification rising = Classify(model, u);
+  EXPECT_TRUE(rising.physical) << ToString(rising.reason) << " " << rising.detail;
 }
 
 }  // namespace

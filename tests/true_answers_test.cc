@@ -98,6 +98,48 @@ TEST(VibratingTable, FoldIsOneTurningPointAtTheClosedFormAndImpactPhasesAreExact
   std::set<std::string> labels;
   for (const nlohmann::json& o : summary["orbits"]) labels.insert(o["label"].get<std::string>());
   EXPECT_EQ(labels, (std::set<std::string>{"period one, late impact", "period one, early impact"}));
+  // The early-impact family ends where the ball's path touches the rising table during the rebound (the
+  // file's constraint 'gap', CB). In closed form: leaving the table at phase th = -acos(A_sn/A) with speed
+  // pi, the gap after time t is G(t) = A sin th + pi t - t^2/2 - A sin(th + t); the end is the A at which
+  // G's interior minimum (G' = pi - t - A cos(th + t) from - to +) is 0, found here by bisection in A.
+  const auto interior_minimum = [&](double A) {
+    const double th = -std::acos(A_sn / A);
+    const auto slope = [&](double t) { return std::numbers::pi - t - A * std::cos(th + t); };
+    double smallest = 1e300;
+    constexpr int kSamples = 4000;
+    for (int i = 1; i < kSamples; ++i) {
+      double a = 2 * std::numbers::pi * (i - 1) / kSamples, b = 2 * std::numbers::pi * i / kSamples;
+      if (!(slope(a) < 0 && slope(b) > 0)) continue;
+      for (int it = 0; it < 100; ++it) (slope(0.5 * (a + b)) < 0 ? a : b) = 0.5 * (a + b);
+      smallest = std::min(smallest, A * std::sin(th) + std::numbers::pi * a - a * a / 2 - A * std::sin(th + a));
+    }
+    return smallest;
+  };
+  double lo = 2.0, hi = 3.0;
+  for (int it = 0; it < 60; ++it) (interior_minimum(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);
+  int boundaries = 0;
+  double tool_end = std::nan("");
+  for (const nlohmann::json& sp : summary["special_points"]) {
+    if (sp["type"] != "CB" || sp["duplicate_of"] != -1) continue;
+    ++boundaries;
+    tool_end = sp["A"].get<double>();
+    EXPECT_EQ(sp["status"], "located");
+    EXPECT_NEAR(sp["A"].get<double>(), lo, 1e-10) << "closed form " << lo;
+  }
+  EXPECT_EQ(boundaries, 1);
+  bool early_ends_at_cb = false;
+  for (const nlohmann::json& b : summary["branches"]) {
+    for (const nlohmann::json& r : b.value("physical_ranges", nlohmann::json::array())) {
+      if (r["family"] != "period one, early impact") continue;
+      for (const char* end : {"from", "to"}) {
+        if (r[std::string(end) + "_how"].get<std::string>().rfind("CB #", 0) == 0) {
+          early_ends_at_cb = std::abs(r[end].get<double>() - lo) < 1e-10;
+        }
+      }
+    }
+  }
+  EXPECT_TRUE(early_ends_at_cb) << summary["report"];
+  std::printf("vibrating table: early impact ends at A = %.12f (closed form %.12f)\n", tool_end, lo);
   fs::remove_all(dir);
 }
 

@@ -42,19 +42,25 @@ double SegmentGuard(const HybridModel& model, int i, const Vector& x, RowVector*
   return model.anchor().Evaluate(x, grad);
 }
 
+// The event of the phase segment i runs in (the return segment m runs in phase 1 up to the anchor).
+double PhaseEvent(const HybridModel& model, int i, const Vector& x, RowVector* grad) {
+  return model.phase(i % model.num_phases()).Event(x, grad);
+}
+
 // The first time inside the segment (before its end) at which the trajectory is beyond its guard: a
 // downward crossing (g > 0, then g <= 0), or for an event guard any value g < -penetration, including at
 // the start (the end of a rod below the ground right after the other end's impact). Searched on the
 // Hermite interpolant of every step. Returns the local time or NaN if none.
 double FirstViolation(const HybridModel& model, const OrbitTrace& trace, int i, int samples_per_step,
-                      bool forbid_negative, bool from_above) {
+                      bool forbid_negative, bool from_above,
+                      double (*guard)(const HybridModel&, int, const Vector&, RowVector*) = SegmentGuard) {
   const auto& nodes = trace.segment(i);
   const double end = trace.duration(i);
   // Crossings within this fraction of the segment's end are the end crossing itself.
   const double end_slack = 1e-9 * std::max(1.0, std::abs(end));
   // Round-off below zero at the start of a phase (a reset onto its own guard) is not a penetration.
   constexpr double kPenetration = 1e-9;
-  double previous = SegmentGuard(model, i, nodes.front().x, nullptr);
+  double previous = guard(model, i, nodes.front().x, nullptr);
   if (forbid_negative && previous < -kPenetration) return 0.0;
   // An automaton's guard fires where it is crossed from above (observable.h): a phase that begins on it
   // (within kGuardStartTolerance) or below it is not beyond it until it has been above it.
@@ -73,7 +79,7 @@ double FirstViolation(const HybridModel& model, const OrbitTrace& trace, int i, 
       const double t = nodes[j].t + (nodes[j + 1].t - nodes[j].t) * s / samples;
       if (std::abs(end - t) <= end_slack) return std::nan("");
       const Vector x = s == samples ? nodes[j + 1].x : trace.Interpolate(i, static_cast<int>(j), t);
-      const double g = SegmentGuard(model, i, x, nullptr);
+      const double g = guard(model, i, x, nullptr);
       if ((previous > 0.0 && g <= 0.0) || (forbid_negative && g < -kPenetration)) return t;
       previous = g;
     }
@@ -149,6 +155,18 @@ Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const Or
       os << (i < m ? "event" : "anchor") << " of segment " << i + 1 << " violated at t = " << t << " < "
          << trace.duration(i);
       return NonPhysical(i < m ? OrbitClass::kMissedEvent : OrbitClass::kMissedAnchor, os.str());
+    }
+  }
+  // The return segment runs in phase 1 before its section: phase 1's own event may not be crossed there
+  // from above either. A reset may land below it (a walker's swing foot under the ground at the scuffing
+  // the model ignores), so there it counts from where it has been above 0, as an automaton's guard does.
+  {
+    const double t = FirstViolation(model, trace, m, options.samples_per_step, /*forbid_negative=*/false,
+                                    /*from_above=*/true, PhaseEvent);
+    if (!std::isnan(t)) {
+      os << "event of phase 1 violated in segment " << m + 1 << " (before the section) at t = " << t << " < "
+         << trace.duration(m);
+      return NonPhysical(OrbitClass::kMissedEvent, os.str());
     }
   }
   // Admissibility constraints (observable.h): each minimum >= 0, the first violated one named.
