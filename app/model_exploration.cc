@@ -56,6 +56,11 @@ class ModelExploration::TestWorkSink {
     work_.counters += map.counters();
     work_.evaluations += map.num_evaluations();
   }
+  // Integrations outside a map (the own events' minima, FloquetTestFunctions::own_event_counters).
+  void AddIntegrationWork(const FlowCounters& work) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    work_.counters += work;
+  }
   TestFunctionWork work() {
     const std::lock_guard<std::mutex> lock(mutex_);
     const auto& curve = dynamic_cast<const ShootingProblem&>(*inner_);  // a clone of a shooting map
@@ -91,6 +96,7 @@ class EngineFloquetTests : public TestFunctions {
   }
   ~EngineFloquetTests() override {
     sink_->AddMapWork(floquet_->shooting());
+    sink_->AddIntegrationWork(floquet_->own_event_counters());
     if (state_) sink_->AddMapWork(*state_);
   }
   EngineFloquetTests(const EngineFloquetTests&) = delete;

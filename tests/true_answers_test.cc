@@ -48,6 +48,31 @@ nlohmann::json RunQuietly(const std::vector<std::string>& model_and_options, con
   return nlohmann::json::parse(in);
 }
 
+// The ball on a vibrating table (g = w = 1, restitution e): where its early-impact period-one orbit ends.
+// Leaving the table at phase th = -acos(A_sn/A) with speed pi, the gap after time t is
+// G(t) = A sin th + pi t - t^2/2 - A sin(th + t); the orbit ends at the A where G's interior minimum (where
+// G' = pi - t - A cos(th + t) goes from - to +) is 0: the ball's path touches the rising table. Bisection
+// in A on the minimum, each found by bisection on G'.
+double EarlyImpactEnd(double e) {
+  const double A_sn = (1 - e) * std::numbers::pi / (1 + e);
+  const auto interior_minimum = [&](double A) {
+    const double th = -std::acos(A_sn / A);
+    const auto slope = [&](double t) { return std::numbers::pi - t - A * std::cos(th + t); };
+    double smallest = 1e300;
+    constexpr int kSamples = 4000;
+    for (int i = 1; i < kSamples; ++i) {
+      double a = 2 * std::numbers::pi * (i - 1) / kSamples, b = 2 * std::numbers::pi * i / kSamples;
+      if (!(slope(a) < 0 && slope(b) > 0)) continue;
+      for (int it = 0; it < 100; ++it) (slope(0.5 * (a + b)) < 0 ? a : b) = 0.5 * (a + b);
+      smallest = std::min(smallest, A * std::sin(th) + std::numbers::pi * a - a * a / 2 - A * std::sin(th + a));
+    }
+    return smallest;
+  };
+  double lo = 2.0, hi = 3.0;
+  for (int it = 0; it < 60; ++it) (interior_minimum(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);
+  return lo;
+}
+
 TEST(VibratingTable, FoldIsOneTurningPointAtTheClosedFormAndImpactPhasesAreExact) {
   const fs::path dir = fs::temp_directory_path() / "hybridcont_true_table";
   const nlohmann::json summary = RunQuietly({ModelPath("vibrating-table.toml")}, dir);
@@ -99,24 +124,8 @@ TEST(VibratingTable, FoldIsOneTurningPointAtTheClosedFormAndImpactPhasesAreExact
   for (const nlohmann::json& o : summary["orbits"]) labels.insert(o["label"].get<std::string>());
   EXPECT_EQ(labels, (std::set<std::string>{"period one, late impact", "period one, early impact"}));
   // The early-impact family ends where the ball's path touches the rising table during the rebound (the
-  // file's constraint 'gap', CB). In closed form: leaving the table at phase th = -acos(A_sn/A) with speed
-  // pi, the gap after time t is G(t) = A sin th + pi t - t^2/2 - A sin(th + t); the end is the A at which
-  // G's interior minimum (G' = pi - t - A cos(th + t) from - to +) is 0, found here by bisection in A.
-  const auto interior_minimum = [&](double A) {
-    const double th = -std::acos(A_sn / A);
-    const auto slope = [&](double t) { return std::numbers::pi - t - A * std::cos(th + t); };
-    double smallest = 1e300;
-    constexpr int kSamples = 4000;
-    for (int i = 1; i < kSamples; ++i) {
-      double a = 2 * std::numbers::pi * (i - 1) / kSamples, b = 2 * std::numbers::pi * i / kSamples;
-      if (!(slope(a) < 0 && slope(b) > 0)) continue;
-      for (int it = 0; it < 100; ++it) (slope(0.5 * (a + b)) < 0 ? a : b) = 0.5 * (a + b);
-      smallest = std::min(smallest, A * std::sin(th) + std::numbers::pi * a - a * a / 2 - A * std::sin(th + a));
-    }
-    return smallest;
-  };
-  double lo = 2.0, hi = 3.0;
-  for (int it = 0; it < 60; ++it) (interior_minimum(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);
+  // file's constraint 'gap', CB), at the closed form.
+  const double lo = EarlyImpactEnd(e);
   int boundaries = 0;
   double tool_end = std::nan("");
   for (const nlohmann::json& sp : summary["special_points"]) {
@@ -140,6 +149,75 @@ TEST(VibratingTable, FoldIsOneTurningPointAtTheClosedFormAndImpactPhasesAreExact
   }
   EXPECT_TRUE(early_ends_at_cb) << summary["report"];
   std::printf("vibrating table: early impact ends at A = %.12f (closed form %.12f)\n", tool_end, lo);
+  fs::remove_all(dir);
+}
+
+// The same ball and table written as one phase from impact to impact (the table's phase as a point on a
+// stable limit cycle (c, s), so that nothing is wrapped): the early-impact orbit's own event, the gap, is
+// touched inside the flight where the family ends. That end is located as a grazing inside the phase (GR),
+// at the closed form within its stated precision, and the family's physical range ends there.
+TEST(VibratingTable, AnEventTouchedInsideItsPhaseEndsTheFamilyAtALocatedGrazing) {
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_true_table_one_phase";
+  fs::create_directories(dir);
+  std::ofstream(dir / "table1.toml") << R"toml(hybridcont = 1
+name = "table-one-phase"
+conservative = false
+
+[parameters]
+A = { value = 1.4, range = "(0, inf)" }
+e = { value = 0.5, range = "[0, 1)" }
+
+[definitions]
+A_sn = "(1 - e)*pi/(1 + e)"
+th_i = "acos(A_sn/A)"
+
+[[phases]]
+name = "flight"
+states = ["y", "v", "c", "s"]
+typical = [2.0, -1.0, 0.5, 0.5]
+ode = { y = "v", v = "-1", c = "-s + c*(1 - c^2 - s^2)", s = "c + s*(1 - c^2 - s^2)" }
+event = "y - A*s"
+anchor = "v"
+reset = { y = "y", v = "(1 + e)*A*c - e*v", c = "c", s = "s" }
+
+[start]
+kind = "simulation"
+cycles = 1
+values = { x1_y = "A*sin(th_i) + pi^2/2", x1_v = 0, x1_c = "cos(th_i + pi)", x1_s = "sin(th_i + pi)" }
+
+[run]
+parameter = "A"
+bounds = { A = [0.5, 3.0], period = [0, 20] }
+
+[[families]]
+name = "late impact"
+when = "x1_s < 0"
+
+[[families]]
+name = "early impact"
+)toml";
+  const nlohmann::json summary = RunQuietly({(dir / "table1.toml").string()}, dir / "out");
+  const double exact = EarlyImpactEnd(0.5);
+  int grazings = 0, gr_id = -1;
+  for (const nlohmann::json& sp : summary["special_points"]) {
+    if (sp["type"] != "GR" || sp["duplicate_of"] != -1) continue;
+    ++grazings;
+    gr_id = sp["id"].get<int>();
+    EXPECT_EQ(sp["status"], "located");
+    const double precision = sp["precision"].get<double>();
+    EXPECT_LT(precision, 1e-8);
+    EXPECT_LE(std::abs(sp["A"].get<double>() - exact), precision) << "closed form " << exact;
+    std::printf("one-phase table: GR at A = %.12f, precision %.1e (closed form %.12f)\n", sp["A"].get<double>(),
+                precision, exact);
+  }
+  EXPECT_EQ(grazings, 1);
+  bool ends_there = false;
+  for (const nlohmann::json& b : summary["branches"]) {
+    for (const nlohmann::json& r : b.value("physical_ranges", nlohmann::json::array())) {
+      ends_there = ends_there || (r["family"] == "early impact" && r["to_special_point"] == gr_id);
+    }
+  }
+  EXPECT_TRUE(ends_there) << summary["report"];
   fs::remove_all(dir);
 }
 

@@ -36,6 +36,8 @@
 
 #include "hybridcont/classification.h"
 #include "hybridcont/floquet.h"
+#include "hybridcont/orbit_observables.h"
+#include "hybridcont/orbit_trace.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/test_function.h"
 #include "hybridcont/timebased_shooting.h"
@@ -63,6 +65,14 @@ double PeriodDoublingTest(const Matrix& dr, const ShootingLayout& layout);
 // sides of the grazing point. A model without first integral keeps every zero; a conservative model keeps
 // those where a physical family ends (the orbit there is physical but for the tangency: class grazing), not
 // the many where the crossing speed changes sign on orbits that are no motion of the system.
+//
+// Last, one more kGrazing function per phase: the smallest interior minimum of the phase's own event
+// (OwnEventObservable, orbit_observables.h), 0 where the event is touched inside the phase: the end of a
+// physical family beyond which its orbits cross that event early (missed-event). It is evaluated at a
+// branch point only where the point is physical or missed-event and its trace shows a local minimum of the
+// event inside the phase after it has been above 0 (elsewhere it is NaN: no interior minimum, or no
+// physical family ending), and at a trial point between branch points only where the last branch point had
+// a value, so it costs integrations only on such orbits; its zeros are kept where a physical family ends.
 class FloquetTestFunctions : public TestFunctions {
  public:
   // Keeps a reference to model (it must outlive this object and its clones). With free parameters
@@ -93,11 +103,22 @@ class FloquetTestFunctions : public TestFunctions {
   // The map the multipliers and PeriodDoublingTest are computed with: its counters are this object's work
   // (the classification and replay of branch points not included).
   const TimeBasedShooting& shooting() const { return shooting_; }
+  // The integrations of the own events' minima (not the map's).
+  FlowCounters own_event_counters() const {
+    return own_event_evaluator_ ? own_event_evaluator_->counters() : FlowCounters();
+  }
 
  private:
   // The model at u's free-parameter values (nullptr outside a parameter's range).
   const HybridModel* ModelAt(const Vector& u_free) const;
-  Classification Classify(const HybridModel& model, const Vector& u) const;
+  // The class of u; with `trace`, the integrated orbit too (null where the unknowns alone decide).
+  Classification Classify(const HybridModel& model, const Vector& u,
+                          std::unique_ptr<OrbitTrace>* trace = nullptr) const;
+  // Whether a physical family may end at u by a missed event (physical, missed-event or grazing).
+  bool MissedEventEndsPhysicalFamily(const Vector& u_free) const;
+  // Phase i's own-event functions at u into values->segment(first_own_event(), m) (see above).
+  void EvaluateOwnEvents(const Vector& u, const OrbitTrace* trace, Vector* values);
+  int first_own_event() const;
   // The event-driven replay of u (the model's own layout) returns (replay.h).
   bool Replays(const HybridModel& model, const Vector& u) const;
 
@@ -109,6 +130,10 @@ class FloquetTestFunctions : public TestFunctions {
   int base_unknowns_;                            // u without the free parameters
   std::unique_ptr<HybridModel> point_model_;     // with free parameters: set to u's values to classify
   Matrix dr_;
+  // The own events' minima, on the shooting map's model (at u's parameter values), made at first use.
+  std::unique_ptr<ObservableEvaluator> own_event_evaluator_;
+  std::vector<Observable> own_events_;
+  std::vector<char> own_defined_;  // per phase: whether the last branch point had a value
 };
 
 }  // namespace hybridcont

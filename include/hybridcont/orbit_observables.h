@@ -48,6 +48,10 @@ class ObservableEvaluator {
   // All observables of the model at u (no gradients); NaN where one fails.
   Vector EvaluateAll(const Vector& u);
 
+  // An extremum observable that the model does not hold (kind kMinimum or kMaximum, `phases` with one
+  // entry per phase of the model), evaluated as Evaluate evaluates the model's own; e.g. OwnEventObservable.
+  EvaluationStatus EvaluateExtremum(const Observable& o, const Vector& u, double* value, RowVector* du);
+
   // Whether the last extremum evaluated lies inside its segment (not at an end): a constraint's boundary
   // is a zero of its interior minimum (observable.h).
   bool last_extremum_interior() const { return last_interior_; }
@@ -83,6 +87,14 @@ class ObservableEvaluator {
   int last_segment_ = -1;
   double last_time_ = 0.0;
 };
+
+// Phase `phase`'s own event e_i as a guard observable (observable.h: a minimum that counts from where the
+// event has been above 0, as an automaton's competing guard does), over the segments of that phase. Its
+// smallest *interior* minimum is the margin by which the trajectory clears the event before the phase's
+// end; it is 0 where the event is touched inside the phase, the grazing beyond which the orbit crosses its
+// event early (classified missed-event). Reads `model`'s phase, which must outlive the observable; the
+// gradient with respect to the parameters needs Phase::has_parameter_derivatives.
+Observable OwnEventObservable(const HybridModel& model, int phase);
 
 }  // namespace hybridcont
 

@@ -1,5 +1,6 @@
 #include "hybridcont/floquet_test_functions.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include <Eigen/LU>
@@ -60,7 +61,12 @@ std::vector<SpecialPointType> FloquetTestFunctions::types() const {
   types.insert(types.end(), model_->num_phases(), SpecialPointType::kGrazing);
   types.push_back(SpecialPointType::kNeimarkSacker);
   if (model_->num_first_integrals() > 0) types.push_back(SpecialPointType::kKreinCollision);
+  types.insert(types.end(), model_->num_phases(), SpecialPointType::kGrazing);  // the own events
   return types;
+}
+
+int FloquetTestFunctions::first_own_event() const {
+  return 2 + model_->num_phases() + 1 + (model_->num_first_integrals() > 0 ? 1 : 0);
 }
 
 const HybridModel* FloquetTestFunctions::ModelAt(const Vector& u_free) const {
@@ -76,13 +82,76 @@ const HybridModel* FloquetTestFunctions::ModelAt(const Vector& u_free) const {
   return point_model_.get();
 }
 
-Classification FloquetTestFunctions::Classify(const HybridModel& model, const Vector& u) const {
+Classification FloquetTestFunctions::Classify(const HybridModel& model, const Vector& u,
+                                              std::unique_ptr<OrbitTrace>* trace) const {
   Classification c;
   if (!ClassifyByUnknowns(model, u, ClassificationOptions{}, &c)) {
-    const OrbitTrace trace(model, u, integrator_);
-    c = ClassifyOrbit(model, u, trace, ClassificationOptions{});
+    auto orbit = std::make_unique<OrbitTrace>(model, u, integrator_);
+    c = ClassifyOrbit(model, u, *orbit, ClassificationOptions{});
+    if (trace != nullptr) *trace = std::move(orbit);
   }
   return c;
+}
+
+bool FloquetTestFunctions::MissedEventEndsPhysicalFamily(const Vector& u_free) const {
+  const HybridModel* model = ModelAt(u_free);
+  if (model == nullptr) return false;
+  const Classification c = Classify(*model, u_free.head(base_unknowns_));
+  return c.physical || c.reason == OrbitClass::kMissedEvent || c.reason == OrbitClass::kGrazing;
+}
+
+namespace {
+
+// Whether the trace shows a local minimum of phase i's event inside the phase once the event has been above
+// 0 (armed, as OwnEventObservable counts it). Phase 1 runs the return segment m and then segment 0; a
+// walker's heel-strike guard, below 0 after the strike until mid-stance (scuffing), has its dip before it is
+// armed. The event is sampled on the Hermite interpolant of every step, finely enough that no state moves
+// by more than 0.02 between samples (a nearly exactly integrated flight takes a few long steps).
+bool HasArmedEventMinimum(const HybridModel& model, const OrbitTrace& trace, int phase) {
+  const int m = model.num_phases();
+  constexpr double kMaxMotion = 0.02;
+  constexpr int kMaxSamplesPerStep = 1000;
+  bool armed = false;
+  double before = std::numeric_limits<double>::quiet_NaN(), last = before;  // the two previous samples
+  for (const int s : phase == 0 ? std::vector<int>{m, 0} : std::vector<int>{phase}) {
+    const auto& nodes = trace.segment(s);
+    for (std::size_t j = 0; j < nodes.size(); ++j) {
+      const int samples = j == 0 ? 1 : static_cast<int>(std::clamp<double>(
+          std::ceil(std::max(nodes[j - 1].f.cwiseAbs().maxCoeff(), nodes[j].f.cwiseAbs().maxCoeff()) *
+                    std::abs(nodes[j].t - nodes[j - 1].t) / kMaxMotion), 1, kMaxSamplesPerStep));
+      for (int k = 1; k <= samples; ++k) {
+        const double t = j == 0 ? nodes[0].t : nodes[j - 1].t + (nodes[j].t - nodes[j - 1].t) * k / samples;
+        const double g = model.phase(phase).Event(
+            k == samples ? nodes[j].x : trace.Interpolate(s, static_cast<int>(j) - 1, t), nullptr);
+        if (armed && before > last && g > last) return true;  // `last` is a local minimum
+        armed = armed || g > kGuardStartTolerance;
+        before = last, last = g;
+      }
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+void FloquetTestFunctions::EvaluateOwnEvents(const Vector& u, const OrbitTrace* trace, Vector* values) {
+  const int m = model_->num_phases();
+  const HybridModel& model = shooting_.model();  // at u's parameter values (after shooting_.Evaluate)
+  if (!own_event_evaluator_) {
+    own_event_evaluator_ = std::make_unique<ObservableEvaluator>(model, shooting_.layout(), integrator_);
+    for (int i = 0; i < m; ++i) own_events_.push_back(OwnEventObservable(model, i));
+    own_defined_.assign(m, true);  // a fresh copy (a refined one) evaluates at trial points
+  }
+  for (int i = 0; i < m; ++i) {
+    // At a branch point: where the trace shows an armed minimum. At a trial point between two branch points:
+    // where the last branch point had a value (a zero is only located between two that have one).
+    if (trace != nullptr) own_defined_[i] = HasArmedEventMinimum(*model_, *trace, i);
+    if (!own_defined_[i]) continue;
+    double value = 0.0;
+    if (!own_event_evaluator_->EvaluateExtremum(own_events_[i], u, &value, nullptr).ok) continue;
+    if (own_event_evaluator_->last_extremum_interior()) (*values)(first_own_event() + i) = value;
+    if (trace != nullptr) own_defined_[i] = own_event_evaluator_->last_extremum_interior();
+  }
 }
 
 bool FloquetTestFunctions::Physical(const Vector& u_free) const {
@@ -110,13 +179,19 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
   const int m = model_->num_phases();
   const int ns = 2 + m;  // the Neimark–Sacker function, then (conservative) the Krein one
   const bool krein = model_->num_first_integrals() > 0;
-  *values = Vector::Constant(ns + 1 + (krein ? 1 : 0), std::numeric_limits<double>::quiet_NaN());
+  *values = Vector::Constant(ns + 1 + (krein ? 1 : 0) + m, std::numeric_limits<double>::quiet_NaN());
   const bool evaluated = shooting_.Evaluate(u, nullptr, &dr_).ok;
   // A branch point's class: it decides whether the Floquet functions are defined there (physical_only) and,
   // for a conservative model, whether the crossing speeds are (see below).
   const HybridModel* model_at_u = branch_point ? ModelAt(u) : model_;
   Classification c;
-  if (branch_point && model_at_u != nullptr) c = Classify(*model_at_u, u.head(base_unknowns_));
+  std::unique_ptr<OrbitTrace> trace;
+  if (branch_point && model_at_u != nullptr) c = Classify(*model_at_u, u.head(base_unknowns_), &trace);
+  // A phase's own event touched inside it: at branch points where a physical family may end so (physical
+  // or missed-event) and the trace shows an interior minimum of the event; at trial points always.
+  if (evaluated && (!branch_point || (trace && (c.physical || c.reason == OrbitClass::kMissedEvent)))) {
+    EvaluateOwnEvents(u, branch_point ? trace.get() : nullptr, values);
+  }
   // The crossing speeds of every orbit of a model without first integral; of a conservative model, at
   // branch points that are physical or fail only by an event's direction (wrong-direction, grazing): where
   // a physical family ends at grazing its next point is of that class, and the zeros elsewhere, on orbits
@@ -163,6 +238,10 @@ bool FloquetTestFunctions::Keep(int function, const Vector& u, std::string* note
     if (model != nullptr && Classify(*model, u.head(base_unknowns_)).reason == OrbitClass::kConstraintViolated) {
       return false;
     }
+  }
+  if (function >= first_own_event()) {
+    *note = "the event of phase '" + model_->phase(function - first_own_event()).name() + "' touched inside the phase";
+    return MissedEventEndsPhysicalFamily(u);
   }
   if (type == SpecialPointType::kGrazing) {
     // A conservative model's grazing is kept where a physical family ends: the orbit there is physical

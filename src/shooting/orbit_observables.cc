@@ -297,6 +297,55 @@ EvaluationStatus ObservableEvaluator::Final(const Observable& o, const Vector& u
   return ValueAt(*o.phases[i], i, u(layout_.time_index(i)), true, u, value, du);
 }
 
+EvaluationStatus ObservableEvaluator::EvaluateExtremum(const Observable& o, const Vector& u, double* value,
+                                                       RowVector* du) {
+  HYBRIDCONT_DEMAND(o.kind == ObservableKind::kMinimum || o.kind == ObservableKind::kMaximum);
+  HYBRIDCONT_DEMAND(static_cast<int>(o.phases.size()) == model_->num_phases());
+  HYBRIDCONT_DEMAND(u.size() >= layout_.num_orbit_unknowns() + layout_.num_free_parameters());
+  if (du) du->setZero(u.size());
+  EvaluationStatus status = Extremum(o, u, value, du);
+  if (status.ok && !std::isfinite(*value)) status = EvaluationStatus::Failure("not finite");
+  if (!status.ok) status.message = "'" + o.name + "': " + status.message;
+  return status;
+}
+
+namespace {
+
+// e_i(x) of one phase as a smooth function of (x, p).
+class PhaseEventFunction : public SmoothFunction {
+ public:
+  PhaseEventFunction(const HybridModel& model, int phase) : model_(&model), phase_(phase) {}
+  double Evaluate(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& p, RowVector* dx,
+                  RowVector* dp) const override {
+    const Phase& phase = model_->phase(phase_);
+    if (dp != nullptr) {
+      HYBRIDCONT_DEMAND(phase.has_parameter_derivatives());
+      dp->setZero(p.size());
+      for (int j = 0; j < p.size(); ++j) phase.ParameterDerivatives(x, j, nullptr, nullptr, &(*dp)(j), nullptr);
+    }
+    return phase.Event(x, dx);
+  }
+
+ private:
+  const HybridModel* model_;
+  int phase_;
+};
+
+}  // namespace
+
+Observable OwnEventObservable(const HybridModel& model, int phase) {
+  HYBRIDCONT_DEMAND(phase >= 0 && phase < model.num_phases());
+  Observable o;
+  o.name = model.phase(phase).name() + "_event";
+  o.description = "the event of phase '" + model.phase(phase).name() + "' stays >= 0 until the phase's end";
+  o.kind = ObservableKind::kMinimum;
+  o.phases.resize(model.num_phases());
+  o.phases[phase] = std::make_shared<PhaseEventFunction>(model, phase);
+  o.constraint = true;
+  o.guard = true;
+  return o;
+}
+
 EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector& u, double* value, RowVector* du) {
   const int m = model_->num_phases();
   const int k = layout_.num_first_integrals();
