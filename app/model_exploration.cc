@@ -82,18 +82,20 @@ namespace {
 
 // The Floquet test functions of the time-based map on the engine's unknowns: scaled u ./ s back to model
 // units, and for the state-based formulation expanded into the time-based layout (ToTimeBased on a map of
-// its own: each stepper evaluates on its own thread). Each copy leaves its work in `sink` when destroyed.
+// its own: each stepper evaluates on its own thread; a refined copy's map is refined too, so that the
+// integration error of the expansion is in the error estimate of a located point). Each copy leaves its
+// work in `sink` when destroyed.
 class EngineFloquetTests : public TestFunctions {
  public:
+  // `state`: this copy's own map of the state-based formulation (null for the time-based one).
   EngineFloquetTests(std::unique_ptr<TestFunctions> floquet, std::unique_ptr<TestFunctions> observables,
-                     Vector scales, const StateBasedShooting* state, std::shared_ptr<ModelExploration::TestWorkSink> sink)
+                     Vector scales, std::unique_ptr<ZeroProblem> state,
+                     std::shared_ptr<ModelExploration::TestWorkSink> sink)
       : floquet_(static_cast<FloquetTestFunctions*>(floquet.release())),  // Clone and Refined keep the type
         observables_(std::move(observables)),
         scales_(std::move(scales)),
-        state_prototype_(state),
-        sink_(std::move(sink)) {
-    if (state != nullptr) state_.reset(static_cast<StateBasedShooting*>(state->Clone().release()));
-  }
+        state_(static_cast<StateBasedShooting*>(state.release())),  // Clone and Refined keep the type
+        sink_(std::move(sink)) {}
   ~EngineFloquetTests() override {
     sink_->AddMapWork(floquet_->shooting());
     sink_->AddIntegrationWork(floquet_->own_event_counters());
@@ -131,12 +133,12 @@ class EngineFloquetTests : public TestFunctions {
   }
   std::unique_ptr<TestFunctions> Clone() const override {
     return std::make_unique<EngineFloquetTests>(floquet_->Clone(), observables_ ? observables_->Clone() : nullptr,
-                                                scales_, state_prototype_, sink_);
+                                                scales_, state_ ? state_->Clone() : nullptr, sink_);
   }
   std::unique_ptr<TestFunctions> Refined(double factor) const override {
     return std::make_unique<EngineFloquetTests>(floquet_->Refined(factor),
                                                 observables_ ? observables_->Refined(factor) : nullptr, scales_,
-                                                state_prototype_, sink_);
+                                                state_ ? state_->Refined(factor) : nullptr, sink_);
   }
   void AddCurveWork(const ZeroProblem& copy) override { sink_->AddCurveWork(copy); }
 
@@ -150,7 +152,6 @@ class EngineFloquetTests : public TestFunctions {
   std::unique_ptr<FloquetTestFunctions> floquet_;
   std::unique_ptr<TestFunctions> observables_;  // null: the model has no constraints and nothing is monitored
   Vector scales_;
-  const StateBasedShooting* state_prototype_;  // the exploration's map, cloned per copy
   std::unique_ptr<StateBasedShooting> state_;
   std::shared_ptr<ModelExploration::TestWorkSink> sink_;
 };
@@ -242,7 +243,7 @@ ModelExploration::ModelExploration(const HybridModel& model, const Scenario& sce
   }
   c.test_functions = std::make_shared<EngineFloquetTests>(
       std::make_unique<FloquetTestFunctions>(model_, integrator_, true, shooting_.free_parameters()),
-      std::move(observable_tests), scales, state_.get(), test_work_);
+      std::move(observable_tests), scales, state_ ? state_->Clone() : nullptr, test_work_);
 }
 
 ZeroProblem& ModelExploration::problem() {
