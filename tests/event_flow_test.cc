@@ -151,6 +151,34 @@ TEST(EventFlow, GrazingIsReportedForATouchAndForANearlyTangentCrossing) {
   EXPECT_NEAR(res.t, 1.0 - std::sqrt(2e-6), 1e-12);
 }
 
+// A guard reached only from above (an automaton's, from_above) that the phase begins on stays unarmed while
+// the trajectory rises above it by no more than touch_tolerance and falls back: the ball leaving the ground at
+// speed 1e-5 rises by 5e-11 and sinks below it (the scuffing a model ignores), and the guard is never crossed.
+// A guard that counts everywhere calls the same rise a grazing touch; a rise by 5e-7 arms either, and the
+// ball's return is the event, at t = 2 v.
+TEST(EventFlow, ARiseWithinTouchToleranceLeavesAnUnarmedGuardUnarmed) {
+  const HybridModel ball = MakeBouncingBall();  // g = 1
+  const PhaseEventGuard ground(ball.phase(0));
+  EventFlowOptions above;
+  above.from_above = true;
+  above.max_duration = 5.0;
+  EventFlowResult res;
+  EXPECT_EQ(EventFlow(ball.phase(0), above).Integrate(Vec({0.0, 1e-5}), Vector::Zero(1), ground, false, &res),
+            EventFlowStatus::kGuardNotReached)
+      << res.message;
+  EventFlowOptions everywhere;
+  everywhere.max_duration = 5.0;
+  EXPECT_EQ(EventFlow(ball.phase(0), everywhere).Integrate(Vec({0.0, 1e-5}), Vector::Zero(1), ground, false, &res),
+            EventFlowStatus::kGrazing)
+      << res.message;
+  for (const EventFlowOptions& options : {above, everywhere}) {
+    ASSERT_EQ(EventFlow(ball.phase(0), options).Integrate(Vec({0.0, 1e-3}), Vector::Zero(1), ground, false, &res),
+              EventFlowStatus::kEventReached)
+        << res.message;
+    EXPECT_NEAR(res.t, 2e-3, 1e-12);
+  }
+}
+
 TEST(EventFlow, AGuardThatIsNeverReachedIsAStatusNotAHang) {
   const HybridModel ball = MakeBouncingBall();
   EventFlowOptions opts;

@@ -124,7 +124,9 @@ AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u,
             lo = 0;
           } else if (before[j] <= 0 && after[j] <= 0 && rate_before[j] > 0 && rate_after[j] < 0) {
             // A bump above 0 between the samples (a foot that barely clears the ground) arms the guard, and
-            // it is crossed on the way down after the maximum.
+            // it is crossed on the way down after the maximum; one by no more than the event flow's touch
+            // tolerance does not (a foot that starts on the ground and sinks into it at once, rising by
+            // rounding first), as in the replay of the word (event_flow.h).
             double top = hi;
             Vector y_top = y_hi;
             for (int b = 0; b < kBisections; ++b) {  // the maximum: the rate's zero
@@ -134,7 +136,7 @@ AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u,
               if (rates(y)[j] > 0) lo = mid;
               else top = mid, y_top = y;
             }
-            if (!(values(y_top)[j] > 0)) continue;
+            if (!(values(y_top)[j] > EventFlowOptions{}.touch_tolerance)) continue;
             lo = top;
           } else if (!(before[j] > 0 && after[j] <= 0)) {
             continue;

@@ -164,7 +164,11 @@ EventFlowStatus EventFlow::Integrate(const Eigen::Ref<const Vector>& x0, const E
                   0.0, w.z, g_prev, g_dot_prev);
   }
   if (observer) observer(0.0, x0);
-  if (options_.from_above && g_prev <= kGuardStartTolerance) {
+  // A guard reached only from above that the phase begins on or below is unarmed until the trajectory has
+  // left it upward; while it is, a rise by no more than touch_tolerance that falls back (rounding, or a foot
+  // that starts on the ground and sinks into it at once: the scuffing the model ignores) leaves it unarmed.
+  bool unarmed = options_.from_above && g_prev <= kGuardStartTolerance;
+  if (unarmed) {
     g_prev = std::min(g_prev, 0.0);  // on or below the guard: not above it
   } else if (std::abs(g_prev) <= options_.start_tolerance && g_dot_prev < 0.0) {
     std::ostringstream os;
@@ -260,7 +264,7 @@ EventFlowStatus EventFlow::Integrate(const Eigen::Ref<const Vector>& x0, const E
         crossing = true;
         t_prev = t_max;
         g_prev = g_max;
-      } else if (g_max > 0.0) {
+      } else if (g_max > 0.0 && !unarmed) {
         std::ostringstream os;
         os << at(t_max) << "the trajectory rises above the guard by only " << g_max << " <= touch_tolerance "
            << options_.touch_tolerance << " and falls back: grazing";
@@ -315,6 +319,7 @@ EventFlowStatus EventFlow::Integrate(const Eigen::Ref<const Vector>& x0, const E
     t_prev = t_new;
     g_prev = g_new;
     g_dot_prev = g_dot_new;
+    unarmed = unarmed && g_new <= 0.0;
   }
 }
 
