@@ -81,5 +81,38 @@ TEST(FamilyRanges, AStretchEndsAtABoundaryPointAndABranchPointAloneIsNoStableStr
   EXPECT_TRUE(r.stable.empty());
 }
 
+// A family that starts at rest (point 0: zero duration, on the boundary) and is stable from its first orbit
+// on: physical and stable both from the boundary point, exactly.
+TEST(FamilyRanges, AStableStretchStartsAtABoundaryPointToo) {
+  const Branch b = EightPoints();
+  const std::vector<bool> physical = {false, true, true, true, true, true, true, true};
+  const std::vector<bool> stable = {false, true, true, true, true, true, true, true};
+  std::vector<bool> boundary(8, false);
+  boundary[0] = true;
+  const BranchRanges r = RangesOnBranch(b, physical, stable, boundary, 0);
+  ASSERT_EQ(r.physical.size(), 1u);
+  ASSERT_EQ(r.stable.size(), 1u);
+  for (const Range* range : {&r.physical[0], &r.stable[0]}) {
+    EXPECT_TRUE(range->from.located);
+    EXPECT_EQ(range->from.how, "point 0, on the boundary");
+    EXPECT_DOUBLE_EQ(range->from.value, 0.0);
+  }
+}
+
+// A branch that leaves a special point, physical there only (its next point violates a constraint, nothing
+// located between): the family's one physical orbit is that point, and the stretch ends where it starts.
+TEST(FamilyRanges, APhysicalStartPointAloneIsAStretchOfOnePoint) {
+  Branch b = EightPoints();
+  b.parent_special_point = 2;
+  const std::vector<bool> physical = {true, false, false, false, false, false, false, false};
+  const std::vector<bool> stable(8, false);
+  const std::vector<bool> boundary(8, false);
+  const BranchRanges r = RangesOnBranch(b, physical, stable, boundary, 0);
+  ASSERT_EQ(r.physical.size(), 1u);
+  EXPECT_EQ(r.physical[0].to.how, "start of the branch, at special point #2");
+  EXPECT_EQ(r.physical[0].to.special_point, 2);
+  EXPECT_DOUBLE_EQ(r.physical[0].to.value, r.physical[0].from.value);
+}
+
 }  // namespace
 }  // namespace hybridcont

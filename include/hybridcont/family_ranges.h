@@ -47,9 +47,10 @@ struct BranchRanges {
 // The ranges of branch b (special points from b.special_points). physical[i] and stable[i] are the classes
 // of b.points[i] (stable only counts where physical); boundary[i] marks a point that is not physical only
 // because it lies on the boundary of the physical orbits (a phase of zero duration, a tangential event): a
-// physical stretch next to it ends at it, exactly. `coordinate` indexes u. A stable stretch of the branch's
-// start point alone, where the branch leaves a special point (the bifurcation itself, neutral there), is no
-// stretch and is left out.
+// physical or stable stretch next to it ends at it, exactly. `coordinate` indexes u. A stable stretch of the
+// branch's start point alone, where the branch leaves a special point (the bifurcation itself, neutral
+// there), is no stretch and is left out; a physical one, with no special point before the next point, is the
+// family's only physical orbit and ends where it starts.
 BranchRanges RangesOnBranch(const Branch& b, const std::vector<bool>& physical, const std::vector<bool>& stable,
                             const std::vector<bool>& boundary, int coordinate);
 

@@ -89,6 +89,12 @@ std::vector<Range> Runs(const Branch& b, const std::vector<bool>& in, int coordi
     r.from = i == 0 ? AtPoint(b, 0, coordinate, true) : Between(b, i - 1, coordinate, types, boundary, i - 1);
     r.to = j + 1 == static_cast<int>(b.points.size()) ? AtPoint(b, j, coordinate, false)
                                                        : Between(b, j, coordinate, types, boundary, j + 1);
+    // A branch that leaves a special point (a change of the phase sequence, a bifurcation) and is physical
+    // there only, its next point not, without a special point between them: the family is physical at that
+    // point alone (a stance-only oscillation that meets hopping where the flight shrinks to zero).
+    if (j == 0 && b.parent_special_point >= 0 && !r.to.located && r.to.special_point < 0) {
+      r.to = AtPoint(b, 0, coordinate, true);
+    }
     // Split at the folds of the coordinate inside the run: each stretch runs one way in it, from end to end.
     for (const SpecialPoint& sp : b.special_points) {
       if (sp.type != SpecialPointType::kTurningPoint || sp.component_index != coordinate || sp.u.size() == 0 ||
@@ -121,7 +127,7 @@ BranchRanges RangesOnBranch(const Branch& b, const std::vector<bool>& physical, 
   std::vector<bool> both(stable.size());
   for (std::size_t i = 0; i < stable.size(); ++i) both[i] = physical[i] && stable[i];
   out.physical = Runs(b, physical, coordinate, kPhysicalEnds, boundary);
-  out.stable = Runs(b, both, coordinate, kStabilityEnds, {});
+  out.stable = Runs(b, both, coordinate, kStabilityEnds, boundary);
   if (!out.stable.empty() && b.parent_special_point >= 0 && out.stable.front().last_point == 0) {
     out.stable.erase(out.stable.begin());  // the bifurcation point the branch leaves, neutral there
   }
