@@ -2,7 +2,7 @@
 # Installs what hybridcont needs to build, test and draw figures, from Debian's registry, if missing.
 # Idempotent: does nothing (and needs no network) when everything is present.
 set -eu
-PACKAGES="g++ cmake make ninja-build libeigen3-dev libboost-dev libcli11-dev nlohmann-json3-dev libfmt-dev libtomlplusplus-dev libgtest-dev libbenchmark-dev python3 python3-matplotlib python3-pytest python3-scipy"
+PACKAGES="g++ cmake make ninja-build libeigen3-dev libboost-dev libcli11-dev nlohmann-json3-dev libfmt-dev libtomlplusplus-dev libssl-dev libgtest-dev libbenchmark-dev python3 python3-matplotlib python3-pytest python3-scipy"
 missing=""
 for p in $PACKAGES; do
   dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"

@@ -1,8 +1,10 @@
 #include "model_compiler.h"
 
 #include "hybridcont/version.h"
+#include "model_cache.h"
 
 #include <dlfcn.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -165,21 +167,50 @@ std::vector<std::pair<int, std::string>> ScalarTypes(int n, bool second_order) {
 std::string EntryName(int slot, int kind) { return "hybridcont_model_" + std::to_string(slot) + "_" + std::to_string(kind); }
 std::string ParamJetEntryName(int slot) { return "hybridcont_model_" + std::to_string(slot) + "_param_jet"; }
 
-// FNV-1a, 64 bits: a stable name for the cache (not a security measure; the cache is the user's own).
-std::string Hash(const std::string& text) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
-  char buffer[17];
-  std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(h));
-  return buffer;
-}
-
 fs::path CacheDirectory(const ModelFileOptions& options) {
   if (!options.cache_dir.empty()) return options.cache_dir;
   if (const char* d = std::getenv("HYBRIDCONT_CACHE"); d && *d) return d;
   if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d) return fs::path(d) / "hybridcont";
   if (const char* d = std::getenv("HOME"); d && *d) return fs::path(d) / ".cache" / "hybridcont";
-  return fs::temp_directory_path() / "hybridcont-cache";
+  return fs::temp_directory_path() / ("hybridcont-cache-" + std::to_string(geteuid()));
+}
+
+// What identifies the compiler for the cache key: its resolved path, size and modification time (an
+// upgraded compiler is another one).
+std::string CompilerIdentity(const std::string& compiler) {
+  std::error_code ec;
+  const fs::path real = fs::canonical(compiler, ec);
+  struct stat st;
+  if (ec || stat(real.c_str(), &st) != 0) return compiler;
+  return real.string() + " " + std::to_string(st.st_size) + " " + std::to_string(st.st_mtime);
+}
+
+constexpr const char* kSourceDigestSymbol = "hybridcont_model_source_sha256";
+
+// The entry points of a loaded library, all of them, and its source digest: false (nothing stored) when a
+// symbol is missing or the digest is another model's.
+bool LoadEntries(void* handle, int slots, const std::string& source_digest, CompiledPrograms* compiled,
+                 std::string* why) {
+  const auto* digest = static_cast<const char*>(dlsym(handle, kSourceDigestSymbol));
+  if (digest == nullptr || source_digest != digest) {
+    *why = "it was compiled from another model's code";
+    return false;
+  }
+  compiled->entries.resize(slots);
+  compiled->param_jet_entries.resize(slots);
+  for (int slot = 0; slot < slots; ++slot) {
+    compiled->param_jet_entries[slot] = reinterpret_cast<CompiledParamJetFn>(dlsym(handle, ParamJetEntryName(slot).c_str()));
+    for (int kind = 0; kind < kNumScalarKinds; ++kind) {
+      compiled->entries[slot][kind] = reinterpret_cast<CompiledProgramFn>(dlsym(handle, EntryName(slot, kind).c_str()));
+    }
+    // The programs GenerateModelSource emits: four per phase (slot 5 i + 0..3) and the anchor (5 m + 4), each
+    // with its parameter-jet entry and at least the double one.
+    const bool emitted = (slot < slots - 5 && slot % 5 != 4) || slot == slots - 1;
+    if (emitted && (compiled->param_jet_entries[slot] == nullptr || compiled->entries[slot][0] == nullptr)) {
+      *why = "it lacks the entry points of program " + std::to_string(slot);
+    }
+  }
+  return why->empty();
 }
 
 // The folder holding hybridcont/model.h for the generated code: $HYBRIDCONT_INCLUDE_DIR, the installed
@@ -268,59 +299,75 @@ std::shared_ptr<const CompiledPrograms> CompileModel(const ExpressionModelSpec& 
   for (const std::string& dir : {std::string(HYBRIDCONT_EIGEN_INCLUDE_DIR)}) {
     if (!dir.empty() && dir != include.string()) flags += " -I" + Quote(dir);
   }
-  const std::string key = Hash(source + "\n" + compiler + " " + flags + "\n" + HYBRIDCONT_VERSION);
+  const std::string source_digest = Sha256Hex(source);
+  const std::string code = source + "extern \"C\" const char " + kSourceDigestSymbol + "[] = \"" + source_digest + "\";\n";
+  const std::string key =
+      Sha256Hex(source_digest + "\n" + CompilerIdentity(compiler) + " " + flags + "\n" + HYBRIDCONT_VERSION).substr(0, 32);
   const fs::path cache = CacheDirectory(options);
-  const fs::path library = cache / ("model-" + key + ".so");
-  std::error_code ec;
-  if (!fs::exists(library, ec)) {
-    fs::create_directories(cache, ec);
-    if (ec) return note("cannot create the cache folder " + cache.string() + " (" + ec.message() + ")");
-    const std::string stem = "model-" + key + "." + std::to_string(getpid());
-    const fs::path src = cache / (stem + ".cc"), tmp = cache / (stem + ".so"), log = cache / ("model-" + key + ".log");
-    {
-      std::ofstream f(src);
-      f << source;
-      if (!f) return note("cannot write to the cache folder " + cache.string());
-    }
-    if (options.log) {
-      *options.log << "compiling model '" << spec.name << "' (first use of this model; cached in " << cache.string()
-                   << ")..." << std::flush;
-    }
-    const auto start = std::chrono::steady_clock::now();
-    const std::string command =
-        Quote(compiler) + " " + flags + " -o " + Quote(tmp.string()) + " " + Quote(src.string()) + " > " +
-        Quote(log.string()) + " 2>&1";
-    const int rc = std::system(command.c_str());
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    fs::remove(src, ec);
-    if (rc != 0) {
-      if (options.log) *options.log << " failed\n";
-      fs::remove(tmp, ec);
-      return note("compiling the generated code failed (compiler output in " + log.string() + ")");
-    }
-    fs::rename(tmp, library, ec);
-    if (ec) return note("cannot move the compiled model into " + library.string());
-    fs::remove(log, ec);
-    if (options.log) {
-      char buffer[64];
-      std::snprintf(buffer, sizeof buffer, " %.1f s\n", seconds);
-      *options.log << buffer;
-    }
+  if (const std::string why = CheckCacheFolder(cache); !why.empty()) {
+    return note("the cache folder is not trusted: " + why);
   }
-  void* handle = dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
-  if (handle == nullptr) return note("loading " + library.string() + " failed: " + dlerror());
-  auto compiled = std::make_shared<CompiledPrograms>();
-  compiled->library = std::shared_ptr<void>(handle, [](void*) {
-    // Never unloaded: phases of models built from it may outlive this object in a user's program.
-  });
-  const int m = static_cast<int>(spec.phases.size());
-  compiled->entries.resize(5 * m + 5);
-  compiled->param_jet_entries.resize(5 * m + 5);
-  for (int slot = 0; slot < 5 * m + 5; ++slot) {
-    compiled->param_jet_entries[slot] = reinterpret_cast<CompiledParamJetFn>(dlsym(handle, ParamJetEntryName(slot).c_str()));
-    for (int kind = 0; kind < kNumScalarKinds; ++kind) {
-      compiled->entries[slot][kind] = reinterpret_cast<CompiledProgramFn>(dlsym(handle, EntryName(slot, kind).c_str()));
+  const int slots = 5 * static_cast<int>(spec.phases.size()) + 5;
+  const CacheEntry entry = EntryFor(cache, key);
+  const auto load = [&](const fs::path& library, std::string* why) -> std::shared_ptr<CompiledPrograms> {
+    void* handle = dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (handle == nullptr) {
+      *why = std::string("loading failed: ") + dlerror();
+      return nullptr;
     }
+    auto compiled = std::make_shared<CompiledPrograms>();
+    // Never unloaded: phases of models built from it may outlive this object in a user's program.
+    compiled->library = std::shared_ptr<void>(handle, [](void*) {});
+    if (!LoadEntries(handle, slots, source_digest, compiled.get(), why)) return nullptr;
+    return compiled;
+  };
+  bool absent = false;
+  std::string why = VerifyEntry(entry, key, &absent);
+  if (why.empty()) {
+    if (auto compiled = load(entry.library, &why)) return compiled;
+  }
+  if (!absent) {
+    if (options.log) *options.log << "note: the cached model " << entry.library.string() << " is not used (" << why << "); compiling it again\n";
+    RemoveEntry(entry);
+  }
+  // Compiled under names of this process, loaded from there, then published.
+  const std::string stem = "model-" + key + "." + std::to_string(getpid());
+  const fs::path src = cache / (stem + ".cc"), tmp = cache / (stem + ".so"), log = cache / ("model-" + key + ".log");
+  {
+    std::ofstream f(src);
+    f << code;
+    if (!f) return note("cannot write to the cache folder " + cache.string());
+  }
+  if (options.log) {
+    *options.log << "compiling model '" << spec.name << "' (" << (absent ? "first use of this model; " : "")
+                 << "cached in " << cache.string() << ")..." << std::flush;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const std::string command = Quote(compiler) + " " + flags + " -o " + Quote(tmp.string()) + " " + Quote(src.string()) +
+                              " > " + Quote(log.string()) + " 2>&1";
+  const int rc = std::system(command.c_str());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::error_code ec;
+  fs::remove(src, ec);
+  if (rc != 0) {
+    if (options.log) *options.log << " failed\n";
+    fs::remove(tmp, ec);
+    return note("compiling the generated code failed (compiler output in " + log.string() + ")");
+  }
+  fs::remove(log, ec);
+  if (options.log) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, " %.1f s\n", seconds);
+    *options.log << buffer;
+  }
+  why.clear();
+  auto compiled = load(tmp, &why);
+  if (!compiled) {
+    fs::remove(tmp, ec);
+    return note("the compiled model cannot be used: " + why);
+  }
+  if (const std::string published = PublishEntry(tmp, entry, key); !published.empty() && options.log) {
+    *options.log << "note: model '" << spec.name << "' is not cached: " << published << "\n";
   }
   return compiled;
 }

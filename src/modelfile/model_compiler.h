@@ -7,9 +7,9 @@
 // instruction codes, register numbers and numbers (as hexadecimal floating-point literals, exact) are
 // written; no text of the model file reaches the compiler.
 //
-// Cache: <cache_dir>/<hash>.so, where the hash covers the generated source, the compiler command and the
-// library's version; a changed model, compiler or library compiles anew. The file appears atomically
-// (compiled under a temporary name, then renamed), so concurrent runs never load half a library.
+// Cache: model_cache.h (an entry is loaded only when it is the user's own and is what this program compiled
+// for this model: a SHA-256 record beside it, checked before the library is opened; anything else is
+// deleted and compiled again).
 //
 // Where no compiler is found, or compiling or loading fails, CompileModel returns null and the model runs
 // interpreted; the reason is written to options.log once, with the path of the compiler's output, never
