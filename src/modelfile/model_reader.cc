@@ -16,12 +16,11 @@ ExpressionModelSpec Reader::Read() {
   conservative_ = OptionalBool(root_, "conservative", "", true);
   if (!conservative_) num_integrals_ = 0;
   spec_.name = RequiredString(root_, "name", "");
-  if (spec_.name.empty() || spec_.name.find_first_of("/\\ \t\n") != std::string::npos) {
-    Fail(root_["name"].node(), "name", "a model name must be non-empty without spaces or slashes, got '" +
-                                           spec_.name + "'");
-  }
+  CheckLabel(root_["name"].node(), "name", spec_.name);
   spec_.description = OptionalString(root_, "description", "", "");
+  CheckText(root_["description"].node(), "description", spec_.description);
   spec_.setup.title = OptionalString(root_, "title", "", spec_.name);
+  CheckText(root_["title"].node(), "title", spec_.setup.title);
   ReadParameters();
   ReadDefinitions();
   ReadPhaseHeaders();
@@ -284,6 +283,42 @@ void Reader::CheckName(const toml::node* n, const std::string& field, const std:
                           });
   if (!identifier) Fail(n, field, "'" + name + "' is not a name (letters, digits, '_'; not starting with a digit)");
   if (kReserved.count(name)) Fail(n, field, "'" + name + "' is reserved (a function or a built-in symbol)");
+}
+
+namespace {
+
+// The text with every byte that is not printable ASCII written as \xNN (a name in a message).
+std::string Escaped(const std::string& text) {
+  std::string out;
+  for (const unsigned char c : text) {
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      char buffer[5];
+      std::snprintf(buffer, sizeof buffer, "\\x%02x", c);
+      out += buffer;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+void Reader::CheckLabel(const toml::node* n, const std::string& field, const std::string& label) const {
+  const bool ok = !label.empty() && label.size() <= kMaxLabelLength && label[0] != '-' &&
+                  std::all_of(label.begin(), label.end(), [](char c) {
+                    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+                  });
+  if (!ok) {
+    Fail(n, field, "'" + Escaped(label) + "' is not a label (1 to " + std::to_string(kMaxLabelLength) +
+                       " letters, digits, '_' or '-', not starting with '-'): it names files and CSV columns");
+  }
+}
+
+void Reader::CheckText(const toml::node* n, const std::string& field, const std::string& text) const {
+  for (const unsigned char c : text) {
+    if (c < 0x20 || c == 0x7f) Fail(n, field, "'" + Escaped(text) + "' holds a control character");
+  }
 }
 
 std::string Reader::JoinNames(const std::vector<std::string>& names) {

@@ -77,6 +77,14 @@ class Reader {
   // Checks shared by several sections.
   // A symbol name must be an identifier that is not a function or a reserved name.
   void CheckName(const toml::node* n, const std::string& field, const std::string& name) const;
+  // A label names files, folders and CSV columns (the model, its phases or modes, its symmetries): 1 to
+  // kMaxLabelLength of letters, digits, '_' and '-', not starting with '-'. One rule, so that no output path
+  // leaves the results folder ("..") and no CSV cell needs quoting.
+  void CheckLabel(const toml::node* n, const std::string& field, const std::string& label) const;
+  // Free text shown to a person (a title, a description, a family's name): no control characters (a
+  // newline would break a message or a report line).
+  void CheckText(const toml::node* n, const std::string& field, const std::string& text) const;
+  static constexpr std::size_t kMaxLabelLength = 64;
   // `name` must be an unknown of the time-based layout (or, with allow_period, "period").
   void CheckUnknown(const toml::node* n, const std::string& field, const std::string& name, bool allow_period) const;
   // `name` must be an unknown of `word`'s time-based layout.

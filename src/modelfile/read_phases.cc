@@ -19,6 +19,7 @@ ExpressionPhaseSpec Reader::ReadPhaseHeader(const toml::table& t, const std::str
   }
   ExpressionPhaseSpec p;
   p.name = RequiredString(t, "name", field);
+  CheckLabel(t.get("name"), field + ".name", p.name);
   if (p.name.empty() || !names->insert(p.name).second) {
     Fail(t.get("name"), field + ".name", std::string(mode ? "mode" : "phase") + " name '" + p.name +
                                              "' is empty or used twice");
@@ -432,7 +433,7 @@ void Reader::ReadSymmetries() {
     CheckKeys(t, field, {"name", "reverses_time", "flip"});
     ModelSymmetry s;
     s.name = RequiredString(t, "name", field);
-    if (s.name.empty()) Fail(t.get("name"), field + ".name", "a symmetry needs a name");
+    CheckLabel(t.get("name"), field + ".name", s.name);
     s.reverses_time = OptionalBool(t, "reverses_time", field, false);
     const toml::table* flip = OptionalTable(t, "flip", field);
     for (const ExpressionPhaseSpec& p : spec_.phases) s.state_signs.push_back(Vector::Ones(p.state_names.size()));

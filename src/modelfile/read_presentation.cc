@@ -78,6 +78,7 @@ DrawingSpec::PhaseDrawing Reader::ReadPhaseDrawing(const toml::node& node, const
     for (auto&& [pk, pn] : *pts) {
       const std::string name(pk.str());
       const std::string pf = field + ".points." + name;
+      CheckLabel(&pn, pf, name);  // a CSV column of the key-frame orbits (draw.<point>.x)
       const toml::array& xy = AsArray(pn, pf);
       if (xy.size() != 2) Fail(&pn, pf, "expected [x, y]");
       pd.points.push_back({name, DrawingValue(*xy.get(0), pf + "[0]", phase), DrawingValue(*xy.get(1), pf + "[1]", phase)});

@@ -306,6 +306,7 @@ void Reader::ReadFamilies() {
     CheckKeys(t, field, {"name", "when"});
     FamilyRule rule;
     rule.name = RequiredString(t, "name", field);
+    CheckText(t.get("name"), field + ".name", rule.name);
     const toml::node* when = t.get("when");
     rule.when = when ? AsSetupValue(*when, field + ".when") : SetupValue("1", At(&t, field));
     spec_.setup.families.push_back(rule);
