@@ -19,7 +19,8 @@ namespace hybridcont::app {
 
 int ListCommand(const std::vector<std::string>& models, std::ostream& out, std::ostream& err) {
   for (const std::string& name : models.empty() ? BuiltinModelNames() : models) {
-    const HybridModel model = MakeModelWithOverrides(name, {}, &err);
+    // Listing reads the model; it never compiles it (the interpreted model has the same phases).
+    const HybridModel model = MakeModelWithOverrides(name, {}, &err, /*compile=*/false);
     const ShootingLayout layout(model);
     out << fmt::format("{}: {}\n", name, model.description());
     out << fmt::format("  phases (m = {}, N = {} equations in the time-based map):\n", model.num_phases(),

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
@@ -13,6 +14,43 @@
 #include "install_paths.h"
 
 namespace hybridcont::app {
+
+namespace {
+
+// A message as it may be printed to a terminal: valid UTF-8 and printable, with line breaks and tabs kept;
+// any other control byte and any byte that is not part of a valid UTF-8 sequence written as \xNN (a model
+// file's invalid byte, a newline or escape sequence inside an argument).
+std::string Printable(const std::string& text) {
+  std::string out;
+  const auto escape = [&out](unsigned char c) {
+    char buffer[5];
+    std::snprintf(buffer, sizeof buffer, "\\x%02x", c);
+    out += buffer;
+  };
+  for (std::size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c == '\n' || c == '\t' || (c >= 0x20 && c < 0x7f)) {
+      out += static_cast<char>(c);
+      ++i;
+      continue;
+    }
+    // A UTF-8 sequence: its length from the lead byte, continuation bytes 10xxxxxx, no overlong form of a
+    // two-byte sequence, nothing above U+10FFFF.
+    const int length = c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
+    bool valid = length > 0 && i + length <= text.size();
+    for (int k = 1; valid && k < length; ++k) valid = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
+    if (valid) {
+      out.append(text, i, length);
+      i += length;
+    } else {
+      escape(c);
+      ++i;
+    }
+  }
+  return out;
+}
+
+}  // namespace
 
 int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{"hybridcont: families of periodic orbits of conservative hybrid systems"};
@@ -52,7 +90,7 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
     return std::any_of(commands.begin(), commands.end(), [&](const CLI::App* c) { return c->check_name(word); });
   };
   if (argc > 1 && argv[1][0] != '-' && !is_command(argv[1])) {
-    err << "error: unknown command '" << argv[1] << "' (expected list, check, run or plot)\n"
+    err << "error: unknown command '" << Printable(argv[1]) << "' (expected list, check, run or plot)\n"
         << "Run with --help for more information.\n";
     return 2;
   }
@@ -68,7 +106,16 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
       err << e2.str();
       return code;
     }
-    err << "error: " << e.what() << "\nRun with --help for more information.\n";
+    err << "error: " << Printable(e.what());
+    // A model file named like an option ("-x.toml") is read as one: say how to name it.
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (a.size() > 5 && a[0] == '-' && a.compare(a.size() - 5, 5, ".toml") == 0) {
+        err << " ('" << Printable(a) << "' is read as an option; name the model file ./" << Printable(a) << ")";
+        break;
+      }
+    }
+    err << "\nRun with --help for more information.\n";
     return 2;
   }
   try {
@@ -77,10 +124,10 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
     if (*run) return RunCommand(run_args, out, err);
     if (*plot) return PlotCommand(plot_dir, out, err);
   } catch (const std::invalid_argument& e) {
-    err << "error: " << e.what() << "\n";
+    err << "error: " << Printable(e.what()) << "\n";
     return 2;
   } catch (const std::exception& e) {
-    err << "error: " << e.what() << "\n";
+    err << "error: " << Printable(e.what()) << "\n";
     return 1;
   }
   return 0;

@@ -491,7 +491,7 @@ void Append(BifurcationDiagram&& d, BifurcationDiagram* all) {
     all->switches.push_back(std::move(s));
   }
   all->warnings.insert(all->warnings.end(), d.warnings.begin(), d.warnings.end());
-  if (d.status == ExplorationStatus::kMaxBranches) all->status = d.status;
+  if (d.status == ExplorationStatus::kMaxBranches || d.status == ExplorationStatus::kCancelled) all->status = d.status;
 }
 
 }  // namespace
@@ -543,6 +543,7 @@ BifurcationDiagram ModelExploration::RunFromStarts(const std::vector<Vector>& st
       all.status = ExplorationStatus::kMaxBranches;
       break;
     }
+    if (all.status == ExplorationStatus::kCancelled) break;
     ExplorationOptions options = EngineOptions(on_point, offset);
     options.max_branches = options_.max_branches - offset;
     BifurcationDiagram d = Explore(scaled_.get(), scaled_->ToScaled(start), options);

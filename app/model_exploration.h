@@ -66,6 +66,10 @@ class ModelExploration {
   // status is kStartFailed with the corrector's message.
   BifurcationDiagram Run(const PointCallback& on_point = PointCallback());
 
+  // Asked before every step of every branch and before launching one (ContinuationOptions::cancel): true
+  // ends the exploration with the branches traced so far (status kCancelled).
+  void set_cancel(std::function<bool()> cancel) { options_.continuation.cancel = std::move(cancel); }
+
   // The start of Run, checked before anything runs (Run does it when it was not called): a singular start
   // must be an orbit (r = 0 to SingularStartTolerance), a guess must converge under Newton at its level H.
   // False with the reason in *why, which names every part of the cycle that does not close and the unknowns

@@ -1,5 +1,6 @@
 #include "model_options.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -13,6 +14,15 @@
 namespace hybridcont::app {
 
 double ParseFinite(const std::string& option, const std::string& text) {
+  // Decimal numbers only ("1.5", "-2e-3"): strtod would also take hexadecimal ("0x10").
+  std::string word = text.substr(text.find_first_not_of("+-") == std::string::npos ? 0 : text.find_first_not_of("+-"));
+  std::transform(word.begin(), word.end(), word.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (word == "inf" || word == "infinity" || word == "nan") {
+    throw std::invalid_argument(option + ": value '" + text + "' is not finite");
+  }
+  if (text.find_first_not_of("0123456789+-.eE") != std::string::npos) {
+    throw std::invalid_argument(option + ": value '" + text + "' is not a number");
+  }
   std::size_t used = 0;
   double value = 0.0;
   try {
@@ -58,11 +68,12 @@ BoundAssignment ParseBound(const std::string& option, const std::string& text) {
 }
 
 HybridModel MakeModelWithOverrides(const std::string& name, const std::vector<std::string>& assignments,
-                                   std::ostream* log) {
+                                   std::ostream* log, bool compile) {
   HybridModel model = [&] {
     if (!IsModelFilePath(name)) return MakeBuiltinModel(name);
     ModelFileOptions options;
     options.log = log;
+    options.compile = compile;
     // A relative path that does not exist here names one of the shipped models: `hybridcont run
     // stiffening-slip.toml` finds <models folder>/stiffening-slip.toml of this installation.
     std::filesystem::path path = name;

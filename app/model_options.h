@@ -19,9 +19,10 @@ std::pair<std::string, double> ParseAssignment(const std::string& option, const 
 // relative path that does not exist is looked up in the installation's models folder, install_paths.h) —
 // and applies the overrides; throws std::invalid_argument on an unknown model, a bad model file (file,
 // line and field in the message) or an unknown parameter or a value outside its range. Notes on compiling
-// a model file (first use, interpreted fall-back) go to `log`.
+// a model file (first use, interpreted fall-back) go to `log`; without `compile` a model file is interpreted
+// (reading it for a listing needs no compiler).
 HybridModel MakeModelWithOverrides(const std::string& name, const std::vector<std::string>& assignments,
-                                   std::ostream* log = nullptr);
+                                   std::ostream* log = nullptr, bool compile = true);
 
 // Parses "NAME=LOWER:UPPER" (either end may be empty for an unbounded side). Throws std::invalid_argument
 // naming the option and the text.

@@ -1,5 +1,7 @@
 #include "results_writer.h"
 
+#include <sstream>
+
 #include "hybridcont/version.h"
 
 #include <fmt/format.h>
@@ -145,6 +147,7 @@ bool ResultsWriter::WriteFailed(const fs::path& file) {
   if (write_error_.empty()) {
     write_error_ = "writing " + file.string() + " failed (" + (errno ? std::strerror(errno) : "I/O error") + ")";
   }
+  failed_ = true;
   return false;
 }
 
@@ -181,10 +184,13 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
   const auto other = branch_models_.find(branch_id);
   const ShootingLayout& layout = other == branch_models_.end() ? layout_ : other->second.layout;
   const OrbitPresentation& presentation = other == branch_models_.end() ? presentation_ : other->second.presentation;
+  // The row (and, first, the header) is made in memory and written at once; a write that fails leaves the
+  // file cut back to its last whole row (a full disk tears no row).
+  std::ostringstream f;
   auto it = branch_files_.find(branch_id);
   if (it == branch_files_.end()) {
     it = branch_files_.emplace(branch_id, std::ofstream(dir_ / BranchFileName(branch_id))).first;
-    std::ofstream& f = it->second;
+    branch_bytes_[branch_id] = 0;
     f << "index,H,T";
     const auto& names = layout.unknown_names();
     for (int j = 0; j < layout.num_free_parameters(); ++j) f << "," << names[layout.parameter_index(j)];
@@ -199,7 +205,6 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
     for (const auto& [name, value] : p.observables) f << "," << name;
     f << "\n";
   }
-  std::ofstream& f = it->second;
   const Vector& u = p.u;
   // A model without first integral has no H̄: the column stays (every branch file has it) and holds nan.
   f << fmt::format("{},{:.17g},{:.17g}", p.index, layout.has_level() ? u(layout.H_index()) : std::nan(""),
@@ -225,11 +230,17 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
     else f << ",";
   }
   f << "\n";
+  const std::string row = f.str();
+  std::ofstream& file = it->second;
   errno = 0;
-  if (!f.flush()) {
+  if (!file.write(row.data(), static_cast<std::streamsize>(row.size())) || !file.flush()) {
     WriteFailed(dir_ / BranchFileName(branch_id));
+    file.close();
+    std::error_code ec;
+    fs::resize_file(dir_ / BranchFileName(branch_id), branch_bytes_[branch_id], ec);
     return;
   }
+  branch_bytes_[branch_id] += row.size();
   ++points_per_branch_[branch_id];
 }
 
@@ -304,6 +315,9 @@ std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int 
   }
   if (!f.flush()) {
     WriteFailed(dir_ / name);
+    f.close();
+    std::error_code ec;
+    fs::remove(dir_ / name, ec);  // no torn orbit: it is listed nowhere
     return name;
   }
   summary_["orbits"].push_back(

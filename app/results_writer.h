@@ -27,6 +27,7 @@
 #ifndef HYBRIDCONT_APP_RESULTS_WRITER_H_
 #define HYBRIDCONT_APP_RESULTS_WRITER_H_
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -125,6 +126,8 @@ class ResultsWriter {
   // Empty while every file has been written in full; else what failed (file and system message). After a
   // failure nothing more is written.
   const std::string& write_error() const { return write_error_; }
+  // Whether a write has failed: safe to ask from any thread (a run's cancel hook, continuation.h).
+  bool failed() const { return failed_.load(); }
 
   const std::filesystem::path& dir() const { return dir_; }
   static std::string BranchFileName(int id) { return "branch-" + std::to_string(id) + ".csv"; }
@@ -147,7 +150,9 @@ class ResultsWriter {
   std::map<int, std::vector<ClassifiedPoint>> classified_;
   std::map<int, std::ofstream> branch_files_;
   std::map<int, int> points_per_branch_;
+  std::map<int, std::uintmax_t> branch_bytes_;  // bytes of each branch file written in full (whole rows)
   std::string write_error_;
+  std::atomic<bool> failed_{false};
 
   // Records the first failed write of `file` (errno's message) and returns false.
   bool WriteFailed(const std::filesystem::path& file);

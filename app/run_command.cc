@@ -339,6 +339,9 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   const auto on_point = [&](const ProgressInfo& info, const Vector& u_problem) { stream.Add(info, u_problem); };
   std::string starts_report;
   BifurcationDiagram diagram;
+  // A write that fails (a full disk) stops the run at once: the branches end at their last point, nothing
+  // more is computed, and the run says which file could not be written.
+  exploration.set_cancel([&writer] { return writer.failed(); });
   if (setup.free.empty()) {
     starts_report = exploration.start_report();
     if (!args.quiet) out << starts_report;  // how far Newton moved a guess
@@ -362,6 +365,7 @@ int ComputeAndWrite(const RunArguments& args, const HybridModel& model, Formulat
   }
   if (formulation == Formulation::kStateBased) ConvertToTimeBased(exploration, layout, &diagram);
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
+  if (writer.failed()) return FinishAndDraw(args, diagram, writer, out, err);  // reports the failed write
   nlohmann::json special_points = SpecialPointsJson(diagram, layout, &model, setup.integrator);
   const std::string floquet_report = FloquetReport(diagram, layout);
   std::string period_doubled;
@@ -442,6 +446,7 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     throw std::invalid_argument("--period-doubling: not with --free '" + args.free + "'");
   }
   const RunSetup setup = MakeRunSetup(args, model);
+  for (const std::string& note : setup.notes) err << "note: " << note << "\n";
   const nlohmann::json options_json = OptionsJson(args, setup);
   const std::unique_ptr<ModelExploration> exploration = MakeExploration(args, model, setup, formulation);
   CheckConservationAtStart(model, args.model, exploration->shooting().layout(), setup.scenario.start);

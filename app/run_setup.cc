@@ -73,15 +73,19 @@ void ApplyTargetsAndBounds(const RunArguments& args, const HybridModel& model, C
 
 // A target beyond the model's default bound on the same unknown widens that bound to the target: the user
 // asked to reach it (an explicit --bound on that unknown is kept as given).
-void WidenBoundsToTargets(const RunArguments& args, ContinuationOptions* c) {
+void WidenBoundsToTargets(const RunArguments& args, ContinuationOptions* c, std::vector<std::string>* notes) {
   for (const ComponentTarget& t : c->targets) {
     const bool explicit_bound = std::any_of(args.bounds.begin(), args.bounds.end(), [&](const std::string& text) {
       return text.rfind(t.component + "=", 0) == 0;
     });
     for (ComponentBound& b : c->bounds) {
-      if (b.component != t.component || explicit_bound) continue;
+      if (b.component != t.component || explicit_bound || (t.value >= b.lower && t.value <= b.upper)) continue;
+      const double lower = b.lower, upper = b.upper;
       b.lower = std::min(b.lower, t.value);
       b.upper = std::max(b.upper, t.value);
+      notes->push_back(fmt::format("--until {}={:g} lies outside the bound [{:g}, {:g}] of {}: the bound is widened "
+                                   "to [{:g}, {:g}] (give --bound {}=LOWER:UPPER to keep it)",
+                                   t.component, t.value, lower, upper, t.component, b.lower, b.upper, t.component));
     }
   }
 }
@@ -278,7 +282,7 @@ RunSetup MakeRunSetup(const RunArguments& given, const HybridModel& model) {
     return presentation.Family(u);
   };
   ApplyTargetsAndBounds(args, model, &setup.exploration.continuation);
-  WidenBoundsToTargets(args, &setup.exploration.continuation);
+  WidenBoundsToTargets(args, &setup.exploration.continuation, &setup.notes);
   return setup;
 }
 

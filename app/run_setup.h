@@ -30,6 +30,9 @@ struct RunSetup {
   // range within [value/4, 4 value]).
   std::string curve_parameter;
   ComponentBound curve_bound;
+  // What the set-up changed that the user did not write, said before the run ("--until H=5 widens the
+  // bound of H to [0, 5]").
+  std::vector<std::string> notes;
 };
 
 // The model's default scenario with --free, --fix, --curves, --rtol, --atol, --until, --bound, --max-branches, --threads and

@@ -387,6 +387,20 @@ const std::vector<BadInputCase>& Cases() {
        [](const Context& c) {
          const nlohmann::json s = Summary(c.work / "mnt" / "res");
          if (s.is_object()) EXPECT_NE(s["status"], "complete") << "a failed run claims to be complete";
+         // no torn row: every CSV file ends with a whole row, and its rows are as wide as its header
+         std::error_code ec;
+         for (const auto& e : fs::directory_iterator(c.work / "mnt" / "res", ec)) {
+           if (e.path().extension() != ".csv") continue;
+           const std::string text = ReadFile(e.path());
+           if (text.empty()) continue;
+           EXPECT_EQ(text.back(), '\n') << e.path();
+           std::istringstream rows(text);
+           std::string row;
+           std::set<long> widths;
+           while (std::getline(rows, row)) widths.insert(std::count(row.begin(), row.end(), ','));
+           EXPECT_EQ(widths.size(), 1u) << e.path();
+         }
+         EXPECT_NE(ReadFile(c.work.string() + ".stderr").find("failed (No space left on device)"), std::string::npos);
        }},
       {"OutHoldsAnotherModel", Cli({"run", "slip", "--out", "res", "--quiet", "--no-plots"}), 2,
        "--out 'res': holds the results of model 'bouncing-ball', not 'slip'; choose another folder or pass --overwrite",
@@ -543,6 +557,35 @@ const std::vector<BadInputCase>& Cases() {
        BallResultsThen([](const fs::path& res) { fs::resize_file(res / "summary.json", 50); }), Tool::kScript},
       {"ScriptStatusNotAString", Script({"res"}), 2, "'status' must be a string",
        SummaryEdit("\"status\": \"complete\"", "\"status\": 1"), Tool::kScript},
+      // ---------------------------------------------------------------- hostile names, numbers, sizes
+      // a model named ".." would write its results into the working folder: refused, nothing written
+      {"ModelNamedDots", Cli({"run", "m.toml", "--quiet", "--no-plots"}), 2, "m.toml:5: name: '..' is not a label",
+       BallFile("m.toml", "name = \"bouncing-ball\"", "name = \"..\"")},
+      {"ModelNamedDot", Cli({"run", "m.toml", "--quiet", "--no-plots"}), 2, "name: '.' is not a label",
+       BallFile("m.toml", "name = \"bouncing-ball\"", "name = \".\"")},
+      // a phase name that would tear the CSV (a comma, a quote, a newline)
+      {"PhaseNameTearsCsv", Cli({"run", "m.toml", "--quiet", "--no-plots"}), 2, "phases[0].name: 'fl,ight\"' is not a label",
+       BallFile("m.toml", "name = \"flight\"", "name = \"fl,ight\\\"\"")},
+      {"SetHexadecimal", Run("slip", {"--set", "k=0x10"}), 2, "--set 'k=0x10': value '0x10' is not a number"},
+      {"UntilWidensTheBound", Run("bouncing-ball", {"--until", "H=1.5", "--max-branches", "1"}), 0,
+       "note: --until H=1.5 lies outside the bound [-1, 1] of H: the bound is widened to [-1, 1.5]"},
+      {"CommandWithControlBytes", Cli({"fr\x1b[31mob\xff"}), 2, "unknown command 'fr\\x1b[31mob\\xff'"},
+      {"ModelFileNamedLikeAnOption", Cli({"run", "-x.toml"}), 2, "name the model file ./-x.toml",
+       File("-x.toml", [] { return Ball(); })},
+      {"ModelFileTooManyPhases", Cli({"check", "m.toml"}), 2, "m.toml:3: phases: 101 phases; a model has at most 100",
+       File("m.toml", [] { return "hybridcont = 1\nname = \"m\"\n" + Repeat("[[phases]]\nname = \"p\"\n", 101); })},
+      {"ModelFileTooManyNames", Cli({"check", "m.toml"}), 2, "300 entries; a list of names has at most 256",
+       File("m.toml", [] {
+         std::string names;
+         for (int i = 0; i < 300; ++i) names += (i ? ", " : "") + ("\"q" + std::to_string(i) + "\"");
+         return Replace(Ball(), "states = [\"y\", \"dy\"]", "states = [" + names + "]");
+       })},
+      {"ModelFileHugeExpression", Cli({"check", "m.toml"}), 2, "more than 4000 operations in one expression",
+       BallFile("m.toml", "ode = { y = \"dy\"", "ode = { y = \"dy" + Repeat("+dy*dy", 5000) + "\"")},
+      // listing reads a model; it does not compile it
+      {"ListDoesNotCompile", Cli({"list", "m.toml"}), 0, "1. flight         n = 2  (y, dy)",
+       BallFile("m.toml", "ode = { y = \"dy\"", "ode = { y = \"dy*1.000000000123\""), Tool::kCli,
+       [](const Context& c) { EXPECT_EQ(ReadFile(c.work.string() + ".stderr").find("compiling"), std::string::npos); }},
   };
   return cases;
 }

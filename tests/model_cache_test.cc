@@ -189,6 +189,21 @@ TEST_F(ModelCache, AFolderOrFileOthersMayWriteIsNotTrusted) {
   ExpectThePhysicsOf(kBall, folder.model);
 }
 
+// The compiler's memory is bounded ($HYBRIDCONT_COMPILE_MEMORY_MB): past it the model runs interpreted, and
+// the note names the limit and how to raise it. (256 MB of address space is below what compiling any model
+// with Eigen's headers takes.)
+TEST_F(ModelCache, ACompilerPastItsMemoryLimitLeavesTheModelInterpreted) {
+  setenv("HYBRIDCONT_COMPILE_MEMORY_MB", "256", 1);
+  const Loaded loaded = Load(kBall, cache_);
+  unsetenv("HYBRIDCONT_COMPILE_MEMORY_MB");
+  EXPECT_NE(loaded.log.find("runs interpreted (slower): compiling needed more than 256 MB (the limit; raise it with "
+                            "HYBRIDCONT_COMPILE_MEMORY_MB=MB)"),
+            std::string::npos)
+      << loaded.log;
+  ExpectThePhysicsOf(kBall, loaded.model);
+  for (const auto& e : fs::directory_iterator(cache_)) EXPECT_NE(e.path().extension(), ".so") << e.path();
+}
+
 TEST_F(ModelCache, AFolderOfAnotherUserIsNotTrusted) {
   if (geteuid() != 0) GTEST_SKIP() << "giving a folder to another user needs root";
   fs::create_directories(cache_);

@@ -215,7 +215,11 @@ const BadFile kBadFiles[] = {
      "hybridcont: expected the format version as an integer"},
     {"MissingName", "name = \"slip\"\n", "", 1, "name: missing field 'name'"},
     {"NameWithSpace", "name = \"slip\"", "name = \"my slip\"", 4,
-     "name: a model name must be non-empty without spaces"},
+     "name: 'my slip' is not a label (1 to 64 letters, digits, '_' or '-', not starting with '-'): it names files"},
+    {"NameDots", "name = \"slip\"", "name = \"..\"", 4, "name: '..' is not a label"},
+    {"NameNewline", "name = \"slip\"", "name = \"a\\nb\"", 4, "name: 'a\\x0ab' is not a label"},
+    {"PhaseNameComma", "name = \"stance\"", "name = \"st,ance\"", 17, "phases[0].name: 'st,ance' is not a label"},
+    {"TitleNewline", "title = \"SLIP hopper\"", "title = \"SLIP\\nhopper\"", 5, "title: 'SLIP\\x0ahopper' holds a control character"},
     {"UnknownTopLevelField", "title = \"SLIP hopper\"\n", "title = \"SLIP hopper\"\nauthor = \"me\"\n", 6,
      "author: unknown field 'author'"},
     {"StringExpectedGotInteger", "title = \"SLIP hopper\"", "title = 3", 5, "title: expected a string, got an integer"},
@@ -276,8 +280,8 @@ const BadFile kBadFiles[] = {
     {"NestedTooDeep", "ode.l = \"dl\"", "ode.l = \"" + Repeat("(", 250) + "dl" + Repeat(")", 250) + "\"", 21,
      "phases.stance.ode.l: in expression '" + Repeat("(", 77) + "...' at column 101: nested more than 200 levels deep"},
     {"SumTooLong", "ode.l = \"dl\"", "ode.l = \"dl" + Repeat("+dl", 10000) + "\"", 21,
-     "phases.stance.ode.l: in expression 'dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl...' at column 30003: "
-     "more than 10000 operations deep"},
+     "phases.stance.ode.l: in expression 'dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl+dl...' at column 12006: "
+     "more than 4000 operations in one expression (split it into `let` quantities or definitions)"},
     {"LetCycle", "let.s = \"sin(alpha)\"\nlet.c = \"cos(alpha)\"", "let.s = \"c\"\nlet.c = \"s\"", 42,
      "phases.flight.let.c: 'c' is defined in terms of itself"},
     {"LetShadowsState", "let.s = \"sin(alpha)\"", "let.y = \"sin(alpha)\"", 41,
@@ -305,7 +309,7 @@ const BadFile kBadFiles[] = {
      "symmetries[1].flip.hover: 'hover' is not a phase"},
     {"SymmetryDeclaredTwice", "name = \"time-reversal\"", "name = \"mirror\"", 53,
      "symmetries[1].name: symmetry 'mirror' declared twice"},
-    {"SymmetryWithoutName", "name = \"mirror\"", "name = \"\"", 49, "symmetries[0].name: a symmetry needs a name"},
+    {"SymmetryWithoutName", "name = \"mirror\"", "name = \"\"", 49, "symmetries[0].name: '' is not a label"},
     {"SymmetryIsTheIdentity", "flip = { stance = [\"alpha\", \"dalpha\"], flight = [\"alpha\", \"dx\", \"dalpha\"] }",
      "flip = {}", 50, "symmetries[0].flip: symmetry 'mirror' flips no state and does not reverse time"},
     // ---- start and run

@@ -184,6 +184,10 @@ struct ContinuationOptions {
   // Called with each accepted point; returning true ends the branch there (kUserStop). E.g. a maximum
   // period computed from u by the caller.
   std::function<bool(const Vector& u)> stop_predicate;
+  // Asked before every step, on the tracing thread (so thread-safe): true ends the branch at its last
+  // point (kUserStop, "cancelled"), and an exploration launches no further branch (kCancelled). E.g. a
+  // results writer whose disk is full, or a user's interrupt.
+  std::function<bool()> cancel;
   // Recognize a branch that returns to its start point (kClosedLoop).
   bool detect_closed_loop = true;
   // Components reported in ProgressInfo::values (names); empty reports all of u.

@@ -91,6 +91,7 @@ enum class ExplorationStatus {
   kCompleted,    // every reachable branch within the bounds and depth was traced
   kMaxBranches,  // stopped at max_branches
   kStartFailed,  // no branch could be started (see message)
+  kCancelled,    // ContinuationOptions::cancel returned true: the branches traced so far
 };
 std::string ToString(ExplorationStatus status);
 

@@ -167,6 +167,11 @@ std::unique_ptr<HalfBranch> Explorer::FromPoint(const Vector& u, const Vector& d
 // Groups of queued SB points, their switching directions computed now: serially the next one when
 // nothing else is left, concurrently also ahead while half-branches can be handed to the workers.
 void Explorer::LaunchQueued() {
+  const auto& cancel = options_.continuation.cancel;
+  if (cancel && diagram_.status == ExplorationStatus::kCompleted && cancel()) {
+    diagram_.status = ExplorationStatus::kCancelled;
+    diagram_.message = "cancelled";
+  }
   while (!queue_.empty() && diagram_.status == ExplorationStatus::kCompleted) {
     if (!groups_.empty() && (!pool_ || BranchBudgetSpent())) return;
     const int id = queue_.front();
@@ -302,6 +307,7 @@ constexpr EnumName<ExplorationStatus> kExplorationStatusNames[] = {
     {ExplorationStatus::kCompleted, "completed"},
     {ExplorationStatus::kMaxBranches, "max-branches"},
     {ExplorationStatus::kStartFailed, "start-failed"},
+    {ExplorationStatus::kCancelled, "cancelled"},
 };
 
 }  // namespace

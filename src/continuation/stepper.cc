@@ -112,6 +112,7 @@ class ContinuationStepper::Impl {
   // points of the new interval, the user's stop and max_points.
   StepStatus Step() {
     if (finished()) return StepStatus::kFinished;
+    if (options_.cancel && options_.cancel()) return Finish(TerminationReason::kUserStop, "cancelled");
     for (int retry = 0;; ++retry) {
       const ContinuationPoint& a = branch_.points.back();
       ContinuationPoint b;

@@ -87,6 +87,10 @@ class Parser {
   // compiling and destroying a tree recurse that deep, and a long sum "a+a+...+a" is a chain as deep as
   // it has terms (50000 overflowed the stack).
   static constexpr int kMaxTreeDepth = 10000;
+  // Operations written in one expression: the work of compiling a model grows with them (a 10,000-operation
+  // expression compiled for 29 s), and a hand- or CAS-written expression above this is better split.
+  static constexpr int kMaxOperations = 4000;
+  int operations_ = 0;
 
   [[noreturn]] void Fail(const std::string& what) const {
     throw ModelInputError(where_, "in expression '" + Excerpt() + "' at column " + std::to_string(pos_ + 1) +
@@ -126,6 +130,10 @@ class Parser {
     return tree_depth_[e.get()] = depth + 1;
   }
   ExprPtr Node(ExprOp op, std::vector<ExprPtr> args) {
+    if (++operations_ > kMaxOperations) {
+      Fail("more than " + std::to_string(kMaxOperations) +
+           " operations in one expression (split it into `let` quantities or definitions)");
+    }
     int depth = 0;
     for (const ExprPtr& a : args) depth = std::max(depth, TreeDepth(a));
     if (depth + 1 > kMaxTreeDepth) {

@@ -5,8 +5,10 @@
 
 #include <dlfcn.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -187,6 +189,29 @@ std::string CompilerIdentity(const std::string& compiler) {
 
 constexpr const char* kSourceDigestSymbol = "hybridcont_model_source_sha256";
 
+// The compiler's bounds: $HYBRIDCONT_COMPILE_SECONDS (default 120) and $HYBRIDCONT_COMPILE_MEMORY_MB (its
+// address space, default 4096); a value that is not a whole number in range keeps the default.
+constexpr const char* kSecondsVariable = "HYBRIDCONT_COMPILE_SECONDS";
+constexpr const char* kMegabytesVariable = "HYBRIDCONT_COMPILE_MEMORY_MB";
+struct CompileLimits {
+  long seconds = 120;
+  long megabytes = 4096;
+};
+CompileLimits Limits() {
+  CompileLimits limits;
+  const auto read = [](const char* name, long lo, long hi, long* value) {
+    const char* text = std::getenv(name);
+    if (text == nullptr || *text == '\0') return;
+    char* end = nullptr;
+    errno = 0;
+    const long v = std::strtol(text, &end, 10);
+    if (errno == 0 && *end == '\0' && v >= lo && v <= hi) *value = v;
+  };
+  read(kSecondsVariable, 1, 86400, &limits.seconds);
+  read(kMegabytesVariable, 256, 1L << 20, &limits.megabytes);
+  return limits;
+}
+
 // The entry points of a loaded library, all of them, and its source digest: false (nothing stored) when a
 // symbol is missing or the digest is another model's.
 bool LoadEntries(void* handle, int slots, const std::string& source_digest, CompiledPrograms* compiled,
@@ -342,16 +367,33 @@ std::shared_ptr<const CompiledPrograms> CompileModel(const ExpressionModelSpec& 
     *options.log << "compiling model '" << spec.name << "' (" << (absent ? "first use of this model; " : "")
                  << "cached in " << cache.string() << ")..." << std::flush;
   }
+  // The compiler's time and memory are bounded (a huge model could take minutes and gigabytes): past
+  // either the model runs interpreted, and the note names the limit and how to raise it.
+  const CompileLimits limits = Limits();
   const auto start = std::chrono::steady_clock::now();
-  const std::string command = Quote(compiler) + " " + flags + " -o " + Quote(tmp.string()) + " " + Quote(src.string()) +
-                              " > " + Quote(log.string()) + " 2>&1";
-  const int rc = std::system(command.c_str());
+  const std::string command = "ulimit -v " + std::to_string(limits.megabytes * 1024) + "; exec timeout -k 5 " +
+                              std::to_string(limits.seconds) + " " + Quote(compiler) + " " + flags + " -o " +
+                              Quote(tmp.string()) + " " + Quote(src.string()) + " > " + Quote(log.string()) + " 2>&1";
+  const int status = std::system(command.c_str());
+  const int rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::error_code ec;
   fs::remove(src, ec);
   if (rc != 0) {
     if (options.log) *options.log << " failed\n";
     fs::remove(tmp, ec);
+    if (rc == 124 || rc == 137) {
+      fs::remove(log, ec);
+      return note("compiling took more than " + std::to_string(limits.seconds) + " s (the limit; raise it with " +
+                  kSecondsVariable + "=SECONDS)");
+    }
+    std::ifstream in(log);
+    const std::string output((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (output.find("memory exhausted") != std::string::npos || output.find("Cannot allocate memory") != std::string::npos ||
+        output.find("out of memory") != std::string::npos) {
+      return note("compiling needed more than " + std::to_string(limits.megabytes) + " MB (the limit; raise it with " +
+                  kMegabytesVariable + "=MB)");
+    }
     return note("compiling the generated code failed (compiler output in " + log.string() + ")");
   }
   fs::remove(log, ec);

@@ -160,6 +160,10 @@ const toml::array& Reader::AsArray(const toml::node& n, const std::string& field
 std::vector<std::string> Reader::StringArray(const toml::node& n, const std::string& field) const {
   std::vector<std::string> out;
   const toml::array& a = AsArray(n, field);
+  if (a.size() > kMaxListLength) {
+    Fail(&n, field, std::to_string(a.size()) + " entries; a list of names has at most " +
+                        std::to_string(kMaxListLength));
+  }
   for (std::size_t i = 0; i < a.size(); ++i) out.push_back(AsString(*a.get(i), field + "[" + std::to_string(i) + "]"));
   return out;
 }

@@ -85,6 +85,12 @@ class Reader {
   // newline would break a message or a report line).
   void CheckText(const toml::node* n, const std::string& field, const std::string& text) const;
   static constexpr std::size_t kMaxLabelLength = 64;
+  // Bounds on a file's size in names and phases: work that grows with them (deriving the equations of a
+  // phase from its mechanics is cubic in its coordinates and pinned ones; each phase is compiled) stays
+  // bounded for a small file. Far above the largest legitimate models (a 40-state walker, 10 phases).
+  static constexpr std::size_t kMaxListLength = 256;  // entries of a list of names (states, lines, ...)
+  static constexpr std::size_t kMaxPinned = 16;       // pinned coordinates of a mechanical phase
+  static constexpr std::size_t kMaxPhases = 100;      // phases, or modes and transitions of an automaton
   // `name` must be an unknown of the time-based layout (or, with allow_period, "period").
   void CheckUnknown(const toml::node* n, const std::string& field, const std::string& name, bool allow_period) const;
   // `name` must be an unknown of `word`'s time-based layout.

@@ -42,6 +42,10 @@ Reader::MechanicalNames Reader::ReadMechanicalNames(const toml::table& t, const 
   }
   if (const toml::node* pinned = t.get("pinned")) {
     names.pinned = StringArray(*pinned, pf + ".pinned");
+    if (names.pinned.size() > kMaxPinned) {
+      Fail(pinned, pf + ".pinned", std::to_string(names.pinned.size()) + " pinned coordinates; a phase has at most " +
+                                       std::to_string(kMaxPinned));
+    }
     if (!t.get("kinetic")) {
       Fail(pinned, pf + ".pinned", "pinned coordinates need 'kinetic' (the impact's mass matrix in the extended "
                                    "coordinates is derived from T)");

@@ -93,6 +93,9 @@ void Reader::ReadPhaseHeaders() {
   }
   const toml::array& a = AsArray(*n, "phases");
   if (a.empty()) Fail(n, "phases", "a model needs at least one phase");
+  if (a.size() > kMaxPhases) {
+    Fail(n, "phases", std::to_string(a.size()) + " phases; a model has at most " + std::to_string(kMaxPhases));
+  }
   std::set<std::string> names;
   for (std::size_t i = 0; i < a.size(); ++i) {
     const std::string field = "phases[" + std::to_string(i) + "]";
@@ -115,6 +118,9 @@ void Reader::ReadAutomatonHeaders() {
   const toml::node* mn = root_.get("modes");
   if (mn == nullptr) Fail(&root_, "modes", "missing field 'modes' (an automaton's [[modes]] tables)");
   const toml::array& ma = AsArray(*mn, "modes");
+  if (ma.size() > kMaxPhases) {
+    Fail(mn, "modes", std::to_string(ma.size()) + " modes; an automaton has at most " + std::to_string(kMaxPhases));
+  }
   if (ma.empty()) Fail(mn, "modes", "an automaton needs at least one mode");
   std::set<std::string> names;
   std::vector<ExpressionPhaseSpec> modes;
@@ -141,6 +147,9 @@ void Reader::ReadAutomatonHeaders() {
   const toml::node* tn = root_.get("transitions");
   if (tn == nullptr) Fail(&root_, "transitions", "missing field 'transitions' (an automaton's [[transitions]] tables)");
   const toml::array& ta = AsArray(*tn, "transitions");
+  if (ta.size() > kMaxPhases) {
+    Fail(tn, "transitions", std::to_string(ta.size()) + " transitions; an automaton has at most " + std::to_string(kMaxPhases));
+  }
   struct Header {
     AutomatonTransition transition;
     const toml::table* table;
