@@ -283,6 +283,18 @@ RunSetup MakeRunSetup(const RunArguments& given, const HybridModel& model) {
   };
   ApplyTargetsAndBounds(args, model, &setup.exploration.continuation);
   WidenBoundsToTargets(args, &setup.exploration.continuation, &setup.notes);
+  // The continued coordinate with no bound: each branch is bounded by its number of points, said.
+  const std::string continued = !setup.free.parameters.empty() ? setup.free.parameters.front()
+                                : model.num_first_integrals() > 0 ? std::string("H")
+                                                                  : model.setup().run.parameter;
+  const auto& bounds = setup.exploration.continuation.bounds;
+  if (!continued.empty() && std::none_of(bounds.begin(), bounds.end(), [&](const ComponentBound& b) {
+        return b.component == continued && std::isfinite(b.lower) && std::isfinite(b.upper);
+      })) {
+    setup.notes.push_back(fmt::format("{} has no bound (run.bounds or --bound {}=LOWER:UPPER): each branch ends after "
+                                      "{} points (run.max_points)",
+                                      continued, continued, setup.exploration.continuation.max_points));
+  }
   return setup;
 }
 

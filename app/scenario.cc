@@ -1,5 +1,8 @@
 #include "scenario.h"
 
+#include <fmt/format.h>
+
+#include "hybridcont/expression.h"
 #include "hybridcont/setup_evaluation.h"
 
 namespace hybridcont::app {
@@ -14,6 +17,11 @@ Scenario DefaultScenario(const HybridModel& model) {
     const std::string field = "run.bounds." + b.component;
     const double lower = EvaluateSetupValue(model, b.lower, field + "[0]");
     const double upper = EvaluateSetupValue(model, b.upper, field + "[1]");
+    if (!(lower < upper)) {  // a bound evaluates after --set: said at its line, with the values
+      SourceLocation where = b.upper.where;
+      where.field = field;
+      throw ModelInputError(where, fmt::format("the lower end {:g} is not below the upper end {:g}", lower, upper));
+    }
     if (b.component == "period") {
       std::vector<std::string> durations;
       for (int i = 0; i <= model.num_phases(); ++i) durations.push_back(std::string("t").append(std::to_string(i + 1)));

@@ -582,6 +582,15 @@ const std::vector<BadInputCase>& Cases() {
        })},
       {"ModelFileHugeExpression", Cli({"check", "m.toml"}), 2, "more than 4000 operations in one expression",
        BallFile("m.toml", "ode = { y = \"dy\"", "ode = { y = \"dy" + Repeat("+dy*dy", 5000) + "\"")},
+      // a bound whose ends are reversed: said at its line (it is evaluated after --set)
+      {"BoundReversedInTheFile", Cli({"run", "m.toml", "--quiet", "--no-plots"}), 2,
+       "m.toml:34: run.bounds.H: the lower end 1 is not below the upper end -1", BallFile("m.toml", "H = [-1, 1]", "H = [1, -1]")},
+      // a phase's let named like a definition would hide it in that phase only
+      {"LetShadowsADefinition", Cli({"check", "m.toml"}), 2,
+       "phases.flight.let.gg: 'gg' is also a definition ([definitions]); name it otherwise", File("m.toml", [] {
+         return Replace(Replace(Ball(), "[[phases]]", "[definitions]\ngg = \"2*g\"\n\n[[phases]]"),
+                        "ode = { y = \"dy\", dy = \"-g\" }", "let.gg = \"g\"\node = { y = \"dy\", dy = \"-gg\" }");
+       })},
       // listing reads a model; it does not compile it
       {"ListDoesNotCompile", Cli({"list", "m.toml"}), 0, "1. flight         n = 2  (y, dy)",
        BallFile("m.toml", "ode = { y = \"dy\"", "ode = { y = \"dy*1.000000000123\""), Tool::kCli,

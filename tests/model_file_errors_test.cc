@@ -305,6 +305,9 @@ const BadFile kBadFiles[] = {
     // ---- symmetries
     {"SymmetryFlipsUnknownState", "flip = { stance = [\"alpha\", \"dalpha\"]", "flip = { stance = [\"alpha\", \"dbeta\"]", 50,
      "symmetries[0].flip.stance: 'dbeta' is not a state of phase 'stance'"},
+    {"OdeMissingARate", "ode.l = \"dl\"\n", "", 20, "phases.stance.ode: missing the rate of state 'l'"},
+    {"SymmetryFlipsAStateTwice", "flip = { stance = [\"alpha\", \"dalpha\"]", "flip = { stance = [\"alpha\", \"dalpha\", \"alpha\"]", 50,
+     "symmetries[0].flip.stance: 'alpha' is flipped twice (once flips its sign)"},
     {"SymmetryFlipsUnknownPhase", "flight = [\"dx\", \"dy\", \"dalpha\"] }", "hover = [\"dx\", \"dy\", \"dalpha\"] }", 55,
      "symmetries[1].flip.hover: 'hover' is not a phase"},
     {"SymmetryDeclaredTwice", "name = \"time-reversal\"", "name = \"mirror\"", 53,

@@ -2,6 +2,7 @@
 #include "model_reader.h"
 
 #include <algorithm>
+#include <set>
 
 #include "hybridcont/expression_function.h"
 
@@ -302,6 +303,9 @@ void Reader::ReadLets(int i) {
           parameter_index_.count(name)) {
         Fail(&node, pf + ".let." + name, "'" + name + "' is also a state or a parameter");
       }
+      if (definitions_.count(name)) {  // the let would hide the definition inside this phase only
+        Fail(&node, pf + ".let." + name, "'" + name + "' is also a definition ([definitions]); name it otherwise");
+      }
       // Checked where the pinned coordinates are known (a quantity of the energies may use them); a use
       // elsewhere is checked where it is made.
       if (!mechanical_names_[i].pinned.empty()) pinned_symbols_phase_ = i;
@@ -336,7 +340,12 @@ void Reader::ReadVectorField(int i, const std::vector<ExprPtr>& derived) {
     f_where[k] = At(&node, pf + ".ode." + name);
   }
   for (int k = 0; k < dim; ++k) {
-    if (!f[k]) Fail(&ode, pf + ".ode", "missing the rate of state '" + p.state_names[k] + "'");
+    if (f[k]) continue;
+    // Dotted keys (ode.l = "dl") make a table without a place of its own: its first entry's line, else the
+    // phase's.
+    const toml::node* at = &ode;
+    if (ode.source().begin.line == 0) at = ode.empty() ? static_cast<const toml::node*>(&t) : &ode.cbegin()->second;
+    Fail(at, pf + ".ode", "missing the rate of state '" + p.state_names[k] + "'");
   }
   p.vector_field = ExpressionProgram(f, dim, true, f_where);
 }
@@ -453,9 +462,11 @@ void Reader::ReadSymmetries() {
         const auto it = std::find_if(spec_.phases.begin(), spec_.phases.end(),
                                      [&](const ExpressionPhaseSpec& p) { return p.name == phase; });
         if (it == spec_.phases.end()) Fail(&node, ff, "'" + phase + "' is not a phase");
+        std::set<std::string> flipped;
         for (const std::string& state : StringArray(node, ff)) {
           const auto st = std::find(it->state_names.begin(), it->state_names.end(), state);
           if (st == it->state_names.end()) Fail(&node, ff, "'" + state + "' is not a state of phase '" + phase + "'");
+          if (!flipped.insert(state).second) Fail(&node, ff, "'" + state + "' is flipped twice (once flips its sign)");
           for (std::size_t k = 0; k < spec_.phases.size(); ++k) {  // every phase of the mode, in an automaton
             if (spec_.phases[k].name == phase) s.state_signs[k](st - it->state_names.begin()) = -1.0;
           }
