@@ -163,7 +163,8 @@ void RenumberDiagram(int branch_offset, int point_offset, BifurcationDiagram* d)
   const auto point = [&](int* id) { *id = *id >= 0 ? *id + point_offset : *id; };
   const auto special = [&](SpecialPoint* sp) { point(&sp->id), branch(&sp->branch_id), point(&sp->duplicate_of); };
   for (Branch& b : d->branches) {
-    branch(&b.id), branch(&b.image_of), branch(&b.reflected_from), point(&b.parent_special_point);
+    // reflected_from is a point index of the branch itself (continuation.h), not a branch id.
+    branch(&b.id), branch(&b.image_of), point(&b.parent_special_point);
     for (SpecialPoint& sp : b.special_points) special(&sp);
   }
   for (SpecialPoint& sp : d->special_points) special(&sp);

@@ -261,13 +261,11 @@ std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayou
       "Floquet and observable special points (multiplier crossings on physical orbits; grazing events; constraint "
       "boundaries; monitored values):\n";
   int count = 0;
-  for (const auto& [type, code] : {std::pair{SpecialPointType::kFloquetBranchPoint, "BP"},
-                                   std::pair{SpecialPointType::kPeriodDoubling, "PD"},
-                                   std::pair{SpecialPointType::kGrazing, "GR"},
-                                   std::pair{SpecialPointType::kNeimarkSacker, "NS"},
-                                   std::pair{SpecialPointType::kKreinCollision, "KC"},
-                                   std::pair{SpecialPointType::kConstraintBoundary, "CB"},
-                                   std::pair{SpecialPointType::kObservableValue, "UZ"}}) {
+  for (const SpecialPointType type : {SpecialPointType::kFloquetBranchPoint, SpecialPointType::kPeriodDoubling,
+                                      SpecialPointType::kGrazing, SpecialPointType::kNeimarkSacker,
+                                      SpecialPointType::kKreinCollision, SpecialPointType::kConstraintBoundary,
+                                      SpecialPointType::kObservableValue}) {
+    const std::string code = Code(type);  // special_point.h: the one definition of the codes
     for (const SpecialPoint& sp : diagram.special_points) {
       if (sp.type != type || sp.u.size() == 0) continue;
       // Over the components the point's layout has (a state-based point converted to the time-based layout

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <set>
 #include <stdexcept>
+#include <thread>
 
 #include "hybridcont/setup_evaluation.h"
 #include "model_exploration.h"
@@ -91,6 +92,9 @@ void WidenBoundsToTargets(const RunArguments& args, ContinuationOptions* c, std:
 }
 
 void ApplyExplorationLimits(const RunArguments& args, ExplorationOptions* exploration) {
+  // The command line owns the machine: every core unless --threads says otherwise (the library's default
+  // is one thread).
+  exploration->threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   if (args.max_branches) {
     if (*args.max_branches < 1) {
       throw std::invalid_argument("--max-branches " + std::to_string(*args.max_branches) + ": must be >= 1");

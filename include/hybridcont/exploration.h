@@ -72,9 +72,10 @@ struct ExplorationOptions {
   // (plus a quarter of the angle across that chord) and still run along it: far above the tangents'
   // error from integrator noise (~1e-6), far below the angle of a branch crossing at a visible angle.
   double known_branch_angle = 1e-3;
-  // Threads tracing half-branches concurrently; 1 (or a problem without Clone()) traces them one after
-  // the other on the calling thread. Each clone integrates on one thread.
-  int threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  // Threads tracing half-branches concurrently; 1, the default (or a problem without Clone()), traces them
+  // one after the other on the calling thread. Each clone integrates on one thread. A program that owns
+  // the machine sets more (`hybridcont run` takes every core); a worker among many keeps 1.
+  int threads = 1;
   // Map half-branches through the problem's symmetries instead of tracing them: a mapped branch costs
   // two evaluations instead of a trace.
   bool use_symmetries = true;

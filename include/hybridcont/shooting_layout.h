@@ -43,6 +43,7 @@
 #ifndef HYBRIDCONT_SHOOTING_LAYOUT_H_
 #define HYBRIDCONT_SHOOTING_LAYOUT_H_
 
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -124,8 +125,12 @@ class ShootingLayout {
   double Period(const Vector& u) const;
 
  private:
+  // A segment index the caller gave: out of range is the caller's error, an exception (never an abort).
   int CheckedSegment(int i) const {
-    HYBRIDCONT_DEMAND(i >= 0 && i < num_segments());
+    if (i < 0 || i >= num_segments()) {
+      throw std::out_of_range("ShootingLayout: segment " + std::to_string(i) + " outside [0, " +
+                              std::to_string(num_segments()) + ")");
+    }
     return i;
   }
 

@@ -3,6 +3,7 @@
 //
 // The ball (paper §4.1) at level H: apex height h = H / (m g), impact speed v = sqrt(2 g h), fall and rise
 // times v / g. Segment 1 starts at the apex, x = [h, 0]; segment 2 right after the impact, x = [0, +v].
+#include <hybridcont/family_ranges.h>
 #include <hybridcont/models.h>
 #include <hybridcont/shooting_layout.h>
 #include <hybridcont/timebased_shooting.h>
@@ -42,7 +43,20 @@ int main() {
   const double off_orbit = residual(off);
   std::cout << "bouncing-ball, H = " << H << ": |r| = " << on_orbit << " on the orbit, " << off_orbit
             << " with t1 + 1e-3\n";
-  const bool ok = on_orbit >= 0.0 && on_orbit < 1e-10 && off_orbit > 1e-6;
+  // Reports the library formats (fmt, a private dependency of the core library): a family's range on a
+  // one-branch diagram, written as the report writes it.
+  Branch branch;
+  for (int i = 0; i < 3; ++i) {
+    ContinuationPoint point;
+    point.u = u;
+    point.arclength = 0.1 * i;
+    branch.points.push_back(point);
+  }
+  const BranchRanges ranges = RangesOnBranch(branch, {true, true, true}, {true, true, true}, {false, false, false},
+                                             layout.H_index());
+  const std::string range = ranges.physical.empty() ? "" : ToString(ranges.physical.front().from);
+  std::cout << "range starts at " << range << "\n";
+  const bool ok = on_orbit >= 0.0 && on_orbit < 1e-10 && off_orbit > 1e-6 && range.rfind("0.5 (start", 0) == 0;
   if (!ok) std::cerr << "FAILED: expected |r| < 1e-10 on the orbit and > 1e-6 off it\n";
   return ok ? 0 : 1;
 }
