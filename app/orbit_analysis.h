@@ -1,11 +1,11 @@
-// The analysis of one accepted point of a run, in the time-based layout: its classification (physical or
-// why not), and for a physical orbit the event-driven replay and the Floquet multipliers with their test
-// functions, written into the point's extra CSV columns.
+// The analysis of one accepted point of a run (the library's AnalyzeOrbit, orbit_analysis.h) as the
+// results files write it: the point's record with its extra CSV columns.
 //   PointRecord record;  record.u = u;  ...
 //   AnalyzePoint(model, integrator, &floquet_map, replay_options, &record);
 #ifndef HYBRIDCONT_APP_ORBIT_ANALYSIS_H_
 #define HYBRIDCONT_APP_ORBIT_ANALYSIS_H_
 
+#include "hybridcont/orbit_analysis.h"
 #include "hybridcont/replay.h"
 #include "hybridcont/timebased_shooting.h"
 #include "results_writer.h"
@@ -23,8 +23,8 @@ ReplayOptions ReplayOptionsFor(const IntegratorOptions& integrator);
 // With free parameters in floquet_map's layout, record->u ends with their values: the orbit is the head of
 // u in the model's own layout, classified and replayed on `model`, which must carry those values
 // (SetFreeParameters); without, `model` is the map's model.
-// Classifies record->u (by its unknowns, or else along its trace), fills the extra columns
-// (AnalyzePhysicalOrbit) and the residual of floquet_map at u (NaN where it cannot be evaluated).
+// AnalyzeOrbit at record->u (with record->at_branch_point), into the record: classification, stability,
+// residual, observables and the extra columns.
 void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator, TimeBasedShooting& floquet_map,
                   const ReplayOptions& replay_options, PointRecord* record);
 
@@ -41,11 +41,8 @@ inline Vector OrbitPart(const ShootingLayout& layout, const Vector& u) {
   return u.head(layout.num_orbit_unknowns());
 }
 
-// Floquet multipliers, stability and the event-driven replay of a physical orbit. A physical point whose
-// replay does not return is reclassified "replay-failed". Columns of non-physical points stay empty
-// (NaN): their monodromy has no meaning for the mechanical system.
-void AnalyzePhysicalOrbit(const HybridModel& model, TimeBasedShooting& floquet_map, const ReplayOptions& replay_options,
-                          const Vector& u, PointRecord* record);
+// The extra CSV columns of an analysis (the order above; NaN where undefined).
+std::vector<std::pair<std::string, double>> ExtraColumns(const HybridModel& model, const OrbitAnalysis& a);
 
 }  // namespace hybridcont::app
 
