@@ -1,16 +1,16 @@
 #include "results_writer.h"
 
-#include <sstream>
-
-#include "hybridcont/version.h"
-
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <set>
+#include <sstream>
 #include <stdexcept>
+
+#include "hybridcont/version.h"
 
 namespace hybridcont::app {
 
@@ -191,6 +191,7 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
   if (it == branch_files_.end()) {
     it = branch_files_.emplace(branch_id, std::ofstream(dir_ / BranchFileName(branch_id))).first;
     branch_bytes_[branch_id] = 0;
+    StartBranchEntry(branch_id);  // listed from its first point on: an interrupted run shows what it traced
     f << "index,H,T";
     const auto& names = layout.unknown_names();
     for (int j = 0; j < layout.num_free_parameters(); ++j) f << "," << names[layout.parameter_index(j)];
@@ -247,27 +248,45 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
 void ResultsWriter::EndBranch(const Branch& b) {
   auto file = branch_files_.find(b.id);
   if (file != branch_files_.end()) file->second.close();
-  summary_["branches"].push_back({{"id", b.id},
-                                  {"file", BranchFileName(b.id)},
-                                  {"parent", b.parent_special_point},
-                                  {"direction", b.direction},
-                                  {"depth", b.depth},
-                                  {"points", points_per_branch_[b.id]},
-                                  {"termination", ToString(b.termination)},
-                                  {"message", b.message},
-                                  {"newton_iterations", b.newton_iterations},
-                                  {"rejected_steps", b.rejected_steps}});
+  nlohmann::json entry = {{"id", b.id},
+                          {"file", BranchFileName(b.id)},
+                          {"parent", b.parent_special_point},
+                          {"direction", b.direction},
+                          {"depth", b.depth},
+                          {"points", points_per_branch_[b.id]},
+                          {"termination", ToString(b.termination)},
+                          {"message", b.message},
+                          {"newton_iterations", b.newton_iterations},
+                          {"rejected_steps", b.rejected_steps}};
   // Its phase sequence: the modes of its word (a cyclic model's phases).
   const auto other = branch_models_.find(b.id);
-  summary_["branches"].back()["word"] = other == branch_models_.end() ? model_.WordModeNames() : other->second.word;
+  entry["word"] = other == branch_models_.end() ? model_.WordModeNames() : other->second.word;
   if (b.image_of >= 0) {  // mapped, not traced (exploration.h, "Symmetries")
-    summary_["branches"].back()["image_of"] = b.image_of;
-    summary_["branches"].back()["symmetry"] = b.symmetry;
+    entry["image_of"] = b.image_of;
+    entry["symmetry"] = b.symmetry;
   }
   if (b.reflected_from >= 0) {  // a loop traced to its midpoint and completed by reflection
-    summary_["branches"].back()["reflected_from"] = b.reflected_from;
-    summary_["branches"].back()["symmetry"] = b.symmetry;
+    entry["reflected_from"] = b.reflected_from;
+    entry["symmetry"] = b.symmetry;
   }
+  // The entry listed at the branch's first point (StartBranchEntry) is replaced in place.
+  nlohmann::json& branches = summary_["branches"];
+  const auto listed = std::find_if(branches.begin(), branches.end(), [&](const nlohmann::json& e) { return e["id"] == b.id; });
+  if (listed != branches.end()) {
+    *listed = std::move(entry);
+  } else {
+    branches.push_back(std::move(entry));
+  }
+  WriteSummary();
+}
+
+void ResultsWriter::StartBranchEntry(int branch_id) {
+  const auto other = branch_models_.find(branch_id);
+  summary_["branches"].push_back({{"id", branch_id},
+                                  {"file", BranchFileName(branch_id)},
+                                  {"points", 0},
+                                  {"termination", "running"},
+                                  {"word", other == branch_models_.end() ? model_.WordModeNames() : other->second.word}});
   WriteSummary();
 }
 

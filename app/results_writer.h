@@ -156,6 +156,9 @@ class ResultsWriter {
 
   // Records the first failed write of `file` (errno's message) and returns false.
   bool WriteFailed(const std::filesystem::path& file);
+  // Lists branch `branch_id` in summary.json ("termination": "running") when its first point is written;
+  // EndBranch completes the entry.
+  void StartBranchEntry(int branch_id);
 };
 
 }  // namespace hybridcont::app
