@@ -31,6 +31,7 @@
 #ifndef HYBRIDCONT_FLOQUET_TEST_FUNCTIONS_H_
 #define HYBRIDCONT_FLOQUET_TEST_FUNCTIONS_H_
 
+#include <initializer_list>
 #include <memory>
 #include <vector>
 
@@ -116,6 +117,8 @@ class FloquetTestFunctions : public TestFunctions {
                           std::unique_ptr<OrbitTrace>* trace = nullptr) const;
   // Whether a physical family may end at u by a missed event (physical, missed-event or grazing).
   bool MissedEventEndsPhysicalFamily(const Vector& u_free) const;
+  // Whether the orbit at u is physical or fails for one of `reasons` only.
+  bool PhysicalOr(const Vector& u_free, std::initializer_list<OrbitClass> reasons) const;
   // Phase i's own-event functions at u into values->segment(first_own_event(), m) (see above).
   void EvaluateOwnEvents(const Vector& u, const OrbitTrace* trace, Vector* values);
   int first_own_event() const;

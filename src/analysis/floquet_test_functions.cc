@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "hybridcont/classification.h"
+#include "hybridcont/orbit_analysis.h"
 #include "hybridcont/orbit_trace.h"
 #include "hybridcont/replay.h"
 
@@ -94,10 +95,14 @@ Classification FloquetTestFunctions::Classify(const HybridModel& model, const Ve
 }
 
 bool FloquetTestFunctions::MissedEventEndsPhysicalFamily(const Vector& u_free) const {
+  return PhysicalOr(u_free, {OrbitClass::kMissedEvent, OrbitClass::kGrazing});
+}
+
+bool FloquetTestFunctions::PhysicalOr(const Vector& u_free, std::initializer_list<OrbitClass> reasons) const {
   const HybridModel* model = ModelAt(u_free);
   if (model == nullptr) return false;
   const Classification c = Classify(*model, u_free.head(base_unknowns_));
-  return c.physical || c.reason == OrbitClass::kMissedEvent || c.reason == OrbitClass::kGrazing;
+  return c.physical || std::find(reasons.begin(), reasons.end(), c.reason) != reasons.end();
 }
 
 namespace {
@@ -162,17 +167,11 @@ bool FloquetTestFunctions::Physical(const Vector& u_free) const {
 }
 
 bool FloquetTestFunctions::Replays(const HybridModel& model, const Vector& u) const {
-  ReplayOptions replay;
-  replay.poincare.event.integrator.rtol = integrator_.rtol;
-  replay.poincare.event.integrator.atol = integrator_.atol;
-  return ReplayOrbit(model, u, replay).physical();
+  return ReplayOrbit(model, u, OrbitAnalysisOptions::For(integrator_).replay).physical();
 }
 
 bool FloquetTestFunctions::GrazingEndsPhysicalFamily(const Vector& u_free) const {
-  const HybridModel* model = ModelAt(u_free);
-  if (model == nullptr) return false;
-  const Classification c = Classify(*model, u_free.head(base_unknowns_));
-  return c.physical || c.reason == OrbitClass::kGrazing;
+  return PhysicalOr(u_free, {OrbitClass::kGrazing});
 }
 
 void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* values) {
