@@ -13,7 +13,7 @@
 #include "hybridcont/derivative_check.h"
 #include "hybridcont/models.h"
 #include "hybridcont/shooting_layout.h"
-#include "model_options.h"
+#include "option_parsing.h"
 
 namespace hybridcont::app {
 

@@ -19,7 +19,7 @@
 #include "hybridcont/models.h"
 #include "model_exploration.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 namespace {
 
 const char* const kModels[] = {"bouncing-ball", "rocking-block", "bouncing-rod", "slip"};
@@ -249,9 +249,9 @@ void BM_ModelFileLoad(benchmark::State& state) { ModelFileLoad(state, false); }
 BENCHMARK(BM_ModelFileLoad)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 namespace {
 
 // Scaling in the number of phases: one corrector solve on the ball-chain with m phases from a
@@ -329,4 +329,4 @@ void BM_LargeModelEvaluate(benchmark::State& state) {
 BENCHMARK(BM_LargeModelEvaluate)->Arg(2)->Arg(4)->Arg(6)->Arg(8)->Arg(9)->Arg(12)->Arg(16)->Unit(benchmark::kMillisecond);
 
 }  // namespace
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

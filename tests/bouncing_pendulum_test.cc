@@ -38,10 +38,10 @@ HybridModel LoadPendulum() {
 }
 
 BifurcationDiagram Explore(const HybridModel& model) {
-  const app::Scenario scenario = app::DefaultScenario(model);
-  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+  const study::Scenario scenario = study::DefaultScenario(model);
+  ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
   options.threads = 1;
-  app::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
+  study::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
   return exploration.Run();
 }
 
@@ -162,11 +162,11 @@ TEST(BouncingPendulum, EveryOrbitConfirmedByAnEventDrivenSimulationAndKeepsItsEn
   ASSERT_NE(pd, nullptr);
   // The period-doubled families: the phase sequence traversed twice.
   const HybridModel doubled = RepeatedModel(model, 2);
-  const app::Scenario scenario = app::DefaultScenario(doubled);
-  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+  const study::Scenario scenario = study::DefaultScenario(doubled);
+  ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
   options.threads = 1;
   options.start_conditions.clear();
-  app::ModelExploration exploration(doubled, scenario, IntegratorOptions{}, options);
+  study::ModelExploration exploration(doubled, scenario, IntegratorOptions{}, options);
   const BifurcationDiagram dd = exploration.RunPeriodDoubled(parent, pd->u);
   const ShootingLayout layout2(doubled);
 

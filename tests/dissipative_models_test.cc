@@ -50,20 +50,20 @@ HybridModel Load(const std::string& name) {
 // The run `hybridcont run MODEL` makes: starts, then the families in the model's parameter.
 struct ParameterRun {
   BifurcationDiagram diagram;
-  std::unique_ptr<app::ModelExploration> exploration;
-  app::RunSetup setup;
+  std::unique_ptr<study::ModelExploration> exploration;
+  study::RunSetup setup;
 };
 
 ParameterRun Explore(const HybridModel& model) {
   ParameterRun run;
-  app::RunArguments args;
+  StudyOptions args;
   args.model = model.name();
-  run.setup = app::MakeRunSetup(args, model);
+  run.setup = study::MakeRunSetup(args, model);
   run.setup.exploration.threads = 1;
-  run.exploration = std::make_unique<app::ModelExploration>(model, run.setup.scenario, run.setup.integrator,
-                                                            run.setup.exploration, app::Formulation::kTimeBased,
+  run.exploration = std::make_unique<study::ModelExploration>(model, run.setup.scenario, run.setup.integrator,
+                                                            run.setup.exploration, Formulation::kTimeBased,
                                                             run.setup.free);
-  const app::OrbitStarts starts = app::FindOrbitStarts(model, run.setup, run.exploration->shooting().layout());
+  const study::OrbitStarts starts = study::FindOrbitStarts(model, run.setup, run.exploration->shooting().layout());
   int skipped = 0;
   run.diagram = run.exploration->RunFromStarts(starts.points, {}, &skipped);
   return run;
@@ -88,19 +88,19 @@ const SpecialPoint* OnlyPeriodDoubling(const BifurcationDiagram& diagram) {
 // The period-doubled family from `pd`, `points` points of it, in the run's free parameter.
 struct DoubledRun {
   std::unique_ptr<HybridModel> model;  // the exploration refers to it
-  std::unique_ptr<app::ModelExploration> exploration;
+  std::unique_ptr<study::ModelExploration> exploration;
   BifurcationDiagram diagram;
 };
 DoubledRun ExplorePeriodDoubled(const HybridModel& model, const ParameterRun& run, const SpecialPoint& pd,
                                 int points) {
   DoubledRun out;
   out.model = std::make_unique<HybridModel>(RepeatedModel(model, 2));
-  const app::Scenario scenario = app::DefaultScenario(*out.model);
-  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+  const study::Scenario scenario = study::DefaultScenario(*out.model);
+  ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
   options.threads = 1;
   options.continuation.max_points = points;
-  out.exploration = std::make_unique<app::ModelExploration>(*out.model, scenario, IntegratorOptions{}, options,
-                                                            app::Formulation::kTimeBased, run.setup.free);
+  out.exploration = std::make_unique<study::ModelExploration>(*out.model, scenario, IntegratorOptions{}, options,
+                                                            Formulation::kTimeBased, run.setup.free);
   out.diagram = out.exploration->RunPeriodDoubled(run.exploration->shooting().layout(), pd.u);
   return out;
 }
@@ -238,7 +238,7 @@ TEST(SimplestWalker, LongPeriodGaitLosesStabilityByPeriodDoublingAtThePublishedS
   // The period-doubled gait: starts at twice the period, is stable at first (the paper's period-two gait).
   DoubledRun doubled = ExplorePeriodDoubled(model, run, *pd, 20);
   const BifurcationDiagram& d2 = doubled.diagram;
-  app::ModelExploration& ex2 = *doubled.exploration;
+  study::ModelExploration& ex2 = *doubled.exploration;
   ASSERT_EQ(d2.status, ExplorationStatus::kCompleted) << d2.message;
   ASSERT_FALSE(d2.branches.empty());
   const ShootingLayout& layout2 = ex2.shooting().layout();
@@ -582,7 +582,7 @@ TEST_P(CompassGaitLegs, GaitsMultipliersAndPeriodDoublingAgreeWithAnIndependentR
   // The period-doubled gait beyond it: two different steps, each the root solve's stride of the other.
   DoubledRun doubled = ExplorePeriodDoubled(model, run, *pd, 8);
   const BifurcationDiagram& d2 = doubled.diagram;
-  app::ModelExploration& ex2 = *doubled.exploration;
+  study::ModelExploration& ex2 = *doubled.exploration;
   ASSERT_EQ(d2.status, ExplorationStatus::kCompleted) << d2.message;
   ASSERT_FALSE(d2.branches.empty());
   const ShootingLayout& layout2 = ex2.shooting().layout();

@@ -367,12 +367,12 @@ struct ScenarioRun {
 };
 ScenarioRun RunScenario(const std::string& name, bool use_symmetries, int max_branches = 0) {
   const HybridModel model = MakeBuiltinModel(name);
-  const app::Scenario scenario = app::DefaultScenario(model);
-  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+  const study::Scenario scenario = study::DefaultScenario(model);
+  ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
   options.use_symmetries = use_symmetries;
   options.threads = 1;
   if (max_branches > 0) options.max_branches = max_branches;
-  app::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
+  study::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
   ScenarioRun run;
   run.diagram = exploration.Run();
   run.evaluations = exploration.num_evaluations();

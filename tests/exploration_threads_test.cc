@@ -267,13 +267,13 @@ TEST(ExplorationThreads, ThreadsAreValidated) {
 void ExpectModelRunIsTheSerialOne(const std::string& name) {
   SCOPED_TRACE(name);
   const HybridModel model = MakeBuiltinModel(name);
-  const app::Scenario scenario = app::DefaultScenario(model);
+  const study::Scenario scenario = study::DefaultScenario(model);
   Run runs[2];
   long rhs[2];
   for (const int threads : {1, 2}) {
-    ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+    ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
     options.threads = threads;
-    app::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
+    study::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
     Run& run = runs[threads - 1];
     run.diagram = exploration.Run([&run](const ProgressInfo& p, const Vector& u) {
       run.reports.push_back({p.branch_id, p.point_index, p.newton_iterations, p.rejected_steps,

@@ -23,14 +23,14 @@ namespace {
 // The default exploration of a built-in model, on one thread.
 struct DefaultRun {
   explicit DefaultRun(const std::string& name) : model(MakeBuiltinModel(name)) {
-    const app::Scenario scenario = app::DefaultScenario(model);
-    ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+    const study::Scenario scenario = study::DefaultScenario(model);
+    ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
     options.threads = 1;
-    exploration = std::make_unique<app::ModelExploration>(model, scenario, IntegratorOptions{}, options);
+    exploration = std::make_unique<study::ModelExploration>(model, scenario, IntegratorOptions{}, options);
     diagram = exploration->Run();
   }
   HybridModel model;
-  std::unique_ptr<app::ModelExploration> exploration;
+  std::unique_ptr<study::ModelExploration> exploration;
   BifurcationDiagram diagram;
 };
 

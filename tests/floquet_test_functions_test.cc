@@ -23,17 +23,17 @@ struct ExplorationRun {
   HybridModel model;
   BifurcationDiagram diagram;
   long evaluations = 0;
-  app::TestFunctionWork tests;
+  study::TestFunctionWork tests;
 };
 
 // The model's default exploration (one thread), with the parameters `set` changed first.
 ExplorationRun Explore(const std::string& name, const std::vector<std::pair<std::string, double>>& set = {}) {
   ExplorationRun run{MakeBuiltinModel(name), {}, 0, {}};
   for (const auto& [parameter, value] : set) run.model.SetParameter(parameter, value);
-  const app::Scenario scenario = app::DefaultScenario(run.model);
-  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+  const study::Scenario scenario = study::DefaultScenario(run.model);
+  ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
   options.threads = 1;
-  app::ModelExploration exploration(run.model, scenario, IntegratorOptions{}, options);
+  study::ModelExploration exploration(run.model, scenario, IntegratorOptions{}, options);
   run.diagram = exploration.Run();
   run.evaluations = exploration.num_evaluations();
   run.tests = exploration.test_function_work();

@@ -45,7 +45,7 @@ TEST(LibraryContracts, RenumberingKeepsTheReflectedLoopsPointIndex) {
   loop.special_points.push_back(sp);
   d.branches.push_back(loop);
   d.special_points.push_back(sp);
-  app::RenumberDiagram(/*branch_offset=*/10, /*point_offset=*/100, &d);
+  study::RenumberDiagram(/*branch_offset=*/10, /*point_offset=*/100, &d);
   const Branch& b = d.branches.front();
   EXPECT_EQ(b.id, 12);
   EXPECT_EQ(b.parent_special_point, 104);

@@ -40,10 +40,10 @@ struct Run {
 };
 
 Run Explore(const HybridModel& model) {
-  const app::Scenario scenario = app::DefaultScenario(model);
-  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+  const study::Scenario scenario = study::DefaultScenario(model);
+  ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
   options.threads = 1;  // the diagram is the serial one at any thread count; one core keeps the test cheap
-  app::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
+  study::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
   Run run;
   const auto start = std::chrono::steady_clock::now();
   run.diagram = exploration.Run();
@@ -154,8 +154,8 @@ void ExpectSameDiagram(const std::string& name, const std::string& file_name = "
 void ExpectSameSetUp(const std::string& name) {
   const HybridModel builtin = MakeBuiltinModel(name);
   const HybridModel file = LoadFile(name);
-  const app::Scenario a = app::DefaultScenario(builtin);
-  const app::Scenario b = app::DefaultScenario(file);
+  const study::Scenario a = study::DefaultScenario(builtin);
+  const study::Scenario b = study::DefaultScenario(file);
   ASSERT_EQ(b.start.size(), a.start.size()) << name;
   EXPECT_LE((b.start - a.start).lpNorm<Eigen::Infinity>(), 1e-15 * (1 + a.start.lpNorm<Eigen::Infinity>())) << name;
   // A TOML table lists its keys in sorted order: terms, bounds and scales are compared as sets.
@@ -168,7 +168,7 @@ void ExpectSameSetUp(const std::string& name) {
     EXPECT_EQ(sorted(b.start_conditions[i].terms), sorted(a.start_conditions[i].terms)) << name;
     EXPECT_EQ(b.start_conditions[i].description, a.start_conditions[i].description) << name;
   }
-  const auto bounds = [](const app::Scenario& s) {
+  const auto bounds = [](const study::Scenario& s) {
     std::map<std::string, std::pair<double, double>> m;
     for (const ComponentBound& x : s.bounds) m[x.component] = {x.lower, x.upper};
     for (const SumBound& x : s.sum_bounds) m["sum of " + std::to_string(x.components.size())] = {x.lower, x.upper};

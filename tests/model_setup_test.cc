@@ -25,7 +25,7 @@ struct Bound {
   double lower, upper;
 };
 
-void ExpectBounds(const app::Scenario& s, const std::vector<Bound>& expected) {
+void ExpectBounds(const study::Scenario& s, const std::vector<Bound>& expected) {
   ASSERT_EQ(s.bounds.size(), expected.size());
   for (std::size_t i = 0; i < expected.size(); ++i) {
     EXPECT_EQ(s.bounds[i].component, expected[i].component);
@@ -35,7 +35,7 @@ void ExpectBounds(const app::Scenario& s, const std::vector<Bound>& expected) {
 }
 
 // At most one sum bound, over all durations t1..t<m+1>.
-void ExpectPeriodBound(const app::Scenario& s, int num_phases, double lower, double upper) {
+void ExpectPeriodBound(const study::Scenario& s, int num_phases, double lower, double upper) {
   ASSERT_EQ(s.sum_bounds.size(), 1u);
   std::vector<std::string> durations;
   for (int i = 1; i <= num_phases + 1; ++i) durations.push_back("t" + std::to_string(i));
@@ -44,7 +44,7 @@ void ExpectPeriodBound(const app::Scenario& s, int num_phases, double lower, dou
   EXPECT_EQ(s.sum_bounds[0].upper, upper);
 }
 
-void ExpectDefaultLimits(const app::Scenario& s, double max_step) {
+void ExpectDefaultLimits(const study::Scenario& s, double max_step) {
   EXPECT_EQ(s.max_branches, 64);
   EXPECT_EQ(s.max_depth, 3);
   EXPECT_EQ(s.max_points, 600);
@@ -67,7 +67,7 @@ Vector WithValues(const HybridModel& model, const std::vector<std::pair<std::str
 
 TEST(ModelSetup, BouncingBallScenarioIsThePapers) {
   const HybridModel model = MakeBuiltinModel("bouncing-ball");
-  const app::Scenario s = app::DefaultScenario(model);
+  const study::Scenario s = study::DefaultScenario(model);
   ExpectBounds(s, {{"xi", -1.0, 1.0}, {"H", -1.0, 1.0}});
   EXPECT_TRUE(s.sum_bounds.empty());
   EXPECT_TRUE(s.unknown_scales.empty());
@@ -83,7 +83,7 @@ void ExpectRockingBlockScenario(const HybridModel& model) {
   const double m = model.parameter("m"), g = model.parameter("g"), l0 = model.parameter("l0"),
                beta = model.parameter("beta");
   const double H_max = m * g * l0 * (1.0 - std::cos(beta));
-  const app::Scenario s = app::DefaultScenario(model);
+  const study::Scenario s = study::DefaultScenario(model);
   ExpectBounds(s, {{"xi", -1.0, 1.0}, {"H", -1.0, H_max}});
   ExpectPeriodBound(s, 1, -20.0, 20.0);
   EXPECT_EQ(s.keyframes.component, "H");
@@ -103,16 +103,16 @@ void ExpectRockingBlockScenario(const HybridModel& model) {
 TEST(ModelSetup, RockingBlockScenarioFollowsTheParameters) {
   HybridModel model = MakeBuiltinModel("rocking-block");
   ExpectRockingBlockScenario(model);
-  EXPECT_EQ(app::DefaultScenario(model).bounds[1].upper, 1.0 - std::cos(0.3));  // H_max at the defaults
+  EXPECT_EQ(study::DefaultScenario(model).bounds[1].upper, 1.0 - std::cos(0.3));  // H_max at the defaults
   model.SetParameter("beta", 0.2);
   model.SetParameter("m", 2.5);
   model.SetParameter("l0", 0.7);
   ExpectRockingBlockScenario(model);
-  EXPECT_EQ(app::DefaultScenario(model).bounds[1].upper, 2.5 * 1.0 * 0.7 * (1.0 - std::cos(0.2)));
+  EXPECT_EQ(study::DefaultScenario(model).bounds[1].upper, 2.5 * 1.0 * 0.7 * (1.0 - std::cos(0.2)));
 }
 
 void ExpectBouncingRodScenario(const HybridModel& model) {
-  const app::Scenario s = app::DefaultScenario(model);
+  const study::Scenario s = study::DefaultScenario(model);
   ExpectBounds(s, {{"xi", -1.0, 1.0}, {"H", -1.0, 0.6}});
   ExpectPeriodBound(s, 2, -10.0, 10.0);
   ASSERT_EQ(s.start_conditions.size(), 1u);
@@ -139,7 +139,7 @@ TEST(ModelSetup, BouncingRodScenarioIsThePapers) {
 void ExpectSlipScenario(const HybridModel& model) {
   const double m = model.parameter("m"), g = model.parameter("g"), k = model.parameter("k"),
                l0 = model.parameter("l0");
-  const app::Scenario s = app::DefaultScenario(model);
+  const study::Scenario s = study::DefaultScenario(model);
   ExpectBounds(s, {{"xi", -1.0, 1.0}, {"H", 0.0, 2.0}});
   ExpectPeriodBound(s, 2, -20.0, 20.0);
   EXPECT_EQ(s.keyframes.component, "H");
@@ -176,7 +176,7 @@ TEST(ModelSetup, BallChainStartsOnItsClosedFormOrbit) {
     chain.SetParameter("m", 0.5);
     EXPECT_EQ(StartPoint(chain), BallChainOrbit(chain, 0.5)) << m;
   }
-  const app::Scenario s = app::DefaultScenario(MakeBuiltinModel("ball-chain"));
+  const study::Scenario s = study::DefaultScenario(MakeBuiltinModel("ball-chain"));
   ExpectBounds(s, {{"xi", -1.0, 1.0}, {"H", -1.0, 1.0}});
   EXPECT_EQ(s.keyframes.value, 0.5);
 }
@@ -190,7 +190,7 @@ TEST(ModelSetup, SlipFamiliesFollowTheForwardSpeed) {
   EXPECT_EQ(presentation.Family(WithValues(model, {{"x2_dx", 5e-7}})), "hopping in place");
   EXPECT_EQ(presentation.Family(WithValues(model, {{"x2_dx", 0.3}})), "forward hopping");
   EXPECT_EQ(presentation.Family(WithValues(model, {{"x2_dx", -2e-6}})), "backward hopping");
-  EXPECT_EQ(app::DefaultScenario(model).describe(WithValues(model, {{"x2_dx", 0.3}})), "forward hopping");
+  EXPECT_EQ(study::DefaultScenario(model).describe(WithValues(model, {{"x2_dx", 0.3}})), "forward hopping");
 }
 
 TEST(ModelSetup, RodFamiliesAndAsymmetry) {
@@ -340,7 +340,7 @@ TEST(ModelSetup, BadSetupValuesNameTheirField) {
 // A model file's [definitions]: named values over parameters and other definitions, usable everywhere.
 TEST(ModelSetup, DefinitionsAreUsableInEveryExpression) {
   HybridModel block = MakeBuiltinModel("rocking-block");
-  const double H_max = app::DefaultScenario(block).bounds[1].upper;
+  const double H_max = study::DefaultScenario(block).bounds[1].upper;
   ModelSetup setup = block.setup();
   setup.definitions = {{"H_half", "0.5*H_max"}, {"H_max", "m*g*l0*(1 - cos(beta))"}};
   setup.run.bounds[1].upper = "H_max";
@@ -349,7 +349,7 @@ TEST(ModelSetup, DefinitionsAreUsableInEveryExpression) {
   setup.families = {{"high", "fill > 0.5"}, {"low", "1"}};
   setup.drawing.phases[0].points[0].y = "H_max";
   block.SetSetup(setup);
-  const app::Scenario s = app::DefaultScenario(block);
+  const study::Scenario s = study::DefaultScenario(block);
   EXPECT_EQ(s.bounds[1].upper, H_max);
   EXPECT_EQ(s.keyframes.value, 0.5 * H_max);
   const OrbitPresentation presentation(block);
@@ -383,20 +383,20 @@ std::vector<std::string> ReadHeader(const std::filesystem::path& file) {
 TEST(ModelSetup, ResultsCarryThePresentation) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "hybridcont_model_setup_test";
   std::filesystem::remove_all(dir);
-  app::ResultsWriter::PrepareDirectory(dir);
+  study::ResultsWriter::PrepareDirectory(dir);
   const HybridModel model = MakeBuiltinModel("bouncing-rod");
-  app::ResultsWriter writer(dir, model, nlohmann::json::object());
-  app::PointRecord point;
+  study::ResultsWriter writer(dir, model, nlohmann::json::object());
+  study::PointRecord point;
   point.u = WithValues(model, {{"t1", 0.1}, {"t2", 0.5}, {"t3", 0.2}, {"H", 0.3}});
   point.extra = {{"stable", 1.0}};
   writer.AddPoint(0, point);
-  const std::vector<std::string> header = ReadHeader(dir / app::ResultsWriter::BranchFileName(0));
+  const std::vector<std::string> header = ReadHeader(dir / study::ResultsWriter::BranchFileName(0));
   ASSERT_GE(header.size(), 2u);
   EXPECT_EQ(header[header.size() - 2], "stable");
   EXPECT_EQ(header.back(), "asym");
 
   const HybridModel slip = MakeBuiltinModel("slip");
-  app::ResultsWriter slip_writer(dir, slip, nlohmann::json::object());
+  study::ResultsWriter slip_writer(dir, slip, nlohmann::json::object());
   const Vector u0 = StartPoint(slip);
   const OrbitTrace trace(slip, u0, IntegratorOptions{});
   ASSERT_TRUE(trace.ok()) << trace.message();

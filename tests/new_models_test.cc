@@ -159,9 +159,9 @@ struct Explored {
 };
 
 Explored ExploreDefault(const HybridModel& model) {
-  const app::Scenario scenario = app::DefaultScenario(model);
+  const study::Scenario scenario = study::DefaultScenario(model);
   const IntegratorOptions integrator;
-  app::ModelExploration exploration(model, scenario, integrator, app::ScenarioExplorationOptions(scenario));
+  study::ModelExploration exploration(model, scenario, integrator, study::ScenarioExplorationOptions(scenario));
   Explored out;
   out.diagram = exploration.Run();
   for (const Branch& branch : out.diagram.branches) {
@@ -213,7 +213,7 @@ TEST(NewModelsTest, StartsAreExactOrbits) {
       slip.SetParameter("k3", k3);
       const SlipParameters p = SlipParametersOf(slip);
       const ShootingLayout layout(slip);
-      const Vector u0 = app::DefaultScenario(slip).start;
+      const Vector u0 = study::DefaultScenario(slip).start;
       const double t_half = StanceHalfDurationAtRest(p);
       EXPECT_LT(RelativeDifference(u0(Index(layout, "t1")), t_half), 1e-13) << "k3 = " << k3;
       EXPECT_LT(RelativeDifference(u0(Index(layout, "t3")), t_half), 1e-13) << "k3 = " << k3;
@@ -231,7 +231,7 @@ TEST(NewModelsTest, StartsAreExactOrbits) {
       pendulum.SetParameter("thw", thw);
       const PendulumParameters p{pendulum.parameter("g"), pendulum.parameter("l"), thw};
       const ShootingLayout layout(pendulum);
-      const Vector u0 = app::DefaultScenario(pendulum).start;
+      const Vector u0 = study::DefaultScenario(pendulum).start;
       // The grazing orbit: the free swing of amplitude thw, a quarter period four times.
       const double quarter = SwingTime(p, 0.0, thw);
       EXPECT_NEAR(u0(layout.H_index()), -(p.g / p.l) * std::cos(thw), 1e-15);

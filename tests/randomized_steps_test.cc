@@ -42,13 +42,13 @@ struct StepRun {
 };
 
 StepRun SpecialPoints(const HybridModel& model, double initial_factor, double max_factor) {
-  const app::Scenario scenario = app::DefaultScenario(model);
-  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+  const study::Scenario scenario = study::DefaultScenario(model);
+  ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
   options.threads = 1;
   options.continuation.initial_step *= initial_factor;
   options.continuation.max_step *= max_factor;
   options.continuation.initial_step = std::min(options.continuation.initial_step, options.continuation.max_step);
-  app::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
+  study::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
   const BifurcationDiagram diagram = exploration.Run();
   EXPECT_EQ(diagram.status, ExplorationStatus::kCompleted) << model.name() << ": " << diagram.message;
   StepRun run;

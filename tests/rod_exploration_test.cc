@@ -21,11 +21,11 @@ struct RodRun {
 
 RodRun ExploreRod(double rtol) {
   const HybridModel model = MakeBuiltinModel("bouncing-rod");
-  const app::Scenario scenario = app::DefaultScenario(model);
+  const study::Scenario scenario = study::DefaultScenario(model);
   IntegratorOptions integrator;
   integrator.rtol = rtol;
   integrator.atol = rtol;
-  app::ModelExploration exploration(model, scenario, integrator, app::ScenarioExplorationOptions(scenario));
+  study::ModelExploration exploration(model, scenario, integrator, study::ScenarioExplorationOptions(scenario));
   RodRun run;
   run.diagram = exploration.Run();
   const TimeBasedShooting& shooting = exploration.shooting();

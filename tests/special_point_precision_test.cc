@@ -161,13 +161,13 @@ TEST(SpecialPointPrecision, ExactProblemsKeepTheBracket) {
 
 BifurcationDiagram ExploreSlip(double tolerance_factor) {
   const HybridModel model = MakeSlip();
-  const app::Scenario scenario = app::DefaultScenario(model);
-  ExplorationOptions options = app::ScenarioExplorationOptions(scenario);
+  const study::Scenario scenario = study::DefaultScenario(model);
+  ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
   options.threads = 1;
   IntegratorOptions integrator;
   integrator.rtol *= tolerance_factor;
   integrator.atol *= tolerance_factor;
-  app::ModelExploration exploration(model, scenario, integrator, options);
+  study::ModelExploration exploration(model, scenario, integrator, options);
   return exploration.Run();
 }
 

@@ -55,6 +55,8 @@ std::string ToString(SpecialPointType type);
 // The short code of reports and summary.json: "SB", "TP", "start", "BP", "PD", "test", "GR", "NS", "UZ", "CB",
 // "KC".
 std::string Code(SpecialPointType type);
+// The type of a code; false for a string that is none.
+bool FromCode(const std::string& code, SpecialPointType* type);
 
 enum class LocationStatus {
   kLocated,    // bracket narrower than the location tolerance

@@ -48,6 +48,16 @@ std::string Code(SpecialPointType type) {
   return "?";
 }
 
+bool FromCode(const std::string& code, SpecialPointType* type) {
+  for (int t = 0; t <= static_cast<int>(SpecialPointType::kKreinCollision); ++t) {
+    if (Code(static_cast<SpecialPointType>(t)) == code) {
+      *type = static_cast<SpecialPointType>(t);
+      return true;
+    }
+  }
+  return false;
+}
+
 std::string ToString(LocationStatus status) { return internal::EnumToString(kLocationStatusNames, status); }
 
 std::string SpecialPoint::BriefReport(const std::vector<std::string>& names) const {

@@ -9,9 +9,9 @@
 #include "hybridcont/orbit_observables.h"
 #include "hybridcont/special_point_curve.h"
 #include "hybridcont/timebased_shooting.h"
-#include "orbit_analysis.h"
+#include "point_analysis.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 namespace {
 
@@ -249,4 +249,4 @@ nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& se
   return curves;
 }
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

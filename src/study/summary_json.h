@@ -1,24 +1,24 @@
-// The JSON that `hybridcont run` writes into summary.json beyond the writer's own: the effective options
+// The JSON that a study writes into summary.json beyond the writer's own: the effective options
 // and the special points of the continuation (SB, TP, start, and the Floquet crossings BP and PD located
 // as test functions, floquet_test_functions.h), with one set of fields for every special point:
 //   {"id", "type", "branch", "index", "H", "T", "status", "precision", "precision_arclength",
 //    "precision_H", "residual", "component", "duplicate_of", "message", "u"}
-#ifndef HYBRIDCONT_APP_SUMMARY_JSON_H_
-#define HYBRIDCONT_APP_SUMMARY_JSON_H_
+#ifndef HYBRIDCONT_STUDY_SUMMARY_JSON_H_
+#define HYBRIDCONT_STUDY_SUMMARY_JSON_H_
 
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "commands.h"
+#include "hybridcont/study.h"
 #include "hybridcont/exploration.h"
 #include "hybridcont/shooting_layout.h"
 #include "run_setup.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 // The effective configuration of a run: formulation, integrator, continuation, bounds, targets,
 // exploration limits, start conditions and the scenario's unknown scales.
-nlohmann::json OptionsJson(const RunArguments& args, const RunSetup& setup);
+nlohmann::json OptionsJson(const StudyOptions& options, const RunSetup& setup);
 
 // The continuation's special points of `d` (u in the time-based layout described by `layout`). With a
 // model, each point also gets "observables": the model's observables and constraints at it (evaluated at
@@ -26,6 +26,6 @@ nlohmann::json OptionsJson(const RunArguments& args, const RunSetup& setup);
 nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayout& layout,
                                  const HybridModel* model = nullptr, const IntegratorOptions& integrator = {});
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-#endif  // HYBRIDCONT_APP_SUMMARY_JSON_H_
+#endif  // HYBRIDCONT_STUDY_SUMMARY_JSON_H_

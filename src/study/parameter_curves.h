@@ -20,8 +20,8 @@
 // (null for a boundary), "name" (a boundary's "t2 = 0", "clearance = 0"), "status", "points", "termination":
 // [backward, forward], "codim_two": [{"type", "name", "status", "H", p}]}].
 // curve_<n>.csv: H, p, then the other curve unknowns (those of the map, and beta for branch points).
-#ifndef HYBRIDCONT_APP_PARAMETER_CURVES_H_
-#define HYBRIDCONT_APP_PARAMETER_CURVES_H_
+#ifndef HYBRIDCONT_STUDY_PARAMETER_CURVES_H_
+#define HYBRIDCONT_STUDY_PARAMETER_CURVES_H_
 
 #include <filesystem>
 #include <string>
@@ -31,7 +31,7 @@
 #include "hybridcont/exploration.h"
 #include "run_setup.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 // Traces the curves of diagram's special points (model units, the model's layout) in
 // setup.curve_parameter within setup.curve_bound and the scenario's H bound, writes their files into
@@ -39,6 +39,6 @@ namespace hybridcont::app {
 nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
                                     const std::filesystem::path& dir, std::string* report);
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-#endif  // HYBRIDCONT_APP_PARAMETER_CURVES_H_
+#endif  // HYBRIDCONT_STUDY_PARAMETER_CURVES_H_

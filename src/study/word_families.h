@@ -10,9 +10,9 @@
 // "word" (ResultsWriter), each explored family "handed_over_from" (the change's index), and summary.json's
 // "word_changes" lists every change considered: where, the rule, accepted or refused with the reason, the
 // new word's orbit compared with the old (state at the section and period), and the branches it leads to.
-//   std::string report = ExploreWordChanges(model, setup, diagram, &special_points, writer, out, quiet);
-#ifndef HYBRIDCONT_APP_WORD_FAMILIES_H_
-#define HYBRIDCONT_APP_WORD_FAMILIES_H_
+//   std::string report = ExploreWordChanges(model, setup, diagram, &special_points, writer, hooks);
+#ifndef HYBRIDCONT_STUDY_WORD_FAMILIES_H_
+#define HYBRIDCONT_STUDY_WORD_FAMILIES_H_
 
 #include <nlohmann/json.hpp>
 #include <ostream>
@@ -23,7 +23,7 @@
 #include "results_writer.h"
 #include "run_setup.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 // Most words one run explores (the run's own included): an automaton's words are unbounded in number, a
 // diagram's hand-overs are few.
@@ -33,8 +33,8 @@ inline constexpr int kMaxWords = 8;
 // Appends the new families' special points to special_points, writes their branches through `writer` and
 // annotates summary.json; returns the report section ("" for a model without an automaton).
 std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
-                               nlohmann::json* special_points, ResultsWriter& writer, std::ostream& out, bool quiet);
+                               nlohmann::json* special_points, ResultsWriter& writer, const StudyHooks& hooks);
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-#endif  // HYBRIDCONT_APP_WORD_FAMILIES_H_
+#endif  // HYBRIDCONT_STUDY_WORD_FAMILIES_H_

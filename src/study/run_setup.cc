@@ -9,9 +9,9 @@
 
 #include "hybridcont/setup_evaluation.h"
 #include "model_exploration.h"
-#include "model_options.h"
+#include "hybridcont/study.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 namespace {
 
@@ -21,44 +21,64 @@ constexpr double kMinRtol = 1e-14;   // below, the error control chases rounding
 constexpr double kMaxTolerance = 0.1;  // above, no digit of a located point means anything
 constexpr int kMaxThreads = 256;     // each thread holds a copy of the problem; more are never useful
 
-void ApplyTolerances(const RunArguments& args, IntegratorOptions* integrator) {
+[[noreturn]] void Refuse(const std::string& field, int index, const std::string& message) {
+  throw StudyOptionError(field, index, message);
+}
+
+std::string Text(const NamedValue& v) { return fmt::format("'{}={:g}'", v.name, v.value); }
+std::string Text(const NamedInterval& b) {
+  return fmt::format("'{}={}:{}'", b.name, std::isfinite(b.lower) ? fmt::format("{:g}", b.lower) : "",
+                     std::isfinite(b.upper) ? fmt::format("{:g}", b.upper) : "");
+}
+
+void ApplyTolerances(const StudyOptions& args, IntegratorOptions* integrator) {
   if (args.rtol) integrator->rtol = *args.rtol;
   if (args.atol) integrator->atol = *args.atol;
   if (const std::string why = integrator->Validate(); !why.empty()) {
-    throw std::invalid_argument("--rtol/--atol: " + why);
+    Refuse(args.rtol ? "rtol" : "atol", -1, why);
   }
   if (args.rtol && !(*args.rtol >= kMinRtol && *args.rtol <= kMaxTolerance)) {
-    throw std::invalid_argument(fmt::format("--rtol {:g}: must lie in [{:g}, {:g}]", *args.rtol, kMinRtol, kMaxTolerance));
+    Refuse("rtol", -1, fmt::format("{:g}: must lie in [{:g}, {:g}]", *args.rtol, kMinRtol, kMaxTolerance));
   }
   if (args.atol && !(*args.atol <= kMaxTolerance)) {
-    throw std::invalid_argument(fmt::format("--atol {:g}: must lie in (0, {:g}]", *args.atol, kMaxTolerance));
+    Refuse("atol", -1, fmt::format("{:g}: must lie in (0, {:g}]", *args.atol, kMaxTolerance));
   }
 }
 
-// One value per name: a repeated --set, --until or --bound is a mistake, not an override.
-void RefuseRepeats(const std::string& option, const std::vector<std::string>& texts) {
+// One value per name: a repeated name in `until`, `bounds` or `monitors` is a mistake, not an override.
+template <typename Entry>
+void RefuseRepeats(const std::string& field, const std::vector<Entry>& entries) {
   std::set<std::string> seen;
-  for (const std::string& text : texts) {
-    const std::string name = text.substr(0, text.find('='));
-    if (!seen.insert(name).second) {
-      throw std::invalid_argument(option + " '" + text + "': '" + name + "' is given twice");
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    if (entries[i].name.empty()) Refuse(field, static_cast<int>(i), Text(entries[i]) + ": the name is empty");
+    if (!seen.insert(entries[i].name).second) {
+      Refuse(field, static_cast<int>(i), Text(entries[i]) + ": '" + entries[i].name + "' is given twice");
     }
   }
 }
 
 // --until targets, then --bound bounds ("period": the sum of the durations), each replacing the model's
 // bound on its unknown; a target outside a bound on its own unknown is refused.
-void ApplyTargetsAndBounds(const RunArguments& args, const HybridModel& model, ContinuationOptions* c) {
-  for (const std::string& u : args.until) {
-    const auto [name, value] = ParseAssignment("--until", u);
-    c->targets.push_back({name, value});
+void ApplyTargetsAndBounds(const StudyOptions& args, const HybridModel& model, ContinuationOptions* c) {
+  for (std::size_t i = 0; i < args.until.size(); ++i) {
+    const NamedValue& u = args.until[i];
+    if (!std::isfinite(u.value)) Refuse("until", static_cast<int>(i), Text(u) + ": the value is not finite");
+    c->targets.push_back({u.name, u.value});
   }
-  for (const std::string& text : args.bounds) {
-    const BoundAssignment b = ParseBound("--bound", text);
-    for (const ComponentTarget& t : c->targets) {
-      if (t.component == b.name && !(t.value >= b.lower && t.value <= b.upper)) {
-        throw std::invalid_argument(fmt::format("--until '{}={:g}' lies outside --bound '{}': no branch could reach it",
-                                                t.component, t.value, text));
+  for (std::size_t i = 0; i < args.bounds.size(); ++i) {
+    const NamedInterval& b = args.bounds[i];
+    const int index = static_cast<int>(i);
+    if (std::isnan(b.lower) || std::isnan(b.upper)) Refuse("bounds", index, Text(b) + ": an end is NaN");
+    if (!std::isfinite(b.lower) && !std::isfinite(b.upper)) {
+      Refuse("bounds", index, Text(b) + ": both ends are unbounded (an unknown without any bound is never reached; "
+                                        "give at least one end, e.g. H=0:)");
+    }
+    if (!(b.lower < b.upper)) Refuse("bounds", index, Text(b) + ": the lower end must be below the upper end");
+    for (std::size_t k = 0; k < args.until.size(); ++k) {
+      const NamedValue& t = args.until[k];
+      if (t.name == b.name && !(t.value >= b.lower && t.value <= b.upper)) {
+        Refuse("until", static_cast<int>(k),
+               fmt::format("{} lies outside bounds[{}] {}: no branch could reach it", Text(t), i, Text(b)));
       }
     }
     if (b.name == "period") {
@@ -74,41 +94,31 @@ void ApplyTargetsAndBounds(const RunArguments& args, const HybridModel& model, C
 
 // A target beyond the model's default bound on the same unknown widens that bound to the target: the user
 // asked to reach it (an explicit --bound on that unknown is kept as given).
-void WidenBoundsToTargets(const RunArguments& args, ContinuationOptions* c, std::vector<std::string>* notes) {
+void WidenBoundsToTargets(const StudyOptions& args, ContinuationOptions* c, std::vector<std::string>* notes) {
   for (const ComponentTarget& t : c->targets) {
-    const bool explicit_bound = std::any_of(args.bounds.begin(), args.bounds.end(), [&](const std::string& text) {
-      return text.rfind(t.component + "=", 0) == 0;
-    });
+    const bool explicit_bound = std::any_of(args.bounds.begin(), args.bounds.end(),
+                                            [&](const NamedInterval& b) { return b.name == t.component; });
     for (ComponentBound& b : c->bounds) {
       if (b.component != t.component || explicit_bound || (t.value >= b.lower && t.value <= b.upper)) continue;
       const double lower = b.lower, upper = b.upper;
       b.lower = std::min(b.lower, t.value);
       b.upper = std::max(b.upper, t.value);
-      notes->push_back(fmt::format("--until {}={:g} lies outside the bound [{:g}, {:g}] of {}: the bound is widened "
-                                   "to [{:g}, {:g}] (give --bound {}=LOWER:UPPER to keep it)",
+      notes->push_back(fmt::format("until {}={:g} lies outside the bound [{:g}, {:g}] of {}: the bound is widened "
+                                   "to [{:g}, {:g}] (give the bound {}=LOWER:UPPER to keep it)",
                                    t.component, t.value, lower, upper, t.component, b.lower, b.upper, t.component));
     }
   }
 }
 
-void ApplyExplorationLimits(const RunArguments& args, ExplorationOptions* exploration) {
-  // The command line owns the machine: every core unless --threads says otherwise (the library's default
-  // is one thread).
-  exploration->threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+void ApplyExplorationLimits(const StudyOptions& args, ExplorationOptions* exploration) {
   if (args.max_branches) {
-    if (*args.max_branches < 1) {
-      throw std::invalid_argument("--max-branches " + std::to_string(*args.max_branches) + ": must be >= 1");
-    }
+    if (*args.max_branches < 1) Refuse("max_branches", -1, std::to_string(*args.max_branches) + ": must be >= 1");
     exploration->max_branches = *args.max_branches;
   }
-  if (args.threads) {
-    if (*args.threads < 1) throw std::invalid_argument("--threads " + std::to_string(*args.threads) + ": must be >= 1");
-    if (*args.threads > kMaxThreads) {
-      throw std::invalid_argument(fmt::format("--threads {}: must be <= {}", *args.threads, kMaxThreads));
-    }
-    exploration->threads = *args.threads;
-  }
-  if (args.no_symmetry) exploration->use_symmetries = false;
+  if (args.threads < 1) Refuse("threads", -1, std::to_string(args.threads) + ": must be >= 1");
+  if (args.threads > kMaxThreads) Refuse("threads", -1, fmt::format("{}: must be <= {}", args.threads, kMaxThreads));
+  exploration->threads = args.threads;
+  exploration->use_symmetries = args.use_symmetries;
 }
 
 // The default interval of a parameter p continued from its value v: its range within [v/4, 4v] (the
@@ -123,35 +133,33 @@ ComponentBound DefaultParameterBound(const HybridModel& model, const std::string
   return {name, lower, upper};
 }
 
-// The named parameter of the model, or std::invalid_argument naming the option and the value.
-void RequireParameter(const std::string& option, const HybridModel& model, const std::string& name) {
+// The named parameter of the model, or StudyOptionError naming the field and the value.
+void RequireParameter(const std::string& field, const HybridModel& model, const std::string& name) {
   if (model.FindParameter(name) >= 0) return;
   std::string known;
   for (const ParameterInfo& info : model.parameters()) known += (known.empty() ? "" : ", ") + info.name;
-  throw std::invalid_argument(fmt::format("{} '{}': model '{}' has no such parameter (parameters: {})", option, name,
-                                          model.name(), known));
+  Refuse(field, -1, fmt::format("'{}': model '{}' has no such parameter (parameters: {})", name, model.name(), known));
 }
 
 // --free/--fix: the parameter joins the unknowns (scale: its value, so that steps are relative to it), with
 // its default bound unless --bound names it. The ordinary run that gives the starts keeps the scenario's
 // options with an H bound widened to the fixed value.
-void ApplyFreeParameter(const RunArguments& args, const HybridModel& model, RunSetup* setup) {
+void ApplyFreeParameter(const StudyOptions& args, const HybridModel& model, RunSetup* setup) {
   setup->seed_exploration = setup->exploration;
   if (model.num_first_integrals() == 0) {
     // No first integral: the families are continued in a parameter (the model's run.parameter, or --free).
     const std::string parameter = args.free.empty() ? model.setup().run.parameter : args.free;
-    if (!args.fix.empty()) {
-      throw std::invalid_argument("--fix '" + args.fix + "': model '" + model.name() +
+    if (args.fix) {
+      Refuse("fix", -1, Text(*args.fix) + ": model '" + model.name() +
                                   "' has no first integral; its families are continued in one parameter alone");
     }
     if (parameter.empty()) {
-      throw std::invalid_argument("model '" + model.name() + "' has no first integral: name the parameter its "
-                                  "families are continued in (--free NAME)");
+      Refuse("free", -1, "model '" + model.name() + "' has no first integral: name the parameter its "
+                         "families are continued in");
     }
-    RequireParameter("--free", model, parameter);
+    RequireParameter("free", model, parameter);
     if (!model.has_parameter_derivatives()) {
-      throw std::invalid_argument(fmt::format("--free '{}': model '{}' has no parameter derivatives", parameter,
-                                              model.name()));
+      Refuse("free", -1, fmt::format("'{}': model '{}' has no parameter derivatives", parameter, model.name()));
     }
     setup->free = FreeParameters{{parameter}, {}, {}};
     const std::string& declared = model.setup().run.parameter;
@@ -178,17 +186,16 @@ void ApplyFreeParameter(const RunArguments& args, const HybridModel& model, RunS
     setup->exploration.start_conditions.clear();
     return;
   }
-  if (args.free.empty() && args.fix.empty()) return;
-  if (args.free.empty()) throw std::invalid_argument("--fix '" + args.fix + "': needs --free PARAMETER");
-  if (args.fix.empty()) {
-    throw std::invalid_argument("--free '" + args.free + "': needs --fix NAME=VALUE (e.g. --fix H=1.5)");
-  }
-  RequireParameter("--free", model, args.free);
+  if (args.free.empty() && !args.fix) return;
+  if (args.free.empty()) Refuse("fix", -1, Text(*args.fix) + ": needs a free parameter (free)");
+  if (!args.fix) Refuse("free", -1, "'" + args.free + "': needs an unknown held fixed (fix NAME=VALUE, e.g. H=1.5)");
+  RequireParameter("free", model, args.free);
   if (!model.has_parameter_derivatives()) {
-    throw std::invalid_argument(fmt::format("--free '{}': model '{}' has no parameter derivatives", args.free,
-                                            model.name()));
+    Refuse("free", -1, fmt::format("'{}': model '{}' has no parameter derivatives", args.free, model.name()));
   }
-  const auto [name, value] = ParseAssignment("--fix", args.fix);
+  const std::string name = args.fix->name;
+  const double value = args.fix->value;
+  if (!std::isfinite(value)) Refuse("fix", -1, Text(*args.fix) + ": the value is not finite");
   // Any unknown of the orbit: H (families over the parameter at one energy), a duration (t2=0: the curve
   // where that phase vanishes, a boundary of the physical families), a state component (x1_dx=1.2: the
   // families at one apex speed).
@@ -198,7 +205,7 @@ void ApplyFreeParameter(const RunArguments& args, const HybridModel& model, RunS
     std::string known;
     for (const std::string& n : names) known += n == "xi" ? "" : (known.empty() ? "" : ", ") + n;
     for (const Observable& o : model.observables()) known += ", " + o.name;
-    throw std::invalid_argument("--fix '" + args.fix + "': '" + name + "' is not an unknown or observable of model '" +
+    Refuse("fix", -1, Text(*args.fix) + ": '" + name + "' is not an unknown or observable of model '" +
                                 model.name() + "' that can be held fixed (" + known + ")");
   }
   setup->free = FreeParameters{{args.free}, {{name, value}}, {}};
@@ -206,7 +213,7 @@ void ApplyFreeParameter(const RunArguments& args, const HybridModel& model, RunS
   ContinuationOptions& seed = setup->seed_exploration.continuation;
   for (ComponentBound& b : seed.bounds) {
     if (b.component == "H" && !(value >= b.lower && value <= b.upper)) {
-      throw std::invalid_argument(fmt::format("--fix '{}': outside the model's H bound [{:g}, {:g}]", args.fix, b.lower,
+      Refuse("fix", -1, fmt::format("{}: outside the model's H bound [{:g}, {:g}]", Text(*args.fix), b.lower,
                                               b.upper));
     }
   }
@@ -219,21 +226,22 @@ void ApplyFreeParameter(const RunArguments& args, const HybridModel& model, RunS
 
 // Observables named by --until, --bound and --monitor join the map's unknowns (shooting_layout.h,
 // "Observables"), in the order named; --monitor names observables only.
-void ApplyObservables(const RunArguments& args, const HybridModel& model, RunSetup* setup) {
-  RefuseRepeats("--monitor", args.monitors);
+void ApplyObservables(const StudyOptions& args, const HybridModel& model, RunSetup* setup) {
+  RefuseRepeats("monitors", args.monitors);
   const auto join = [&](const std::string& name) {
     if (model.FindObservable(name) < 0) return;
     std::vector<std::string>& joined = setup->free.observables;
     if (std::find(joined.begin(), joined.end(), name) == joined.end()) joined.push_back(name);
   };
-  for (const std::string& text : args.until) join(ParseAssignment("--until", text).first);
-  for (const std::string& text : args.bounds) join(ParseBound("--bound", text).name);
-  for (const std::string& text : args.monitors) {
-    const auto [name, value] = ParseAssignment("--monitor", text);
+  for (const NamedValue& u : args.until) join(u.name);
+  for (const NamedInterval& b : args.bounds) join(b.name);
+  for (std::size_t i = 0; i < args.monitors.size(); ++i) {
+    const auto [name, value] = args.monitors[i];
+    if (!std::isfinite(value)) Refuse("monitors", static_cast<int>(i), Text(args.monitors[i]) + ": the value is not finite");
     if (model.FindObservable(name) < 0) {
       std::string known;
       for (const Observable& o : model.observables()) known += (known.empty() ? "" : ", ") + o.name;
-      throw std::invalid_argument("--monitor '" + text + "': '" + name + "' is not an observable of model '" +
+      Refuse("monitors", static_cast<int>(i), Text(args.monitors[i]) + ": '" + name + "' is not an observable of model '" +
                                   model.name() + "' (" + (known.empty() ? "it declares none" : "observables: " + known) +
                                   ")");
     }
@@ -243,24 +251,25 @@ void ApplyObservables(const RunArguments& args, const HybridModel& model, RunSet
 }
 
 // --curves: the parameter and its bound (taken out of --bound, whose other names are the run's unknowns).
-void ApplyCurveParameter(const RunArguments& args, const HybridModel& model, RunArguments* run_args,
+void ApplyCurveParameter(const StudyOptions& args, const HybridModel& model, StudyOptions* run_args,
                          RunSetup* setup) {
   if (args.curves.empty()) return;
-  RequireParameter("--curves", model, args.curves);
+  RequireParameter("curves", model, args.curves);
   if (!model.has_parameter_derivatives()) {
-    throw std::invalid_argument(fmt::format("--curves '{}': model '{}' has no parameter derivatives", args.curves,
+    Refuse("curves", -1, fmt::format("'{}': model '{}' has no parameter derivatives", args.curves,
                                             model.name()));
   }
-  if (!args.free.empty()) throw std::invalid_argument("--curves '" + args.curves + "': not with --free");
+  if (!args.free.empty()) Refuse("curves", -1, "'" + args.curves + "': not with a free parameter (free)");
   setup->curve_parameter = args.curves;
   setup->curve_bound = DefaultParameterBound(model, args.curves);
-  std::erase_if(run_args->bounds, [&](const std::string& text) {
-    const BoundAssignment b = ParseBound("--bound", text);
+  std::erase_if(run_args->bounds, [&](const NamedInterval& b) {
     if (b.name != args.curves) return false;
     const double v = model.parameter(args.curves);
     if (!(v >= b.lower && v <= b.upper)) {
-      throw std::invalid_argument(fmt::format("--bound '{}': excludes the model's {} = {:g}, where the curves start",
-                                              text, args.curves, v));
+      const auto at = std::find_if(args.bounds.begin(), args.bounds.end(),
+                                   [&](const NamedInterval& x) { return x.name == b.name; });
+      Refuse("bounds", static_cast<int>(at - args.bounds.begin()),
+             fmt::format("{}: excludes the model's {} = {:g}, where the curves start", Text(b), args.curves, v));
     }
     setup->curve_bound.lower = b.lower, setup->curve_bound.upper = b.upper;
     return true;
@@ -269,12 +278,12 @@ void ApplyCurveParameter(const RunArguments& args, const HybridModel& model, Run
 
 }  // namespace
 
-RunSetup MakeRunSetup(const RunArguments& given, const HybridModel& model) {
+RunSetup MakeRunSetup(const StudyOptions& given, const HybridModel& model) {
   RunSetup setup;
-  RunArguments args = given;
+  StudyOptions args = given;
   ApplyTolerances(args, &setup.integrator);
-  RefuseRepeats("--until", args.until);
-  RefuseRepeats("--bound", args.bounds);
+  RefuseRepeats("until", args.until);
+  RefuseRepeats("bounds", args.bounds);
   setup.scenario = DefaultScenario(model);
   setup.exploration = ScenarioExplorationOptions(setup.scenario);
   ApplyCurveParameter(given, model, &args, &setup);
@@ -295,11 +304,11 @@ RunSetup MakeRunSetup(const RunArguments& given, const HybridModel& model) {
   if (!continued.empty() && std::none_of(bounds.begin(), bounds.end(), [&](const ComponentBound& b) {
         return b.component == continued && std::isfinite(b.lower) && std::isfinite(b.upper);
       })) {
-    setup.notes.push_back(fmt::format("{} has no bound (run.bounds or --bound {}=LOWER:UPPER): each branch ends after "
+    setup.notes.push_back(fmt::format("{} has no bound (run.bounds or the bound {}=LOWER:UPPER): each branch ends after "
                                       "{} points (run.max_points)",
                                       continued, continued, setup.exploration.continuation.max_points));
   }
   return setup;
 }
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

@@ -7,7 +7,7 @@
 #include "hybridcont/orbit_observables.h"
 #include "model_exploration.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 namespace {
 
@@ -22,9 +22,9 @@ nlohmann::json BoundsJson(const ContinuationOptions& c) {
 
 }  // namespace
 
-nlohmann::json OptionsJson(const RunArguments& args, const RunSetup& setup) {
+nlohmann::json OptionsJson(const StudyOptions& options, const RunSetup& setup) {
   nlohmann::json j;
-  j["formulation"] = args.formulation;
+  j["formulation"] = ToString(options.formulation);
   j["integrator"] = {{"method", ToString(setup.integrator.method)},
                      {"rtol", setup.integrator.rtol},
                      {"atol", setup.integrator.atol}};
@@ -123,4 +123,4 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
   return list;
 }
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

@@ -11,11 +11,11 @@
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/timebased_shooting.h"
 #include "model_exploration.h"
-#include "orbit_analysis.h"
+#include "point_analysis.h"
 #include "scenario.h"
 #include "summary_json.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 namespace {
 
 // The run's continuation options on the doubled layout: a bound or target on an unknown applies to each
@@ -61,7 +61,7 @@ std::string Multipliers(const FloquetResult& f) {
 
 std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridModel& doubled, const RunSetup& setup,
                                          const BifurcationDiagram& diagram, nlohmann::json* special_points,
-                                         ResultsWriter& writer, std::ostream& out, bool quiet) {
+                                         ResultsWriter& writer) {
   // A model without first integral is followed in its parameter: both maps have it free (setup.free).
   const ShootingLayout parent(model, setup.free), layout(doubled, setup.free);
   const ExplorationOptions options = DoubledOptions(setup.exploration, parent);
@@ -82,19 +82,13 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
     ModelExploration exploration(doubled, scenario, setup.integrator, options, Formulation::kTimeBased, setup.free);
     BifurcationDiagram d = exploration.RunPeriodDoubled(parent, u_pd, [&](const ProgressInfo& info, const Vector& u) {
       const int id = info.branch_id + offset;
-      if (log.H.find(id) == log.H.end()) writer.SetBranchModel(id, doubled);
+      if (log.H.find(id) == log.H.end()) writer.SetBranchModel(id, doubled, "period-doubled");
       PointRecord record = RecordOf(info, u);
       SetFreeParameters(layout, u, &at_point);
       AnalyzePoint(at_point, setup.integrator, floquet_map, replay, &record);
       log.stable[id].push_back(record.extra[1].second);
       log.H[id].push_back(u(layout.continued_index()));
       writer.AddPoint(id, record);
-      if (!quiet) {
-        out << fmt::format("  b{:<3} #{:<4} {} = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {} (period-doubled)\n",
-                           id, info.point_index, layout.continued_name(), u(layout.continued_index()), layout.Period(u),
-                           info.step, info.newton_iterations,
-                           ToString(record.classification.reason));
-      }
     });
     const FloquetResult at_pd = ComputeFloquet(parent_map, u_pd);
     report += fmt::format("  from PD #{} at {} = {:.12f} (parent period {:.12f}, multipliers {}):\n", pd_id,
@@ -167,4 +161,4 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
   return report;
 }
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

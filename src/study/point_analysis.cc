@@ -1,11 +1,11 @@
-#include "orbit_analysis.h"
+#include "point_analysis.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "hybridcont/classification.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 ReplayOptions ReplayOptionsFor(const IntegratorOptions& integrator) { return OrbitAnalysisOptions::For(integrator).replay; }
 
@@ -21,6 +21,7 @@ void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator,
   record->residual = a.residual;
   record->observables = a.observables;
   record->extra = ExtraColumns(model, a);
+  record->analysis = a;
 }
 
 std::vector<std::pair<std::string, double>> ExtraColumns(const HybridModel& model, const OrbitAnalysis& a) {
@@ -63,4 +64,4 @@ void SetFreeParameters(const ShootingLayout& layout, const Vector& u, HybridMode
 }
 
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

@@ -1,4 +1,4 @@
-// The exploration of a model's scenario, without any I/O: what `hybridcont run` and the benchmarks share.
+// The exploration of a model's scenario, without any I/O: the engine of a study (study.h) and of the benchmarks.
 //
 //   ExplorationOptions options = ScenarioExplorationOptions(scenario);   // in the model's units
 //   ModelExploration exploration(model, scenario, IntegratorOptions{}, options);  // validates (throws)
@@ -7,8 +7,8 @@
 // The engine works in scaled unknowns u ./ s (scaled_problem.h, Scenario::unknown_scales); bounds,
 // targets and start conditions are converted on the way in and every point on the way out, so callers
 // see the model's units only.
-#ifndef HYBRIDCONT_APP_MODEL_EXPLORATION_H_
-#define HYBRIDCONT_APP_MODEL_EXPLORATION_H_
+#ifndef HYBRIDCONT_STUDY_MODEL_EXPLORATION_H_
+#define HYBRIDCONT_STUDY_MODEL_EXPLORATION_H_
 
 #include <functional>
 #include <memory>
@@ -17,16 +17,11 @@
 #include "hybridcont/scaled_problem.h"
 #include "hybridcont/statebased_shooting.h"
 #include "hybridcont/timebased_shooting.h"
+#include "hybridcont/study.h"
 #include "scenario.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
-// Time-based multiple shooting (paper eq. `timebased`, the default) or the state-based map (eq.
-// `statebased`: event-driven integration, saltation matrices, u = [x̄_1; xi; H]).
-enum class Formulation { kTimeBased, kStateBased };
-std::string ToString(Formulation f);
-// "time" / "state"; false for anything else.
-bool FromString(const std::string& text, Formulation* f);
 
 // The work of the Floquet test functions (floquet_test_functions.h) of a run, summed over the copies of
 // every stepper: their own maps' (multipliers, PD test) and that of their copies of the engine's problem
@@ -139,6 +134,6 @@ class ModelExploration {
   std::string start_report_;
 };
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-#endif  // HYBRIDCONT_APP_MODEL_EXPLORATION_H_
+#endif  // HYBRIDCONT_STUDY_MODEL_EXPLORATION_H_

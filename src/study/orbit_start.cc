@@ -10,7 +10,7 @@
 #include "hybridcont/simulation_start.h"
 #include "hybridcont/timebased_shooting.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 namespace {
 
 // Newton on the square system of an orbit at fixed parameters; the residual's max-norm is returned.
@@ -118,4 +118,4 @@ OrbitStarts FindOrbitStarts(const HybridModel& model, const RunSetup& setup, con
   return starts;
 }
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

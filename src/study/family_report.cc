@@ -7,7 +7,7 @@
 
 #include "hybridcont/family_ranges.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 std::string BranchRangesReport(const Branch& b, const ShootingLayout& layout,
                                const std::function<std::string(const Vector& u)>& describe, ResultsWriter& writer) {
@@ -56,4 +56,4 @@ std::string BranchRangesReport(const Branch& b, const ShootingLayout& layout,
   return report;
 }
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

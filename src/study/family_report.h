@@ -3,8 +3,8 @@
 // results writer classified.
 //
 //   report += BranchRangesReport(branch, layout, describe, writer);   // "" for a branch without physical orbits
-#ifndef HYBRIDCONT_APP_FAMILY_REPORT_H_
-#define HYBRIDCONT_APP_FAMILY_REPORT_H_
+#ifndef HYBRIDCONT_STUDY_FAMILY_REPORT_H_
+#define HYBRIDCONT_STUDY_FAMILY_REPORT_H_
 
 #include <functional>
 #include <string>
@@ -13,7 +13,7 @@
 #include "hybridcont/shooting_layout.h"
 #include "results_writer.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 // Branch b's stretches (its points as the writer classified them; b's special points) in the coordinate
 // layout.continued_index(), each stretch named by `describe` at its middle point: annotated into b's
@@ -22,6 +22,6 @@ namespace hybridcont::app {
 std::string BranchRangesReport(const Branch& b, const ShootingLayout& layout,
                                const std::function<std::string(const Vector& u)>& describe, ResultsWriter& writer);
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-#endif  // HYBRIDCONT_APP_FAMILY_REPORT_H_
+#endif  // HYBRIDCONT_STUDY_FAMILY_REPORT_H_

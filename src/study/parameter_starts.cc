@@ -8,9 +8,9 @@
 #include "hybridcont/corrector.h"
 #include "hybridcont/orbit_observables.h"
 #include "model_exploration.h"
-#include "orbit_analysis.h"
+#include "point_analysis.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 
 ParameterStarts FindParameterStarts(const HybridModel& model, const RunSetup& setup, TimeBasedShooting& free_map) {
@@ -72,4 +72,4 @@ ParameterStarts FindParameterStarts(const HybridModel& model, const RunSetup& se
   return starts;
 }
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

@@ -2,15 +2,15 @@
 // results files write it: the point's record with its extra CSV columns.
 //   PointRecord record;  record.u = u;  ...
 //   AnalyzePoint(model, integrator, &floquet_map, replay_options, &record);
-#ifndef HYBRIDCONT_APP_ORBIT_ANALYSIS_H_
-#define HYBRIDCONT_APP_ORBIT_ANALYSIS_H_
+#ifndef HYBRIDCONT_STUDY_POINT_ANALYSIS_H_
+#define HYBRIDCONT_STUDY_POINT_ANALYSIS_H_
 
 #include "hybridcont/orbit_analysis.h"
 #include "hybridcont/replay.h"
 #include "hybridcont/timebased_shooting.h"
 #include "results_writer.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 // Extra CSV columns (order fixed: every row of a branch has the same header): replay_error, stable,
 // normal, num_unit, max_multiplier, bp_test, pd_test, then mu<j>_re, mu<j>_im per nontrivial multiplier.
@@ -44,6 +44,6 @@ inline Vector OrbitPart(const ShootingLayout& layout, const Vector& u) {
 // The extra CSV columns of an analysis (the order above; NaN where undefined).
 std::vector<std::pair<std::string, double>> ExtraColumns(const HybridModel& model, const OrbitAnalysis& a);
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-#endif  // HYBRIDCONT_APP_ORBIT_ANALYSIS_H_
+#endif  // HYBRIDCONT_STUDY_POINT_ANALYSIS_H_

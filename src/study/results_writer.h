@@ -24,8 +24,8 @@
 // Another run's results in the folder: PrepareDirectory refuses a folder whose summary.json belongs to
 // another model (or cannot be read) unless `overwrite`; the constructor then removes every file an earlier
 // run wrote there (summary.json first, so that the folder claims nothing while it is cleaned).
-#ifndef HYBRIDCONT_APP_RESULTS_WRITER_H_
-#define HYBRIDCONT_APP_RESULTS_WRITER_H_
+#ifndef HYBRIDCONT_STUDY_RESULTS_WRITER_H_
+#define HYBRIDCONT_STUDY_RESULTS_WRITER_H_
 
 #include <atomic>
 #include <filesystem>
@@ -37,12 +37,14 @@
 #include <nlohmann/json.hpp>
 
 #include "hybridcont/classification.h"
+#include "hybridcont/orbit_analysis.h"
 #include "hybridcont/continuation.h"
 #include "hybridcont/orbit_trace.h"
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/shooting_layout.h"
+#include "hybridcont/study.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 // What is known about one branch point beyond u.
 struct PointRecord {
@@ -64,6 +66,8 @@ struct PointRecord {
   // where one is undefined (a mean over zero durations, a failed integration) and, unless it is an unknown of
   // the run, at a non-physical point.
   std::vector<std::pair<std::string, double>> observables;
+  // The typed analysis the fields above are taken from (orbit_analysis.h).
+  OrbitAnalysis analysis;
 };
 
 // The record of an accepted point u before its analysis: index, Newton iterations and step from `info`.
@@ -77,6 +81,9 @@ inline PointRecord RecordOf(const ProgressInfo& info, const Vector& u) {
   return record;
 }
 
+// The record of a study as it grows: the summary document and the analysed points of every branch, kept in
+// memory for the study's result (study.h) and, with a folder, written there as described above. Each point
+// and each finished branch is handed to the caller's hooks.
 class ResultsWriter {
  public:
   // Creates dir if needed and checks that a file can be written in it. Throws std::invalid_argument
@@ -89,15 +96,17 @@ class ResultsWriter {
   // Throws ModelInputError for a model whose presentation does not evaluate (OrbitPresentation).
   // With free parameters, points are in their layout: the CSV files have a column per parameter after T,
   // and the model's figures that plot H on the horizontal axis plot the first parameter instead.
+  // An empty `dir` writes nothing (the record in memory only). `hooks` may be null; it must outlive the writer.
   ResultsWriter(std::filesystem::path dir, const HybridModel& model, nlohmann::json options,
-                const FreeParameters& free = {});
+                const FreeParameters& free = {}, const StudyHooks* hooks = nullptr);
   // Sets a top-level field of summary.json (e.g. "curves") and rewrites it.
   void Annotate(const std::string& key, nlohmann::json value);
 
   // Branch `branch_id` is one of another model (a period-doubled family's, RepeatedModel(model, 2)): its
   // CSV columns follow that model's layout and presentation. Call before its first point; `model` must
   // outlive the writer.
-  void SetBranchModel(int branch_id, const HybridModel& model);
+  // `origin` names the family's kind for the hooks (StudyBranch::origin): "period-doubled", a word's name.
+  void SetBranchModel(int branch_id, const HybridModel& model, const std::string& origin = "");
   void AddPoint(int branch_id, const PointRecord& point);
   // The points added to a branch so far, with their classification (empty for an unknown branch).
   struct ClassifiedPoint {
@@ -130,6 +139,13 @@ class ResultsWriter {
   bool failed() const { return failed_.load(); }
 
   const std::filesystem::path& dir() const { return dir_; }
+  bool writes_files() const { return !dir_.empty(); }
+  // The summary document so far.
+  const nlohmann::json& summary() const { return summary_; }
+  // The analysed points of every branch so far, by branch id.
+  const std::map<int, std::vector<StudyPoint>>& points() const { return points_; }
+  // The key-frame orbits added so far, sampled.
+  const std::vector<StudyOrbit>& orbits() const { return orbits_; }
   static std::string BranchFileName(int id) { return "branch-" + std::to_string(id) + ".csv"; }
   // One more than the largest branch id ended so far (0 for none).
   int next_branch_id() const;
@@ -145,9 +161,14 @@ class ResultsWriter {
     ShootingLayout layout;
     OrbitPresentation presentation;
     std::vector<std::string> word;  // its modes (HybridModel::WordModeNames)
+    std::string model_name;
+    std::string origin;
   };
   std::map<int, BranchModel> branch_models_;  // branches of another model (SetBranchModel)
   std::map<int, std::vector<ClassifiedPoint>> classified_;
+  std::map<int, std::vector<StudyPoint>> points_;
+  std::vector<StudyOrbit> orbits_;
+  const StudyHooks* hooks_ = nullptr;
   std::map<int, std::ofstream> branch_files_;
   std::map<int, int> points_per_branch_;
   std::map<int, std::uintmax_t> branch_bytes_;  // bytes of each branch file written in full (whole rows)
@@ -156,11 +177,16 @@ class ResultsWriter {
 
   // Records the first failed write of `file` (errno's message) and returns false.
   bool WriteFailed(const std::filesystem::path& file);
+  // The point's CSV row (and, first, the file's header and the branch's summary entry).
+  void WritePoint(int branch_id, const PointRecord& p, const ShootingLayout& layout,
+                  const OrbitPresentation& presentation);
+  // The branch as the study's result gives it: its summary entry so far and its points.
+  StudyBranch BranchOf(int branch_id) const;
   // Lists branch `branch_id` in summary.json ("termination": "running") when its first point is written;
   // EndBranch completes the entry.
   void StartBranchEntry(int branch_id);
 };
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-#endif  // HYBRIDCONT_APP_RESULTS_WRITER_H_
+#endif  // HYBRIDCONT_STUDY_RESULTS_WRITER_H_

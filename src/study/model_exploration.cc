@@ -16,7 +16,7 @@
 #include "hybridcont/simulation_start.h"
 #include "hybridcont/start_check.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 ExplorationOptions ScenarioExplorationOptions(const Scenario& sc) {
   ExplorationOptions o;
@@ -171,9 +171,19 @@ void RenumberDiagram(int branch_offset, int point_offset, BifurcationDiagram* d)
 }
 
 
-std::string ToString(Formulation f) { return internal::EnumToString(kFormulationNames, f); }
+}  // namespace hybridcont::study
 
-bool FromString(const std::string& text, Formulation* f) { return internal::EnumFromString(kFormulationNames, text, f); }
+namespace hybridcont {
+
+std::string ToString(Formulation f) { return internal::EnumToString(study::kFormulationNames, f); }
+
+bool FromString(const std::string& text, Formulation* f) {
+  return internal::EnumFromString(study::kFormulationNames, text, f);
+}
+
+}  // namespace hybridcont
+
+namespace hybridcont::study {
 
 ModelExploration::ModelExploration(const HybridModel& model, const Scenario& scenario,
                                    const IntegratorOptions& integrator, ExplorationOptions options,
@@ -577,4 +587,4 @@ BifurcationDiagram ModelExploration::RunPeriodDoubled(const ShootingLayout& pare
   return diagram;
 }
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

@@ -10,8 +10,8 @@
 //   exploration.RunFromStarts(s.points, ...);
 // Every start the model declares ([start], or each [[start]]) gives one point; a start that fails is
 // reported and left out.
-#ifndef HYBRIDCONT_APP_ORBIT_START_H_
-#define HYBRIDCONT_APP_ORBIT_START_H_
+#ifndef HYBRIDCONT_STUDY_ORBIT_START_H_
+#define HYBRIDCONT_STUDY_ORBIT_START_H_
 
 #include <string>
 #include <vector>
@@ -19,7 +19,7 @@
 #include "hybridcont/shooting_layout.h"
 #include "run_setup.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 struct OrbitStarts {
   std::vector<Vector> points;  // in `free_layout`
@@ -28,6 +28,6 @@ struct OrbitStarts {
 
 OrbitStarts FindOrbitStarts(const HybridModel& model, const RunSetup& setup, const ShootingLayout& free_layout);
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-#endif  // HYBRIDCONT_APP_ORBIT_START_H_
+#endif  // HYBRIDCONT_STUDY_ORBIT_START_H_

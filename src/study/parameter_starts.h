@@ -9,8 +9,8 @@
 // held at p0, and kept if it converges to a physical orbit that is not already a start (same-point
 // tolerance). The starts are regular points of the families in p, since a crossing of H̄ = c at fixed p0
 // is a regular point of the family in p at fixed H̄ wherever the two-parameter surface is smooth.
-#ifndef HYBRIDCONT_APP_PARAMETER_STARTS_H_
-#define HYBRIDCONT_APP_PARAMETER_STARTS_H_
+#ifndef HYBRIDCONT_STUDY_PARAMETER_STARTS_H_
+#define HYBRIDCONT_STUDY_PARAMETER_STARTS_H_
 
 #include <string>
 #include <vector>
@@ -18,7 +18,7 @@
 #include "hybridcont/timebased_shooting.h"
 #include "run_setup.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 struct ParameterStarts {
   std::vector<Vector> points;   // in the layout of the free-parameter map, model units
@@ -31,6 +31,6 @@ struct ParameterStarts {
 // collects the starts; free_map is the time-based map with setup.free.
 ParameterStarts FindParameterStarts(const HybridModel& model, const RunSetup& setup, TimeBasedShooting& free_map);
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-#endif  // HYBRIDCONT_APP_PARAMETER_STARTS_H_
+#endif  // HYBRIDCONT_STUDY_PARAMETER_STARTS_H_

@@ -7,8 +7,8 @@
 //
 // These are the defaults of `hybridcont run MODEL`; values can be overridden from the command line
 // (--until, --max-branches, ...). No model is named here: everything comes from model.setup().
-#ifndef HYBRIDCONT_APP_SCENARIO_H_
-#define HYBRIDCONT_APP_SCENARIO_H_
+#ifndef HYBRIDCONT_STUDY_SCENARIO_H_
+#define HYBRIDCONT_STUDY_SCENARIO_H_
 
 #include <functional>
 #include <string>
@@ -17,7 +17,7 @@
 #include "hybridcont/continuation.h"
 #include "hybridcont/model.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 // A linear condition sum_k coefficient_k * direction[component_k] = 0 on the start direction.
 struct StartCondition {
@@ -57,6 +57,6 @@ struct Scenario {
 // ModelInputError (a std::invalid_argument) naming the field of a value that does not evaluate.
 Scenario DefaultScenario(const HybridModel& model);
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-#endif  // HYBRIDCONT_APP_SCENARIO_H_
+#endif  // HYBRIDCONT_STUDY_SCENARIO_H_

@@ -11,8 +11,9 @@
 #include <stdexcept>
 
 #include "hybridcont/version.h"
+#include "study_document.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 namespace fs = std::filesystem;
 
@@ -93,8 +94,9 @@ nlohmann::json PresentationJson(const HybridModel& model, const OrbitPresentatio
 }  // namespace
 
 ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::json options,
-                             const FreeParameters& free)
-    : dir_(std::move(dir)), model_(model), free_(free), layout_(model, free), presentation_(model, free) {
+                             const FreeParameters& free, const StudyHooks* hooks)
+    : dir_(std::move(dir)), model_(model), free_(free), layout_(model, free), presentation_(model, free),
+      hooks_(hooks) {
   summary_["model"] = model.name();
   summary_["version"] = HYBRIDCONT_VERSION;
   summary_["description"] = model.description();
@@ -116,6 +118,7 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
   // Remove the results of an earlier run in the same folder so that the folder describes this run only:
   // summary.json first (while the rest is removed the folder claims nothing), then the CSV files, the
   // figures (the generic ones and those the old summary declared) and the figure script's log.
+  if (!writes_files()) return;
   std::set<std::string> figures = {"H_T", "H_T_xi", "keyframes", "curves"};
   std::error_code ec;
   {
@@ -151,10 +154,10 @@ bool ResultsWriter::WriteFailed(const fs::path& file) {
   return false;
 }
 
-void ResultsWriter::SetBranchModel(int branch_id, const HybridModel& model) {
+void ResultsWriter::SetBranchModel(int branch_id, const HybridModel& model, const std::string& origin) {
   // The run's free parameters are the other model's too (a doubled model's columns: its unknowns and p).
-  branch_models_.insert_or_assign(branch_id,
-                                  BranchModel{ShootingLayout(model, free_), OrbitPresentation(model, free_), model.WordModeNames()});
+  branch_models_.insert_or_assign(branch_id, BranchModel{ShootingLayout(model, free_), OrbitPresentation(model, free_),
+                                                         model.WordModeNames(), model.name(), origin});
 }
 
 int ResultsWriter::next_branch_id() const {
@@ -180,10 +183,18 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
   const bool stable = p.classification.physical && p.extra.size() > 1 && p.extra[1].first == "stable" &&
                       p.extra[1].second == 1;
   classified_[branch_id].push_back({p.index, p.u, p.classification, stable});
-  if (!write_error_.empty()) return;  // a full disk: keep what is there, write nothing more
   const auto other = branch_models_.find(branch_id);
   const ShootingLayout& layout = other == branch_models_.end() ? layout_ : other->second.layout;
-  const OrbitPresentation& presentation = other == branch_models_.end() ? presentation_ : other->second.presentation;
+  std::vector<StudyPoint>& points = points_[branch_id];
+  points.push_back({p.index, p.u, layout.Period(p.u), p.analysis, p.newton_iterations, p.step, p.at_branch_point});
+  if (points.size() == 1 && !writes_files()) StartBranchEntry(branch_id);
+  WritePoint(branch_id, p, layout, other == branch_models_.end() ? presentation_ : other->second.presentation);
+  if (hooks_ && hooks_->on_point) hooks_->on_point(points.back(), BranchOf(branch_id));
+}
+
+void ResultsWriter::WritePoint(int branch_id, const PointRecord& p, const ShootingLayout& layout,
+                               const OrbitPresentation& presentation) {
+  if (!writes_files() || !write_error_.empty()) return;  // a full disk: keep what is there, write nothing more
   // The row (and, first, the header) is made in memory and written at once; a write that fails leaves the
   // file cut back to its last whole row (a full disk tears no row).
   std::ostringstream f;
@@ -248,6 +259,7 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
 void ResultsWriter::EndBranch(const Branch& b) {
   auto file = branch_files_.find(b.id);
   if (file != branch_files_.end()) file->second.close();
+  if (!writes_files()) points_per_branch_[b.id] = static_cast<int>(ClassifiedPoints(b.id).size());
   nlohmann::json entry = {{"id", b.id},
                           {"file", BranchFileName(b.id)},
                           {"parent", b.parent_special_point},
@@ -278,6 +290,23 @@ void ResultsWriter::EndBranch(const Branch& b) {
     branches.push_back(std::move(entry));
   }
   WriteSummary();
+  if (hooks_ && hooks_->on_branch) hooks_->on_branch(BranchOf(b.id));
+}
+
+StudyBranch ResultsWriter::BranchOf(int branch_id) const {
+  const nlohmann::json& branches = summary_["branches"];
+  const auto entry = std::find_if(branches.begin(), branches.end(),
+                                  [&](const nlohmann::json& e) { return e["id"] == branch_id; });
+  const auto other = branch_models_.find(branch_id);
+  const ShootingLayout& layout = other == branch_models_.end() ? layout_ : other->second.layout;
+  const auto points = points_.find(branch_id);
+  StudyBranch b = entry == branches.end() ? StudyBranch{} : BranchFromSummary(*entry, layout.unknown_names());
+  b.id = branch_id;
+  b.continued = layout.continued_name();
+  if (other != branch_models_.end()) b.model = other->second.model_name, b.origin = other->second.origin;
+  else b.model = model_.name();
+  if (points != points_.end()) b.points = points->second;
+  return b;
 }
 
 void ResultsWriter::StartBranchEntry(int branch_id) {
@@ -302,6 +331,15 @@ void ResultsWriter::SetSpecialPoints(nlohmann::json special_points) {
 std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int index, double H, double T,
                                     const std::string& label) {
   const std::string name = "orbit-" + std::to_string(summary_["orbits"].size()) + ".csv";
+  const std::vector<OrbitSample> samples = trace.Sample(400);
+  StudyOrbit orbit{branch_id, index, label, H, T, {}, {}, {}};
+  for (const OrbitSample& s : samples) orbit.t.push_back(s.t), orbit.segment.push_back(s.segment), orbit.x.push_back(s.x);
+  orbits_.push_back(std::move(orbit));
+  if (!writes_files()) {
+    summary_["orbits"].push_back(
+        {{"file", name}, {"branch", branch_id}, {"index", index}, {"H", H}, {"T", T}, {"label", label}});
+    return name;
+  }
   if (!write_error_.empty()) return name;
   errno = 0;
   std::ofstream f(dir_ / name);
@@ -311,7 +349,6 @@ std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int 
   }
   for (const std::string& point : presentation_.point_names()) f << ",draw." << point << ".x,draw." << point << ".y";
   f << "\n";
-  const std::vector<OrbitSample> samples = trace.Sample(400);
   const std::vector<Matrix> drawn = presentation_.DrawOrbit(samples);
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const OrbitSample& s = samples[k];
@@ -347,6 +384,7 @@ std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int 
 void ResultsWriter::SetReport(const std::string& report) { summary_["report"] = report; }
 
 bool ResultsWriter::WriteSummary() {
+  if (!writes_files()) return true;
   if (!write_error_.empty()) return false;
   const fs::path tmp = dir_ / "summary.json.tmp";
   errno = 0;
@@ -379,4 +417,4 @@ void ResultsWriter::Fail(const std::string& message) {
   if (write_error_.empty()) WriteSummary();
 }
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

@@ -1,17 +1,17 @@
-// The validated set-up of `hybridcont run`: the integrator and exploration options and the model's scenario
-// after every command-line option is applied and checked against the model.
+// The validated set-up of a study: the integrator and exploration options and the model's scenario after
+// every option of StudyOptions is applied and checked against the model.
 //   RunSetup setup = MakeRunSetup(args, model);   // throws std::invalid_argument naming the bad option
-#ifndef HYBRIDCONT_APP_RUN_SETUP_H_
-#define HYBRIDCONT_APP_RUN_SETUP_H_
+#ifndef HYBRIDCONT_STUDY_RUN_SETUP_H_
+#define HYBRIDCONT_STUDY_RUN_SETUP_H_
 
-#include "commands.h"
+#include "hybridcont/study.h"
 #include "hybridcont/exploration.h"
 #include "hybridcont/flow.h"
 #include "hybridcont/model.h"
 #include "hybridcont/shooting_layout.h"
 #include "scenario.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 struct RunSetup {
   IntegratorOptions integrator;
@@ -35,11 +35,11 @@ struct RunSetup {
   std::vector<std::string> notes;
 };
 
-// The model's default scenario with --free, --fix, --curves, --rtol, --atol, --until, --bound, --max-branches, --threads and
-// --no-symmetry applied. Throws std::invalid_argument ("--OPTION VALUE: why") for a value the library
-// refuses or that makes no sense for a run (see the README, "Bad input").
-RunSetup MakeRunSetup(const RunArguments& args, const HybridModel& model);
+// The model's default scenario with the options free, fix, curves, rtol, atol, until, bounds, max_branches,
+// threads and use_symmetries applied. Throws StudyOptionError (naming the field) for a value the library
+// refuses or that makes no sense for a study (see docs/bad-input.md).
+RunSetup MakeRunSetup(const StudyOptions& options, const HybridModel& model);
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-#endif  // HYBRIDCONT_APP_RUN_SETUP_H_
+#endif  // HYBRIDCONT_STUDY_RUN_SETUP_H_

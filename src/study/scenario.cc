@@ -5,7 +5,7 @@
 #include "hybridcont/expression.h"
 #include "hybridcont/setup_evaluation.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 Scenario DefaultScenario(const HybridModel& model) {
   const ModelSetup& setup = model.setup();
@@ -44,4 +44,4 @@ Scenario DefaultScenario(const HybridModel& model) {
   return s;
 }
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

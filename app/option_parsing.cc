@@ -1,15 +1,12 @@
-#include "model_options.h"
+#include "option_parsing.h"
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <limits>
-#include <set>
+#include <map>
 #include <stdexcept>
 
-#include "hybridcont/model_file.h"
 #include "install_paths.h"
-#include "hybridcont/models.h"
 
 namespace hybridcont::app {
 
@@ -69,30 +66,32 @@ BoundAssignment ParseBound(const std::string& option, const std::string& text) {
 
 HybridModel MakeModelWithOverrides(const std::string& name, const std::vector<std::string>& assignments,
                                    std::ostream* log, bool compile) {
-  HybridModel model = [&] {
-    if (!IsModelFilePath(name)) return MakeBuiltinModel(name);
-    ModelFileOptions options;
-    options.log = log;
-    options.compile = compile;
-    // A relative path that does not exist here names one of the shipped models: `hybridcont run
-    // stiffening-slip.toml` finds <models folder>/stiffening-slip.toml of this installation.
-    std::filesystem::path path = name;
-    std::error_code ec;
-    if (path.is_relative() && !std::filesystem::exists(path, ec)) {
-      const std::filesystem::path shipped = ModelsDirectory() / path.filename();
-      if (!ModelsDirectory().empty() && std::filesystem::exists(shipped, ec)) path = shipped;
-    }
-    return LoadModelFile(path, options);
-  }();
-  std::set<std::string> assigned;
+  std::vector<NamedValue> parameters;
   for (const std::string& a : assignments) {
     const auto [parameter, value] = ParseAssignment("--set", a);
-    if (!assigned.insert(parameter).second) {
-      throw std::invalid_argument("--set '" + a + "': '" + parameter + "' is given twice");
-    }
-    model.SetParameter(parameter, value);
+    parameters.push_back({parameter, value});
   }
-  return model;
+  try {
+    return MakeStudyModel(name, parameters, ModelsDirectory().string(), log, compile);
+  } catch (const StudyOptionError& e) {
+    throw CommandLineError(e);
+  }
+}
+
+std::string FlagOf(const std::string& field) {
+  static const std::map<std::string, std::string> kFlags = {
+      {"parameters", "--set"},     {"until", "--until"},       {"bounds", "--bound"},
+      {"monitors", "--monitor"},   {"rtol", "--rtol"},         {"atol", "--atol"},
+      {"max_branches", "--max-branches"}, {"threads", "--threads"}, {"formulation", "--formulation"},
+      {"free", "--free"},          {"fix", "--fix"},           {"curves", "--curves"},
+      {"out_dir", "--out"},        {"period_doubling", "--period-doubling"}, {"model", "MODEL"},
+      {"restart", "--restart"},    {"resume", "--resume"}};
+  const auto it = kFlags.find(field);
+  return it == kFlags.end() ? field : it->second;
+}
+
+std::invalid_argument CommandLineError(const StudyOptionError& e) {
+  return std::invalid_argument(FlagOf(e.field()) + " " + e.detail());
 }
 
 }  // namespace hybridcont::app

@@ -16,11 +16,11 @@
 #include "hybridcont/timebased_shooting.h"
 #include "hybridcont/word_change.h"
 #include "model_exploration.h"
-#include "orbit_analysis.h"
+#include "point_analysis.h"
 #include "scenario.h"
 #include "summary_json.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 namespace {
 
 // A duration at most this is 0 (a branch point on a zero-duration family, a start with zero durations).
@@ -204,7 +204,7 @@ ExplorationOptions WordOptions(const ExplorationOptions& run, const ShootingLayo
 }  // namespace
 
 std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
-                               nlohmann::json* special_points, ResultsWriter& writer, std::ostream& out, bool quiet) {
+                               nlohmann::json* special_points, ResultsWriter& writer, const StudyHooks& hooks) {
   if (!model.automaton()) return "";
   const HybridAutomaton& automaton = *model.automaton();
   std::string report = "Phase-sequence changes (words of the automaton):\n";
@@ -264,16 +264,10 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
     int skipped = 0;
     BifurcationDiagram d = w.exploration->RunFromStarts({u}, [&](const ProgressInfo& info, const Vector& v) {
       const int branch = info.branch_id + offset;
-      if (info.point_index == 0) writer.SetBranchModel(branch, *w.model);
+      if (info.point_index == 0) writer.SetBranchModel(branch, *w.model, automaton.WordName(w.word));
       PointRecord record = RecordOf(info, v);
       AnalyzePoint(*w.model, integrator, floquet_map, replay, &record);
       writer.AddPoint(branch, record);
-      if (!quiet) {
-        out << fmt::format("  b{:<3} #{:<4} H = {:<12.8f} T = {:<12.8f} step {:<9.3g} newton {}  {} ({})\n", branch,
-                           info.point_index, v(word_layout.H_index()), word_layout.Period(v), info.step,
-                           info.newton_iterations, ToString(record.classification.reason),
-                           automaton.WordName(w.word));
-      }
     }, &skipped);
     if (d.status == ExplorationStatus::kStartFailed) return d;
     RenumberDiagram(offset, static_cast<int>(special_points->size()), &d);
@@ -313,7 +307,7 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
                             guess(layout.H_index()), corrected.message);
       continue;
     }
-    if (!quiet) out << fmt::format("word {} from its start:\n", name);
+    if (hooks.on_progress) hooks.on_progress({"words", writer.next_branch_id(), 0, fmt::format("word {} from its start:", name)});
     const BifurcationDiagram d = Explore(target, u);
     if (d.status == ExplorationStatus::kStartFailed) {
       report += fmt::format("  start in word {}: not explored, {}\n", name, d.message);
@@ -415,7 +409,9 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
           continue;
         }
         // Explore the new word's family from the orbit, both directions.
-        if (!quiet) out << fmt::format("word {} from {}:\n", automaton.WordName(c.word), c.rule);
+        if (hooks.on_progress) {
+          hooks.on_progress({"words", writer.next_branch_id(), 0, fmt::format("word {} from {}:", automaton.WordName(c.word), c.rule)});
+        }
         BifurcationDiagram d = Explore(target, c.u);
         if (d.status == ExplorationStatus::kStartFailed) {
           j["reason"] = "not explored: " + d.message;
@@ -455,4 +451,4 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
   return report;
 }
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study

@@ -5,9 +5,9 @@
 // floquet_test_functions.h). Branch and special point ids continue the run's; each branch's summary entry says
 // "period_doubled_from" (the PD point's id), "model" (the doubled model's name), "unknowns" (its
 // layout's names, the columns of its CSV) and "stability_changes" (where the linear stability flips).
-//   std::string report = ExplorePeriodDoubledFamilies(model, doubled, setup, diagram, &special_points, writer, out, quiet);
-#ifndef HYBRIDCONT_APP_PERIOD_DOUBLED_FAMILIES_H_
-#define HYBRIDCONT_APP_PERIOD_DOUBLED_FAMILIES_H_
+//   std::string report = ExplorePeriodDoubledFamilies(model, doubled, setup, diagram, &special_points, writer);
+#ifndef HYBRIDCONT_STUDY_PERIOD_DOUBLED_FAMILIES_H_
+#define HYBRIDCONT_STUDY_PERIOD_DOUBLED_FAMILIES_H_
 
 #include <nlohmann/json.hpp>
 #include <ostream>
@@ -18,16 +18,16 @@
 #include "results_writer.h"
 #include "run_setup.h"
 
-namespace hybridcont::app {
+namespace hybridcont::study {
 
 // `doubled` is RepeatedModel(model, 2); `diagram` and `special_points` are the run's (time-based layout);
 // a family starts at each located PD point among the diagram's special points (duplicates skipped). Appends the families' special points to
-// special_points, writes their branches through `writer`, prints progress lines unless quiet; returns the
+// special_points, writes their branches through `writer` (its hooks see their points); returns the
 // report section.
 std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridModel& doubled, const RunSetup& setup,
                                          const BifurcationDiagram& diagram, nlohmann::json* special_points,
-                                         ResultsWriter& writer, std::ostream& out, bool quiet);
+                                         ResultsWriter& writer);
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont::study
 
-#endif  // HYBRIDCONT_APP_PERIOD_DOUBLED_FAMILIES_H_
+#endif  // HYBRIDCONT_STUDY_PERIOD_DOUBLED_FAMILIES_H_

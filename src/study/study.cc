@@ -1,0 +1,506 @@
+// RunStudy (study.h): the pipeline of a study. Order of work, so that bad input writes nothing: validate every
+// option, build the model, validate the exploration options against the problem, check the start, prepare the
+// output folder; only then compute. Points are classified (physical or why not) and handed to the record
+// (results_writer.h) as they are accepted (with threads > 1: branch by branch as the exploration merges
+// them, in the order of one thread).
+//
+// Steps in files of their own: run_setup.h (options -> validated set-up), point_analysis.h (each accepted
+// point), summary_json.h (options and special points in the document), period_doubled_families.h,
+// word_families.h, parameter_curves.h, family_report.h.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include "family_report.h"
+#include "hybridcont/automaton_words.h"
+#include "hybridcont/conservation_check.h"
+#include "hybridcont/exploration.h"
+#include "hybridcont/period_doubling.h"
+#include "hybridcont/setup_evaluation.h"
+#include "hybridcont/study.h"
+#include "hybridcont/timebased_shooting.h"
+#include "hybridcont/version.h"
+#include "model_exploration.h"
+#include "orbit_start.h"
+#include "parameter_curves.h"
+#include "parameter_starts.h"
+#include "period_doubled_families.h"
+#include "point_analysis.h"
+#include "results_writer.h"
+#include "run_setup.h"
+#include "scenario.h"
+#include "study_document.h"
+#include "summary_json.h"
+#include "word_families.h"
+
+namespace hybridcont::study {
+namespace {
+
+// The physicality of the accepted points, per branch id and in the order of the points (false where a point
+// could not be converted to the time-based layout).
+struct PointLog {
+  std::map<int, std::vector<bool>> physical;
+};
+
+// The exploration's point callback: converts each accepted point to the time-based layout (which every
+// output uses, whatever the formulation), analyses it (orbit_analysis.h) and hands it to the record.
+class PointStream {
+ public:
+  PointStream(const HybridModel& model, const RunSetup& setup, ModelExploration& exploration, ResultsWriter& writer)
+      : model_(model), setup_(setup), exploration_(exploration), writer_(writer),
+        floquet_map_(model, setup.integrator, setup.free), replay_options_(ReplayOptionsFor(setup.integrator)),
+        point_model_(setup.free.empty() ? nullptr : std::make_unique<HybridModel>(model.Clone())) {}
+
+  void Add(const ProgressInfo& info, const Vector& u_problem) {
+    Vector u;
+    if (!exploration_.ToTimeBased(u_problem, &u).ok) {
+      log_.physical[info.branch_id].push_back(false);  // keep per-point alignment
+
+      return;
+    }
+    PointRecord record = RecordOf(info, u);
+    if (point_model_) SetFreeParameters(floquet_map_.layout(), u, point_model_.get());
+    AnalyzePoint(point_model_ ? *point_model_ : model_, setup_.integrator, floquet_map_, replay_options_, &record);
+    writer_.AddPoint(info.branch_id, record);
+    log_.physical[info.branch_id].push_back(record.classification.physical);
+  }
+
+  const PointLog& log() const { return log_; }
+  // One map for residuals and Floquet data, separate from the engine's (whose cache stays intact).
+  TimeBasedShooting& floquet_map() { return floquet_map_; }
+
+ private:
+  const HybridModel& model_;
+  const RunSetup& setup_;
+  ModelExploration& exploration_;
+  ResultsWriter& writer_;
+  TimeBasedShooting floquet_map_;
+  const ReplayOptions replay_options_;
+  std::unique_ptr<HybridModel> point_model_;  // with free parameters: the model at the point's values
+  PointLog log_;
+};
+
+// Interval widths of a state-based special point in the time-based layout: the widths of the unknowns both
+// layouts have (x̄_1, ξ, H̄: the same names), NaN for the others; empty when the width is unknown.
+void ConvertWidth(const std::vector<std::string>& state_names, const std::vector<std::string>& time_names,
+                  Vector* width) {
+  if (width->size() != static_cast<Eigen::Index>(state_names.size())) return width->resize(0);
+  Vector w = Vector::Constant(static_cast<Eigen::Index>(time_names.size()), std::nan(""));
+  for (size_t i = 0; i < state_names.size(); ++i) {
+    const auto it = std::find(time_names.begin(), time_names.end(), state_names[i]);
+    if (it != time_names.end()) w(it - time_names.begin()) = (*width)(static_cast<Eigen::Index>(i));
+  }
+  *width = w;
+}
+
+// A state-based diagram in the time-based layout, which everything downstream reads: points (without
+// tangents) and special points, NaN where a point cannot be converted.
+void ConvertToTimeBased(ModelExploration& exploration, const ShootingLayout& layout, BifurcationDiagram* diagram) {
+  const auto convert = [&](Vector* u) {
+    Vector u_time;
+    if (u->size() && exploration.ToTimeBased(*u, &u_time).ok) *u = u_time;
+    else *u = Vector::Constant(layout.num_unknowns(), std::nan(""));
+  };
+  const std::vector<std::string> state_names = diagram->unknown_names, time_names = layout.unknown_names();
+  for (Branch& b : diagram->branches) {
+    for (ContinuationPoint& p : b.points) convert(&p.u), p.tangent.resize(0);
+    for (SpecialPoint& sp : b.special_points) convert(&sp.u), ConvertWidth(state_names, time_names, &sp.interval_width);
+  }
+  for (SpecialPoint& sp : diagram->special_points) {
+    convert(&sp.u), ConvertWidth(state_names, time_names, &sp.interval_width);
+  }
+  diagram->unknown_names = layout.unknown_names();
+}
+
+// The key-frame orbits: per family, as the model names its physical orbits, the physical point closest to
+// the scenario's key-frame target (two halves of one family from a start would otherwise fill the frames
+// with one gait twice); orbits no family rule names, per branch. In the order of their branches, the first
+// scenario.max_keyframe_orbits of them, each traced and written.
+void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log, const HybridModel& model,
+                         const RunSetup& setup, const ShootingLayout& layout, ResultsWriter& writer) {
+  const Scenario& sc = setup.scenario;
+  struct Candidate {
+    int branch = -1, point = -1;
+    double distance = 1e300;
+    std::string family;
+  };
+  std::vector<Candidate> candidates;  // one per named family, one per branch of unnamed orbits
+  for (const Branch& b : diagram.branches) {
+    const auto flags = log.physical.find(b.id);
+    if (flags == log.physical.end()) continue;
+    for (int i = 0; i < static_cast<int>(b.points.size()) && i < static_cast<int>(flags->second.size()); ++i) {
+      if (!flags->second[i]) continue;
+      const Vector& u = b.points[i].u;
+      const double value = sc.keyframes.component == "T" ? layout.Period(u) : u(layout.continued_index());
+      const double distance = std::abs(value - sc.keyframes.value);
+      const std::string family = sc.describe(u);
+      const bool named = family != kUnnamedFamily;
+      auto it = std::find_if(candidates.begin(), candidates.end(), [&](const Candidate& c) {
+        return c.family == family && (named || c.branch == b.id);
+      });
+      if (it == candidates.end()) it = candidates.insert(candidates.end(), Candidate{b.id, i, distance, family});
+      if (distance < it->distance) *it = Candidate{b.id, i, distance, family};
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.branch < b.branch; });
+  std::vector<Vector> drawn;
+  for (const Candidate& c : candidates) {
+    if (static_cast<int>(drawn.size()) >= sc.max_keyframe_orbits) break;
+    const auto branch = std::find_if(diagram.branches.begin(), diagram.branches.end(),
+                                     [&](const Branch& b) { return b.id == c.branch; });
+    const Vector& u = branch->points[c.point].u;
+    if (std::any_of(drawn.begin(), drawn.end(),
+                    [&](const Vector& v) { return (v - u).lpNorm<Eigen::Infinity>() <= 1e-9 * (1 + u.norm()); })) {
+      continue;  // the same orbit, the start of two half-branches
+    }
+    drawn.push_back(u);
+    HybridModel at_point = model.Clone();
+    SetFreeParameters(layout, u, &at_point);
+    const OrbitTrace trace(at_point, OrbitPart(layout, u), setup.integrator);
+    writer.AddOrbit(trace, c.branch, c.point, layout.has_level() ? u(layout.H_index()) : std::nan(""),
+                    layout.Period(u), c.family);
+  }
+}
+
+// Per branch with physical orbits: its family, where its orbits are physical and where stable, in the
+// continued coordinate, each end from the special point located there (family_report.h).
+std::string RangesReport(const BifurcationDiagram& diagram, const Scenario& sc, const ShootingLayout& layout,
+                         ResultsWriter& writer) {
+  std::string report = fmt::format("Physical families (where their orbits are physical and where stable, in {}):\n",
+                                   layout.continued_name());
+  std::string families;
+  for (const Branch& b : diagram.branches) families += BranchRangesReport(b, layout, sc.describe, writer);
+  return report + (families.empty() ? "  none\n" : families);
+}
+
+// The Floquet crossings among the diagram's special points (located by the exploration as test functions,
+// floquet_test_functions.h), one line each, BP before PD.
+std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayout& layout) {
+  std::string report =
+      "Floquet and observable special points (multiplier crossings on physical orbits; grazing events; constraint "
+      "boundaries; monitored values):\n";
+  int count = 0;
+  for (const SpecialPointType type : {SpecialPointType::kFloquetBranchPoint, SpecialPointType::kPeriodDoubling,
+                                      SpecialPointType::kGrazing, SpecialPointType::kNeimarkSacker,
+                                      SpecialPointType::kKreinCollision, SpecialPointType::kConstraintBoundary,
+                                      SpecialPointType::kObservableValue}) {
+    const std::string code = Code(type);  // special_point.h: the one definition of the codes
+    for (const SpecialPoint& sp : diagram.special_points) {
+      if (sp.type != type || sp.u.size() == 0) continue;
+      // Over the components the point's layout has (a state-based point converted to the time-based layout
+      // has no widths for the durations and the later segments' states: NaN there).
+      double precision = 0;
+      bool widths = false;
+      for (Eigen::Index i = 0; i < sp.interval_width.size(); ++i) {
+        if (std::isfinite(sp.interval_width(i))) precision += sp.interval_width(i) * sp.interval_width(i), widths = true;
+      }
+      precision = widths ? std::sqrt(precision) : sp.precision();
+      report += fmt::format("  {} on branch {} after point {}: {} = {:.12f}, T = {:.12f} ({}, precision {:.1e}){}\n", code,
+                            sp.branch_id, sp.index, layout.continued_name(), sp.u(layout.continued_index()),
+                            layout.Period(sp.u), ToString(sp.status), precision,
+                            sp.message.empty() ? "" : " " + sp.message);
+      ++count;
+    }
+  }
+  if (count == 0) report += "  none\n";
+  return report;
+}
+
+// The diagram's report, the Floquet points' and the wall time and work of the whole computation
+// (exploration, classification and replays, Floquet multipliers, key-frame orbits, and the branch and orbit
+// files written on the way), before the summary, report and figures; the Floquet test functions' work on a
+// line of its own (ModelExploration::test_function_work: not the continuation's).
+std::string RunReport(const BifurcationDiagram& diagram, const std::string& floquet_report,
+                      std::chrono::steady_clock::time_point start_time, const ModelExploration& exploration,
+                      const TimeBasedShooting& floquet_map) {
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  const TestFunctionWork tests = exploration.test_function_work();
+  return diagram.FullReport() + floquet_report +
+         fmt::format("\nwall time {:.3f} s, {} right-hand-side evaluations in {} map evaluations; Floquet multipliers "
+                     "of the accepted points: {} right-hand-side evaluations in {} map evaluations\n"
+                     "Floquet test functions (BP and PD): {} right-hand-side evaluations in {} map evaluations, {} of "
+                     "them for curve points between branch points and the location of their zeros\n",
+                     seconds, exploration.counters().rhs_evaluations, exploration.num_evaluations(),
+                     floquet_map.counters().rhs_evaluations, floquet_map.num_evaluations(),
+                     tests.counters.rhs_evaluations, tests.evaluations, tests.curve_evaluations);
+}
+
+// ---- 2. compute, streaming every accepted point; 3. summary, key-frame orbits, report, figures
+void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridModel& model, const RunSetup& setup,
+             ModelExploration& exploration, ResultsWriter& writer, StudyResult* result) {
+  const Formulation formulation = options.formulation;
+  const ShootingLayout& layout = exploration.shooting().layout();
+  PointStream stream(model, setup, exploration, writer);
+  const auto start_time = std::chrono::steady_clock::now();
+  const auto on_point = [&](const ProgressInfo& info, const Vector& u_problem) { stream.Add(info, u_problem); };
+  std::string starts_report;
+  BifurcationDiagram diagram;
+  // A write that fails (a full disk) stops the run at once: the branches end at their last point, nothing
+  // more is computed, and the run says which file could not be written.
+  exploration.set_cancel([&writer, &hooks] { return writer.failed() || (hooks.stop_requested && hooks.stop_requested()); });
+  const auto say = [&](const std::string& stage, const std::string& text) {
+    if (hooks.on_progress) hooks.on_progress({stage, writer.next_branch_id(), 0, text});
+  };
+  if (setup.free.empty()) {
+    starts_report = exploration.start_report();
+    if (!starts_report.empty()) say("start", starts_report);  // how far Newton moved a guess
+    diagram = exploration.Run(on_point);
+  } else if (model.num_first_integrals() == 0) {  // the family in the parameter from the model's start
+    const OrbitStarts starts = FindOrbitStarts(model, setup, layout);
+    int skipped = 0;
+    say("start", starts.report);
+    diagram = exploration.RunFromStarts(starts.points, on_point, &skipped);
+    starts_report = starts.report + fmt::format("  {} of them on branches traced from earlier starts\n", skipped);
+  } else {
+    const ParameterStarts starts = FindParameterStarts(model, setup, exploration.shooting());
+    int skipped = 0;
+    diagram = exploration.RunFromStarts(starts.points, on_point, &skipped);
+    starts_report = starts.report + fmt::format("  {} of them on branches traced from earlier starts\n", skipped);
+    say("start", starts_report);
+    writer.Annotate("starts", {{"crossings", starts.crossings},
+                               {"distinct", starts.points.size()},
+                               {"on_traced_branches", skipped},
+                               {"ordinary_half_branches", starts.ordinary_branches}});
+  }
+  if (formulation == Formulation::kStateBased) ConvertToTimeBased(exploration, layout, &diagram);
+  for (const Branch& b : diagram.branches) writer.EndBranch(b);
+  result->status = diagram.status;
+  result->message = diagram.message;
+  if (writer.failed()) return;  // the failed write is the result's write_error
+  nlohmann::json special_points = SpecialPointsJson(diagram, layout, &model, setup.integrator);
+  const std::string floquet_report = FloquetReport(diagram, layout);
+  std::string period_doubled;
+  const std::unique_ptr<HybridModel> doubled =
+      options.period_doubling ? std::make_unique<HybridModel>(RepeatedModel(model, 2)) : nullptr;
+  const auto stopped = [&] { return writer.failed() || (hooks.stop_requested && hooks.stop_requested()); };
+  if (doubled && !stopped()) {
+    say("period-doubled families", "");
+    period_doubled = ExplorePeriodDoubledFamilies(model, *doubled, setup, diagram, &special_points, writer);
+  }
+  std::string words;
+  if (options.follow_word_changes && !stopped()) {
+    say("words", "");
+    words = ExploreWordChanges(model, setup, diagram, &special_points, writer, hooks);
+  }
+  std::string curves_report;
+  if (!setup.curve_parameter.empty() && !stopped()) {
+    say("curves", "");
+    writer.Annotate("curves", TraceParameterCurves(model, setup, diagram, writer.dir(), &curves_report));
+  }
+  writer.SetSpecialPoints(special_points);
+  say("key frames", "");
+  WriteKeyframeOrbits(diagram, stream.log(), model, setup, layout, writer);
+  const std::string ranges = RangesReport(diagram, setup.scenario, layout, writer);
+  const std::string report =
+      RunReport(diagram, starts_report + floquet_report + ranges + period_doubled + words + curves_report, start_time,
+                exploration, stream.floquet_map());
+  writer.SetReport(report);
+  result->report = report;
+  const TestFunctionWork tests = exploration.test_function_work();
+  result->work.rhs_evaluations = exploration.counters().rhs_evaluations;
+  result->work.map_evaluations = exploration.num_evaluations();
+  result->work.analysis_rhs_evaluations = stream.floquet_map().counters().rhs_evaluations;
+  result->work.analysis_map_evaluations = stream.floquet_map().num_evaluations();
+  result->work.test_rhs_evaluations = tests.counters.rhs_evaluations;
+  result->work.test_map_evaluations = tests.evaluations;
+  result->work.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+}
+
+// The exploration of the model; a problem the exploration refuses names --until/--bound when they were given.
+std::unique_ptr<ModelExploration> MakeExploration(const StudyOptions& options, const HybridModel& model,
+                                                  const RunSetup& setup) {
+  try {
+    return std::make_unique<ModelExploration>(model, setup.scenario, setup.integrator, setup.exploration,
+                                              options.formulation, setup.free, setup.monitors);
+  } catch (const std::invalid_argument& e) {
+    if (options.until.empty() && options.bounds.empty()) throw;
+    throw StudyOptionError(options.until.empty() ? "bounds" : "until", -1, e.what());
+  }
+}
+
+// The model must keep its first integrals (conservation_check.h): checked at the typical states and at the
+// start orbit's states before anything runs; a violation is a modelling error (bad input).
+void CheckConservationAtStart(const HybridModel& model, const std::string& argument, const ShootingLayout& layout,
+                              const Vector& start) {
+  std::vector<std::vector<Vector>> states(model.num_phases());
+  for (int i = 0; i < model.num_phases(); ++i) states[i].push_back(model.phase(i).typical_state());
+  if (start.size() == layout.num_unknowns()) {
+    for (int s = 0; s < layout.num_segments(); ++s) {
+      states[s % model.num_phases()].push_back(start.segment(layout.state_offset(s), layout.dim(s)));
+    }
+  }
+  const ConservationReport report = CheckConservation(model, states);
+  if (!report.passed()) {
+    throw std::invalid_argument("model '" + model.name() + "' does not conserve its energy: " +
+                                report.FirstFailure() + " (`hybridcont check " + argument +
+                                "` shows every phase and reset)");
+  }
+}
+
+
+// A stream whose every line goes to the hooks' on_note (a model file's compile notes as they are said).
+class NoteBuffer : public std::stringbuf {
+ public:
+  explicit NoteBuffer(const StudyHooks& hooks) : hooks_(hooks) {}
+  int sync() override {
+    std::string text = str();
+    std::size_t end;
+    while ((end = text.find('\n')) != std::string::npos) {
+      if (hooks_.on_note) hooks_.on_note(text.substr(0, end));
+      text.erase(0, end + 1);
+    }
+    str(text);
+    return 0;
+  }
+
+ private:
+  const StudyHooks& hooks_;
+};
+
+// A study checked against its model, ready to run: nothing computed or written yet.
+struct PreparedStudy {
+  std::unique_ptr<HybridModel> model;
+  RunSetup setup;
+  std::unique_ptr<ModelExploration> exploration;
+};
+
+PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks) {
+  PreparedStudy p;
+  NoteBuffer notes(hooks);
+  std::ostream log(&notes);
+  if (options.model.empty()) throw StudyOptionError("model", -1, "'': name a built-in model or a model file");
+  p.model = std::make_unique<HybridModel>(MakeStudyModel(options.model, options.parameters, options.models_directory, &log));
+  log.flush();
+  const HybridModel& model = *p.model;
+  if (!options.free.empty() && options.formulation == Formulation::kStateBased) {
+    throw StudyOptionError("formulation", -1, "state: free '" + options.free +
+                           "' needs the time-based formulation (the state-based map has no free parameters)");
+  }
+  if (!options.monitors.empty() && options.formulation == Formulation::kStateBased) {
+    throw StudyOptionError("monitors", -1, "needs the time-based formulation");
+  }
+  if (!options.free.empty() && options.period_doubling) {
+    throw StudyOptionError("period_doubling", -1, "not with a free parameter (free '" + options.free + "')");
+  }
+  p.setup = MakeRunSetup(options, model);
+  p.exploration = MakeExploration(options, model, p.setup);
+  CheckConservationAtStart(model, options.model, p.exploration->shooting().layout(), p.setup.scenario.start);
+  // An automaton's starts in other words take transitions the file's word may not: their words are checked
+  // too, at their typical states and their starts; and every transition that none of these words takes, which
+  // only a change of the phase sequence would reach, on a word through it at the typical states.
+  if (model.automaton() != nullptr) {
+    std::vector<Word> checked = {model.word()};
+    for (const StartSpec& start : model.setup().word_starts) {
+      const HybridModel word_model = WordModelAt(model, start.word);
+      CheckConservationAtStart(word_model, options.model, ShootingLayout(word_model), StartPoint(word_model, start));
+      checked.push_back(start.word);
+    }
+    const HybridAutomaton& automaton = *model.automaton();
+    for (const Word& word : WordsThroughEveryTransition(automaton, checked)) {
+      const HybridModel word_model = WordModelAt(model, word);
+      try {
+        CheckConservationAtStart(word_model, options.model, ShootingLayout(word_model), Vector());
+      } catch (const std::invalid_argument& e) {
+        // Named by the transitions that brought the word in: those no start's word takes.
+        std::string transitions;
+        for (const int k : TransitionsOf(word)) {
+          const bool taken = std::any_of(checked.begin(), checked.end(), [k](const Word& w) {
+            return std::find(w.begin(), w.end(), k) != w.end();
+          });
+          if (!taken) transitions += (transitions.empty() ? "'" : ", '") + automaton.transitions()[k].name + "'";
+        }
+        throw std::invalid_argument("transition " + transitions + ", which a change of the phase sequence may take " +
+                                    "(checked on the word " + automaton.WordName(word) + "): " + e.what());
+      }
+    }
+  }
+  // The ordinary run's start, checked (a guess corrected) before anything is written: a start that is not an
+  // orbit is an error of the model's input, said per part of the cycle that does not close.
+  if (p.setup.free.empty() && model.num_first_integrals() > 0 && !options.restart) {
+    std::string why;
+    if (!p.exploration->PrepareStart(&why)) {
+      SourceLocation where = model.setup().start.where;
+      if (where.field.empty()) where.field = "start";
+      throw ModelInputError(where, why);
+    }
+  }
+  return p;
+}
+
+}  // namespace
+}  // namespace hybridcont::study
+
+namespace hybridcont {
+
+std::string Version() { return HYBRIDCONT_VERSION; }
+
+namespace {
+std::string FieldText(const std::string& field, int index) {
+  return index >= 0 ? field + "[" + std::to_string(index) + "]" : field;
+}
+}  // namespace
+
+StudyOptionError::StudyOptionError(std::string field, int index, const std::string& message)
+    : std::invalid_argument(FieldText(field, index) + " " + message), field_(std::move(field)), index_(index),
+      detail_(message) {}
+
+const StudySpecialPoint* StudyResult::FindSpecialPoint(const std::string& label) const {
+  for (const StudySpecialPoint& p : special_points) {
+    if (p.Label() == label) return &p;
+  }
+  return nullptr;
+}
+
+const StudyBranch& StudyResult::branch(int id) const {
+  if (id < 0 || id >= static_cast<int>(branches.size())) {
+    throw std::out_of_range("StudyResult::branch(" + std::to_string(id) + "): the study has " +
+                            std::to_string(branches.size()) + " branches");
+  }
+  return branches[id];
+}
+
+std::vector<std::string> CheckStudyOptions(const StudyOptions& options) {
+  const study::PreparedStudy p = study::Prepare(options, {});
+  return p.setup.notes;
+}
+
+StudyResult RunStudy(const StudyOptions& options, const StudyHooks& hooks) {
+  using namespace study;
+  PreparedStudy p = Prepare(options, hooks);
+  const HybridModel& model = *p.model;
+  for (const std::string& note : p.setup.notes) {
+    if (hooks.on_note) hooks.on_note(note);
+  }
+  const nlohmann::json options_json = OptionsJson(options, p.setup);
+  const std::filesystem::path dir = options.out_dir;
+  if (!dir.empty()) ResultsWriter::PrepareDirectory(dir, model.name(), options.overwrite);
+  ResultsWriter writer(dir, model, options_json, p.setup.free, &hooks);
+  StudyResult result;
+  try {
+    Compute(options, hooks, model, p.setup, *p.exploration, writer, &result);
+  } catch (const std::exception& e) {
+    // The folder must not look complete: the summary says "failed" (or, if it cannot be written, the last
+    // one written says "running").
+    writer.Fail(e.what());
+    throw;
+  }
+  if (!writer.Finish()) writer.Fail(writer.write_error());  // a full disk: the folder is marked incomplete
+  StudyResult typed = ResultFromSummary(writer.summary(), writer.points());
+  typed.status = result.status;
+  typed.message = result.message;
+  typed.report = result.report;
+  typed.work = result.work;
+  typed.orbits = writer.orbits();
+  typed.write_error = writer.write_error();
+  return typed;
+}
+
+}  // namespace hybridcont

@@ -1,0 +1,53 @@
+#include "hybridcont/study.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <set>
+#include <stdexcept>
+
+#include "hybridcont/model_file.h"
+#include "hybridcont/models.h"
+
+namespace hybridcont {
+
+HybridModel MakeStudyModel(const std::string& name, const std::vector<NamedValue>& parameters,
+                           const std::string& models_directory_text, std::ostream* log, bool compile) {
+  const std::filesystem::path models_directory = models_directory_text;
+  HybridModel model = [&] {
+    if (!IsModelFilePath(name)) return MakeBuiltinModel(name);
+    ModelFileOptions options;
+    options.log = log;
+    options.compile = compile;
+    // A relative path that does not exist here names one of the shipped models: `hybridcont run
+    // stiffening-slip.toml` finds <models folder>/stiffening-slip.toml of this installation.
+    std::filesystem::path path = name;
+    std::error_code ec;
+    if (path.is_relative() && !std::filesystem::exists(path, ec)) {
+      const std::filesystem::path shipped = models_directory / path.filename();
+      if (!models_directory.empty() && std::filesystem::exists(shipped, ec)) path = shipped;
+    }
+    return LoadModelFile(path, options);
+  }();
+  std::set<std::string> assigned;
+  for (std::size_t i = 0; i < parameters.size(); ++i) {
+    const NamedValue& p = parameters[i];
+    const std::string text = fmt::format("'{}={:g}'", p.name, p.value);
+    if (!assigned.insert(p.name).second) {
+      throw StudyOptionError("parameters", static_cast<int>(i), text + ": '" + p.name + "' is given twice");
+    }
+    try {
+      model.SetParameter(p.name, p.value);
+    } catch (const ModelInputError&) {
+      throw;
+    } catch (const std::invalid_argument& e) {
+      throw StudyOptionError("parameters", static_cast<int>(i), text + ": " + e.what());
+    }
+  }
+  return model;
+}
+
+}  // namespace hybridcont
