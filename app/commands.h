@@ -43,6 +43,7 @@ struct RunArguments {
   bool overwrite = false;              // replace another model's results in --out (refused otherwise)
   bool one_word = false;               // an automaton: follow the start's word only (no phase-sequence changes)
   bool period_doubling = false;        // explore the period-doubled family of every located PD point
+  bool resume = false;                 // continue the study interrupted in --out
   std::string free;                    // a model parameter continued as an unknown (needs `fix`)
   std::string fix;                     // NAME=VALUE: the unknown held fixed while `free` varies, e.g. H=1.5
   std::string curves;                  // a model parameter: trace special points in (H, it) after the run

@@ -32,6 +32,8 @@ HybridModel MakeModelWithOverrides(const std::string& name, const std::vector<st
 
 // The command-line flag of a StudyOptions field ("until" -> "--until").
 std::string FlagOf(const std::string& field);
+// A study's message in the command line's words: fields as flags ("bounds[0] " -> "--bound ").
+std::string CommandLineWords(std::string text);
 // A study's refusal as the command line says it: the flag and the value ("--until 'H=5': ...").
 std::invalid_argument CommandLineError(const StudyOptionError& e);
 

@@ -66,6 +66,9 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
   run->add_flag("--one-word", args->one_word,
                 "a model given as an automaton: follow the start's phase sequence only, not the words its families "
                 "lead into where a phase vanishes or a competing guard is touched");
+  run->add_flag("--resume", args->resume,
+                "continue the run interrupted in --out (killed, stopped, out of disk): the branches it traced are "
+                "taken as they are, the rest computed; the options must be those of that run");
   run->add_flag("--quiet", args->quiet, "no progress lines");
   run->add_flag("--no-plots", args->no_plots, "do not draw figures");
 }
@@ -119,13 +122,14 @@ StudyOptions StudyOptionsOf(const RunArguments& args) {
   o.curves = args.curves;
   o.out_dir = args.out_dir;
   o.overwrite = args.overwrite;
+  o.resume = args.resume;
   return o;
 }
 
 // Progress on `out`: a line per branch and per accepted point, and what each stage begins with.
 StudyHooks PrintingHooks(const RunArguments& args, std::ostream& out, std::ostream& err) {
   StudyHooks hooks;
-  hooks.on_note = [&err](const std::string& line) { err << "note: " << line << "\n"; };
+  hooks.on_note = [&err](const std::string& line) { err << "note: " << CommandLineWords(line) << "\n"; };
   if (args.quiet) return hooks;
   auto current = std::make_shared<int>(-1);
   hooks.on_point = [&out, current](const StudyPoint& p, const StudyBranch& b) {

@@ -32,6 +32,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -84,6 +85,14 @@ struct ExplorationOptions {
   // the exploring thread; must depend on (u, v) only. Example: the parent family traversed twice, in the
   // exploration of a period-doubled family (period_doubling.h). Empty: none.
   std::function<bool(const Vector& u, const Vector& v)> known_ray;
+  // Half-branches this exploration traced before (an exploration resumed after an interruption): asked with
+  // the id the next half-branch gets; a branch returned is taken as its trace (no integration; its points are
+  // reported as if traced). It must be the branch given to on_branch under that id by an exploration of the
+  // same problem with the same options: the diagram is then that of an uninterrupted exploration. Called on
+  // the exploring thread.
+  std::function<std::optional<Branch>(int id)> recorded_branch;
+  // Each branch as it is merged into the diagram, in the serial order, on the exploring thread.
+  std::function<void(const Branch& branch)> on_branch;
 
   std::string Validate() const;
 };

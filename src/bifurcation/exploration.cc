@@ -263,6 +263,7 @@ void Explorer::Trace(HalfBranch* half, int parent, int depth) {
     registry_.AddRay(parent, -branch.points.back().tangent);  // it returns to the point from this side
   }
   branches_.push_back(std::move(branch));
+  if (options_.on_branch) options_.on_branch(branches_.back());
   // A half-branch with a parent starts at that special point, singular (also where it is a mapped image).
   if (parent >= 0 && !half->progress.empty() && half->progress.front().point_index == 0) {
     half->progress.front().at_singular_point = true;
@@ -275,10 +276,18 @@ void Explorer::Trace(HalfBranch* half, int parent, int depth) {
   }
 }
 
-// The half-branch as the serial search traces it as branch `id`: the image of a merged branch, else
-// traced now (serially, or not handed to a worker), else its worker's result.
+// The half-branch as the serial search traces it as branch `id`: recorded by an earlier exploration, else the
+// image of a merged branch, else traced now (serially, or not handed to a worker), else its worker's result.
 Branch Explorer::Traced(HalfBranch* half, int id) {
   Unreserve(half);
+  if (options_.recorded_branch) {
+    if (std::optional<Branch> recorded = options_.recorded_branch(id)) {
+      Recall(half, /*wait=*/true);  // traced ahead for nothing
+      half->progress.clear();
+      if (options_.continuation.progress) images_.ReportImage(*recorded, &half->progress);
+      return std::move(*recorded);
+    }
+  }
   if (std::optional<Branch> image = images_.Image(*half, id, branches_, evaluator_, &diagram_.warnings)) {
     Recall(half, /*wait=*/true);  // traced ahead for nothing
     half->progress.clear();

@@ -312,6 +312,11 @@ ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point
       on_point(numbered, scaled_->FromScaled(v));
     };
   }
+  if (store_ != nullptr) {
+    const int offset = store_offset_ + branch_offset;
+    options.recorded_branch = [store = store_, offset](int id) { return store->Lookup(offset + id); };
+    options.on_branch = [store = store_, offset](const Branch& b) { store->Save(offset + b.id, b); };
+  }
   return options;
 }
 

@@ -18,6 +18,7 @@
 #include "hybridcont/statebased_shooting.h"
 #include "hybridcont/timebased_shooting.h"
 #include "hybridcont/study.h"
+#include "resume_store.h"
 #include "scenario.h"
 
 namespace hybridcont::study {
@@ -60,6 +61,11 @@ class ModelExploration {
   // guess (StartSpec::Kind::kGuess) is first corrected by Newton at its H; if that fails the diagram's
   // status is kStartFailed with the corrector's message.
   BifurcationDiagram Run(const PointCallback& on_point = PointCallback());
+
+  // Branches of an interrupted study (resume_store.h): each exploration of this object takes the branches
+  // `store` holds under their ids in the study (this exploration's ids plus `offset`) instead of tracing them,
+  // and stores the branches it merges. Null: none.
+  void set_branch_store(ResumeStore* store, int offset = 0) { store_ = store, store_offset_ = offset; }
 
   // Asked before every step of every branch and before launching one (ContinuationOptions::cancel): true
   // ends the exploration with the branches traced so far (status kCancelled).
@@ -132,6 +138,8 @@ class ModelExploration {
   bool start_prepared_ = false;
   Vector prepared_start_;        // the time-based start (model units), a guess corrected
   std::string start_report_;
+  ResumeStore* store_ = nullptr;
+  int store_offset_ = 0;
 };
 
 }  // namespace hybridcont::study

@@ -80,6 +80,7 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
     const int offset = next_branch;
     FamilyLog log;
     ModelExploration exploration(doubled, scenario, setup.integrator, options, Formulation::kTimeBased, setup.free);
+    exploration.set_branch_store(writer.resume_store(), offset);
     BifurcationDiagram d = exploration.RunPeriodDoubled(parent, u_pd, [&](const ProgressInfo& info, const Vector& u) {
       const int id = info.branch_id + offset;
       if (log.H.find(id) == log.H.end()) writer.SetBranchModel(id, doubled, "period-doubled");

@@ -43,6 +43,7 @@
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/study.h"
+#include "resume_store.h"
 
 namespace hybridcont::study {
 
@@ -140,6 +141,10 @@ class ResultsWriter {
 
   const std::filesystem::path& dir() const { return dir_; }
   bool writes_files() const { return !dir_.empty(); }
+  // Where the explorations of the study keep their branches for a resume (resume_store.h); null without a
+  // folder.
+  ResumeStore* resume_store() const { return resume_store_; }
+  void set_resume_store(ResumeStore* store) { resume_store_ = store; }
   // The summary document so far.
   const nlohmann::json& summary() const { return summary_; }
   // The analysed points of every branch so far, by branch id.
@@ -169,6 +174,7 @@ class ResultsWriter {
   std::map<int, std::vector<StudyPoint>> points_;
   std::vector<StudyOrbit> orbits_;
   const StudyHooks* hooks_ = nullptr;
+  ResumeStore* resume_store_ = nullptr;
   std::map<int, std::ofstream> branch_files_;
   std::map<int, int> points_per_branch_;
   std::map<int, std::uintmax_t> branch_bytes_;  // bytes of each branch file written in full (whole rows)

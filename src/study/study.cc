@@ -8,11 +8,14 @@
 // point), summary_json.h (options and special points in the document), period_doubled_families.h,
 // word_families.h, parameter_curves.h, family_report.h.
 #include <fmt/format.h>
+#include <openssl/evp.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -22,6 +25,7 @@
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/conservation_check.h"
 #include "hybridcont/exploration.h"
+#include "hybridcont/model_file.h"
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/study.h"
@@ -346,6 +350,66 @@ void CheckConservationAtStart(const HybridModel& model, const std::string& argum
 }
 
 
+// SHA-256 of a file's bytes as hex; empty when it cannot be read.
+std::string FileDigest(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return "";
+  const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int size = 0;
+  if (EVP_Digest(bytes.data(), bytes.size(), digest, &size, EVP_sha256(), nullptr) != 1) return "";
+  std::string hex;
+  for (unsigned int i = 0; i < size; ++i) hex += fmt::format("{:02x}", digest[i]);
+  return hex;
+}
+
+// The model file a study reads (as MakeStudyModel finds it).
+std::string ModelFilePath(const StudyOptions& o) {
+  std::error_code ec;
+  const std::filesystem::path path = o.model;
+  if (path.is_relative() && !std::filesystem::exists(path, ec) && !o.models_directory.empty()) {
+    return (std::filesystem::path(o.models_directory) / path.filename()).string();
+  }
+  return o.model;
+}
+
+// The options that decide a study's results, with the model's parameter values and, for a model file, the
+// digest of its text: a resumed study must have the same (threads, the folder and how it is written do not
+// change the results).
+nlohmann::json ResultOptionsJson(const StudyOptions& o, const HybridModel& model) {
+  const auto values = [](const std::vector<NamedValue>& list) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const NamedValue& v : list) a.push_back({v.name, v.value});
+    return a;
+  };
+  nlohmann::json bounds = nlohmann::json::array();
+  for (const NamedInterval& b : o.bounds) {
+    bounds.push_back({b.name, std::isfinite(b.lower) ? nlohmann::json(b.lower) : nlohmann::json(nullptr),
+                      std::isfinite(b.upper) ? nlohmann::json(b.upper) : nlohmann::json(nullptr)});
+  }
+  nlohmann::json parameters = nlohmann::json::object();
+  for (const ParameterInfo& info : model.parameters()) parameters[info.name] = model.parameter(info.name);
+  nlohmann::json j = {{"model", o.model},
+                      {"model_name", model.name()},
+                      {"model_text_sha256", IsModelFilePath(o.model) ? FileDigest(ModelFilePath(o)) : ""},
+                      {"parameters", parameters},
+                      {"until", values(o.until)},
+                      {"bounds", bounds},
+                      {"monitors", values(o.monitors)},
+                      {"rtol", o.rtol ? nlohmann::json(*o.rtol) : nlohmann::json(nullptr)},
+                      {"atol", o.atol ? nlohmann::json(*o.atol) : nlohmann::json(nullptr)},
+                      {"max_branches", o.max_branches ? nlohmann::json(*o.max_branches) : nlohmann::json(nullptr)},
+                      {"formulation", ToString(o.formulation)},
+                      {"use_symmetries", o.use_symmetries},
+                      {"follow_word_changes", o.follow_word_changes},
+                      {"period_doubling", o.period_doubling},
+                      {"free", o.free},
+                      {"fix", o.fix ? nlohmann::json({o.fix->name, o.fix->value}) : nlohmann::json(nullptr)},
+                      {"curves", o.curves}};
+  if (o.restart) j["restart"] = {o.restart->from, o.restart->label, ToString(o.restart->kind)};
+  return j;
+}
+
 // A stream whose every line goes to the hooks' on_note (a model file's compile notes as they are said).
 class NoteBuffer : public std::stringbuf {
  public:
@@ -354,7 +418,9 @@ class NoteBuffer : public std::stringbuf {
     std::string text = str();
     std::size_t end;
     while ((end = text.find('\n')) != std::string::npos) {
-      if (hooks_.on_note) hooks_.on_note(text.substr(0, end));
+      std::string line = text.substr(0, end);
+      if (line.rfind("note: ", 0) == 0) line.erase(0, 6);
+      if (hooks_.on_note) hooks_.on_note(line);
       text.erase(0, end + 1);
     }
     str(text);
@@ -388,7 +454,7 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks) {
     throw StudyOptionError("monitors", -1, "needs the time-based formulation");
   }
   if (!options.free.empty() && options.period_doubling) {
-    throw StudyOptionError("period_doubling", -1, "not with a free parameter (free '" + options.free + "')");
+    throw StudyOptionError("period_doubling", -1, ": not with a free parameter (free '" + options.free + "')");
   }
   p.setup = MakeRunSetup(options, model);
   p.exploration = MakeExploration(options, model, p.setup);
@@ -442,6 +508,18 @@ namespace hybridcont {
 
 std::string Version() { return HYBRIDCONT_VERSION; }
 
+std::string ToString(RestartSpec::Kind kind) {
+  switch (kind) {
+    case RestartSpec::Kind::kAuto: return "auto";
+    case RestartSpec::Kind::kContinue: return "continue";
+    case RestartSpec::Kind::kSwitch: return "switch";
+    case RestartSpec::Kind::kPeriodDoubled: return "period-doubled";
+    case RestartSpec::Kind::kCurve: return "curve";
+    case RestartSpec::Kind::kFree: return "free";
+  }
+  return "?";
+}
+
 namespace {
 std::string FieldText(const std::string& field, int index) {
   return index >= 0 ? field + "[" + std::to_string(index) + "]" : field;
@@ -449,7 +527,8 @@ std::string FieldText(const std::string& field, int index) {
 }  // namespace
 
 StudyOptionError::StudyOptionError(std::string field, int index, const std::string& message)
-    : std::invalid_argument(FieldText(field, index) + " " + message), field_(std::move(field)), index_(index),
+    : std::invalid_argument(FieldText(field, index) + (message.rfind(":", 0) == 0 ? "" : " ") + message),
+      field_(std::move(field)), index_(index),
       detail_(message) {}
 
 const StudySpecialPoint* StudyResult::FindSpecialPoint(const std::string& label) const {
@@ -482,7 +561,18 @@ StudyResult RunStudy(const StudyOptions& options, const StudyHooks& hooks) {
   const nlohmann::json options_json = OptionsJson(options, p.setup);
   const std::filesystem::path dir = options.out_dir;
   if (!dir.empty()) ResultsWriter::PrepareDirectory(dir, model.name(), options.overwrite);
+  // An interrupted study's branches (resume_store.h): checked before anything is written.
+  std::unique_ptr<ResumeStore> store;
+  if (!dir.empty()) {
+    try {
+      store = std::make_unique<ResumeStore>(dir, ResultOptionsJson(options, model), options.resume);
+    } catch (const std::invalid_argument& e) {
+      throw StudyOptionError("resume", -1, e.what());
+    }
+    p.exploration->set_branch_store(store.get());
+  }
   ResultsWriter writer(dir, model, options_json, p.setup.free, &hooks);
+  writer.set_resume_store(store.get());
   StudyResult result;
   try {
     Compute(options, hooks, model, p.setup, *p.exploration, writer, &result);
@@ -493,6 +583,11 @@ StudyResult RunStudy(const StudyOptions& options, const StudyHooks& hooks) {
     throw;
   }
   if (!writer.Finish()) writer.Fail(writer.write_error());  // a full disk: the folder is marked incomplete
+  const bool complete = writer.write_error().empty() && result.status != ExplorationStatus::kCancelled;
+  if (store) {
+    result.work.resumed_branches = store->used();
+    if (complete) store->Complete();  // nothing left to resume
+  }
   StudyResult typed = ResultFromSummary(writer.summary(), writer.points());
   typed.status = result.status;
   typed.message = result.message;

@@ -48,12 +48,6 @@ struct Degeneracy {
 // The first branch id of an explored diagram (renumbered after the run's).
 int FirstId(const BifurcationDiagram& d) { return d.branches.empty() ? -1 : d.branches.front().id; }
 
-std::string Names(const std::vector<std::string>& names) {
-  std::string text;
-  for (const std::string& n : names) text += (text.empty() ? "" : " > ") + n;
-  return text;
-}
-
 // Zero durations of phases 2..m on the physical families of `d`, located with the duration held at 0.
 void ZeroDurations(const HybridModel& model, const BifurcationDiagram& d, const IntegratorOptions& integrator,
                    std::vector<Degeneracy>* out) {
@@ -259,6 +253,7 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
   const auto Explore = [&](int target, const Vector& u) {
     WordEntry& w = words[target];
     const int offset = writer.next_branch_id();
+    w.exploration->set_branch_store(writer.resume_store(), offset);
     TimeBasedShooting floquet_map(*w.model, integrator);
     const ShootingLayout word_layout(*w.model);
     int skipped = 0;

@@ -1,0 +1,288 @@
+#include "resume_store.h"
+
+#include <cerrno>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+
+#include "hybridcont/version.h"
+
+namespace hybridcont::study {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kFormat = 1;
+
+nlohmann::json NumberJson(double x) {
+  if (std::isnan(x)) return "nan";
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  return x;
+}
+
+double NumberFrom(const nlohmann::json& j, const std::string& where) {
+  if (j.is_number()) return j.get<double>();
+  if (j.is_string()) {
+    const std::string s = j.get<std::string>();
+    if (s == "nan") return std::numeric_limits<double>::quiet_NaN();
+    if (s == "inf") return std::numeric_limits<double>::infinity();
+    if (s == "-inf") return -std::numeric_limits<double>::infinity();
+  }
+  throw std::invalid_argument(where + ": expected a number, found " + j.dump());
+}
+
+nlohmann::json VectorJson(const Vector& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(NumberJson(v(i)));
+  return a;
+}
+
+Vector VectorFrom(const nlohmann::json& j, const std::string& where) {
+  if (!j.is_array()) throw std::invalid_argument(where + ": expected a list of numbers");
+  Vector v(static_cast<Eigen::Index>(j.size()));
+  for (std::size_t i = 0; i < j.size(); ++i) v(static_cast<Eigen::Index>(i)) = NumberFrom(j[i], where + "[" + std::to_string(i) + "]");
+  return v;
+}
+
+const nlohmann::json& At(const nlohmann::json& j, const char* key, const std::string& where) {
+  if (!j.is_object() || !j.contains(key)) throw std::invalid_argument(where + "." + key + ": missing");
+  return j.at(key);
+}
+
+int IntFrom(const nlohmann::json& j, const char* key, const std::string& where) {
+  const nlohmann::json& v = At(j, key, where);
+  if (!v.is_number_integer()) throw std::invalid_argument(where + "." + key + ": expected an integer");
+  return v.get<int>();
+}
+
+std::string TextFrom(const nlohmann::json& j, const char* key, const std::string& where) {
+  const nlohmann::json& v = At(j, key, where);
+  if (!v.is_string()) throw std::invalid_argument(where + "." + key + ": expected a string");
+  return v.get<std::string>();
+}
+
+template <typename Enum>
+Enum EnumFrom(const nlohmann::json& j, const char* key, const std::string& where, Enum last) {
+  const int v = IntFrom(j, key, where);
+  if (v < 0 || v > static_cast<int>(last)) throw std::invalid_argument(where + "." + key + ": out of range");
+  return static_cast<Enum>(v);
+}
+
+nlohmann::json SpecialPointJson(const SpecialPoint& p) {
+  return {{"id", p.id},
+          {"type", static_cast<int>(p.type)},
+          {"status", static_cast<int>(p.status)},
+          {"branch_id", p.branch_id},
+          {"index", p.index},
+          {"arclength", NumberJson(p.arclength)},
+          {"component", p.component},
+          {"component_index", p.component_index},
+          {"u", VectorJson(p.u)},
+          {"tangent", VectorJson(p.tangent)},
+          {"tangent_before", VectorJson(p.tangent_before)},
+          {"tangent_after", VectorJson(p.tangent_after)},
+          {"test_value", NumberJson(p.test_value)},
+          {"interval_lo", NumberJson(p.interval_lo)},
+          {"interval_hi", NumberJson(p.interval_hi)},
+          {"interval_width", VectorJson(p.interval_width)},
+          {"residual_norm", NumberJson(p.residual_norm)},
+          {"iterations", p.iterations},
+          {"duplicate_of", p.duplicate_of},
+          {"message", p.message}};
+}
+
+SpecialPoint SpecialPointFrom(const nlohmann::json& j, const std::string& where) {
+  SpecialPoint p;
+  p.id = IntFrom(j, "id", where);
+  p.type = EnumFrom(j, "type", where, SpecialPointType::kKreinCollision);
+  p.status = EnumFrom(j, "status", where, LocationStatus::kBracketed);
+  p.branch_id = IntFrom(j, "branch_id", where);
+  p.index = IntFrom(j, "index", where);
+  p.arclength = NumberFrom(At(j, "arclength", where), where + ".arclength");
+  p.component = TextFrom(j, "component", where);
+  p.component_index = IntFrom(j, "component_index", where);
+  p.u = VectorFrom(At(j, "u", where), where + ".u");
+  p.tangent = VectorFrom(At(j, "tangent", where), where + ".tangent");
+  p.tangent_before = VectorFrom(At(j, "tangent_before", where), where + ".tangent_before");
+  p.tangent_after = VectorFrom(At(j, "tangent_after", where), where + ".tangent_after");
+  p.test_value = NumberFrom(At(j, "test_value", where), where + ".test_value");
+  p.interval_lo = NumberFrom(At(j, "interval_lo", where), where + ".interval_lo");
+  p.interval_hi = NumberFrom(At(j, "interval_hi", where), where + ".interval_hi");
+  p.interval_width = VectorFrom(At(j, "interval_width", where), where + ".interval_width");
+  p.residual_norm = NumberFrom(At(j, "residual_norm", where), where + ".residual_norm");
+  p.iterations = IntFrom(j, "iterations", where);
+  p.duplicate_of = IntFrom(j, "duplicate_of", where);
+  p.message = TextFrom(j, "message", where);
+  return p;
+}
+
+// Writes `text` to `file` whole: a temp file renamed over it.
+bool WriteWhole(const fs::path& file, const std::string& text) {
+  const fs::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream f(tmp);
+    f << text;
+    f.close();
+    if (f.fail()) return false;
+  }
+  std::error_code ec;
+  fs::rename(tmp, file, ec);
+  if (ec) fs::remove(tmp, ec);
+  return !ec;
+}
+
+nlohmann::json ReadJson(const fs::path& file) {
+  std::ifstream f(file);
+  nlohmann::json j = nlohmann::json::parse(f, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded()) throw std::invalid_argument(file.string() + ": not a JSON document");
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json BranchToJson(const Branch& b) {
+  nlohmann::json points = nlohmann::json::array();
+  for (const ContinuationPoint& p : b.points) {
+    points.push_back({{"u", VectorJson(p.u)},
+                      {"tangent", VectorJson(p.tangent)},
+                      {"arclength", NumberJson(p.arclength)},
+                      {"step", NumberJson(p.step)},
+                      {"newton_iterations", p.newton_iterations},
+                      {"contraction", NumberJson(p.contraction)},
+                      {"sb_test", NumberJson(p.sb_test)},
+                      {"test_values", VectorJson(p.test_values)}});
+  }
+  nlohmann::json special = nlohmann::json::array();
+  for (const SpecialPoint& p : b.special_points) special.push_back(SpecialPointJson(p));
+  return {{"id", b.id},
+          {"direction", b.direction},
+          {"parent_special_point", b.parent_special_point},
+          {"depth", b.depth},
+          {"points", points},
+          {"special_points", special},
+          {"termination", static_cast<int>(b.termination)},
+          {"message", b.message},
+          {"newton_iterations", b.newton_iterations},
+          {"rejected_steps", b.rejected_steps},
+          {"located_iterations", b.located_iterations},
+          {"image_of", b.image_of},
+          {"symmetry", b.symmetry},
+          {"reflected_from", b.reflected_from}};
+}
+
+Branch BranchFromJson(const nlohmann::json& j, const std::string& where) {
+  Branch b;
+  b.id = IntFrom(j, "id", where);
+  b.direction = IntFrom(j, "direction", where);
+  b.parent_special_point = IntFrom(j, "parent_special_point", where);
+  b.depth = IntFrom(j, "depth", where);
+  const nlohmann::json& points = At(j, "points", where);
+  if (!points.is_array()) throw std::invalid_argument(where + ".points: expected a list");
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const std::string at = where + ".points[" + std::to_string(i) + "]";
+    const nlohmann::json& q = points[i];
+    ContinuationPoint p;
+    p.u = VectorFrom(At(q, "u", at), at + ".u");
+    p.tangent = VectorFrom(At(q, "tangent", at), at + ".tangent");
+    p.arclength = NumberFrom(At(q, "arclength", at), at + ".arclength");
+    p.step = NumberFrom(At(q, "step", at), at + ".step");
+    p.newton_iterations = IntFrom(q, "newton_iterations", at);
+    p.contraction = NumberFrom(At(q, "contraction", at), at + ".contraction");
+    p.sb_test = NumberFrom(At(q, "sb_test", at), at + ".sb_test");
+    p.test_values = VectorFrom(At(q, "test_values", at), at + ".test_values");
+    if (!b.points.empty() && (p.u.size() != b.points.front().u.size() || p.tangent.size() != p.u.size())) {
+      throw std::invalid_argument(at + ": its size differs from the branch's first point");
+    }
+    b.points.push_back(std::move(p));
+  }
+  const nlohmann::json& special = At(j, "special_points", where);
+  if (!special.is_array()) throw std::invalid_argument(where + ".special_points: expected a list");
+  for (std::size_t i = 0; i < special.size(); ++i) {
+    b.special_points.push_back(SpecialPointFrom(special[i], where + ".special_points[" + std::to_string(i) + "]"));
+  }
+  b.termination = EnumFrom(j, "termination", where, TerminationReason::kStartFailed);
+  b.message = TextFrom(j, "message", where);
+  b.newton_iterations = IntFrom(j, "newton_iterations", where);
+  b.rejected_steps = IntFrom(j, "rejected_steps", where);
+  b.located_iterations = IntFrom(j, "located_iterations", where);
+  b.image_of = IntFrom(j, "image_of", where);
+  b.symmetry = TextFrom(j, "symmetry", where);
+  b.reflected_from = IntFrom(j, "reflected_from", where);
+  if (b.reflected_from >= static_cast<int>(b.points.size())) {
+    throw std::invalid_argument(where + ".reflected_from: beyond the branch's points");
+  }
+  return b;
+}
+
+ResumeStore::ResumeStore(const fs::path& dir, const nlohmann::json& options, bool resume) : dir_(dir / ".resume") {
+  std::error_code ec;
+  const fs::path study = dir_ / "study.json";
+  if (resume && fs::exists(study, ec)) {
+    const nlohmann::json saved = ReadJson(study);
+    const bool same_format = saved.is_object() && saved.value("format", 0) == kFormat &&
+                             saved.value("version", std::string()) == HYBRIDCONT_VERSION;
+    if (same_format) {
+      const nlohmann::json& old = saved.contains("options") ? saved["options"] : nlohmann::json();
+      if (old != options) {
+        std::string differs = "its options";
+        if (old.is_object()) {
+          for (const auto& [key, value] : options.items()) {
+            if (!old.contains(key) || old[key] != value) {
+              differs = "'" + key + "' (" + (old.contains(key) ? old[key].dump() : "unset") + " there, " +
+                        value.dump() + " now)";
+              break;
+            }
+          }
+        }
+        throw std::invalid_argument("'" + dir.string() + "' holds a study with other options: " + differs +
+                                    "; resume it with the options it was run with, or run afresh without resume");
+      }
+      for (const auto& entry : fs::directory_iterator(dir_, ec)) {
+        const std::string name = entry.path().filename().string();
+        if (name.rfind("branch-", 0) != 0 || entry.path().extension() != ".json") continue;
+        const nlohmann::json j = ReadJson(entry.path());
+        if (!j.is_object() || j.value("format", 0) != kFormat || !j.contains("branch")) {
+          throw std::invalid_argument(entry.path().string() + ": not a stored branch of format " + std::to_string(kFormat));
+        }
+        int id = -1;
+        try {
+          id = std::stoi(name.substr(7));
+        } catch (const std::exception&) {
+          throw std::invalid_argument(entry.path().string() + ": the file name gives no branch id");
+        }
+        if (id < 0) throw std::invalid_argument(entry.path().string() + ": the file name gives no branch id");
+        loaded_.emplace(id, BranchFromJson(j["branch"], entry.path().string() + ": branch"));
+      }
+    }
+  }
+  if (!resume || loaded_.empty()) {
+    fs::remove_all(dir_, ec);
+    loaded_.clear();
+  }
+  fs::create_directories(dir_, ec);
+  WriteWhole(study, nlohmann::json{{"format", kFormat}, {"version", HYBRIDCONT_VERSION}, {"options", options}}.dump());
+}
+
+std::optional<Branch> ResumeStore::Lookup(int id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = loaded_.find(id);
+  if (it == loaded_.end()) return std::nullopt;
+  ++used_;
+  return it->second;
+}
+
+void ResumeStore::Save(int id, const Branch& branch) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (loaded_.count(id)) return;  // stored already
+  WriteWhole(dir_ / ("branch-" + std::to_string(id) + ".json"),
+             nlohmann::json{{"format", kFormat}, {"branch", BranchToJson(branch)}}.dump());
+}
+
+void ResumeStore::Complete() {
+  std::error_code ec;
+  fs::remove_all(dir_, ec);
+}
+
+}  // namespace hybridcont::study
