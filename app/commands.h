@@ -44,6 +44,9 @@ struct RunArguments {
   bool one_word = false;               // an automaton: follow the start's word only (no phase-sequence changes)
   bool period_doubling = false;        // explore the period-doubled family of every located PD point
   bool resume = false;                 // continue the study interrupted in --out
+  std::string from;                    // a saved study (results folder) to restart from, at label `at`
+  std::string at;                      // "PD4", "SB36", "B5", "B5:12"
+  std::string as = "auto";             // what to do there: continue, switch, period-doubled, curve, free
   std::string free;                    // a model parameter continued as an unknown (needs `fix`)
   std::string fix;                     // NAME=VALUE: the unknown held fixed while `free` varies, e.g. H=1.5
   std::string curves;                  // a model parameter: trace special points in (H, it) after the run

@@ -66,6 +66,16 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
   run->add_flag("--one-word", args->one_word,
                 "a model given as an automaton: follow the start's phase sequence only, not the words its families "
                 "lead into where a phase vanishes or a competing guard is touched");
+  NonEmpty(run->add_option("--from", args->from,
+                           "restart from a saved study (a results folder) at the point --at names, instead of the "
+                           "model's start; the new families go to --out"));
+  NonEmpty(run->add_option("--at", args->at,
+                           "with --from: a special point's label (PD4, SB36, TP22: its type and id in that study), "
+                           "a branch's end (B5) or one of its points (B5:12)"));
+  NonEmpty(run->add_option("--as", args->as,
+                           "with --from: continue (the family beyond the point), switch (every branch through an SB "
+                           "point), period-doubled (the family born at a PD point), curve (the point in (H, --curves)), "
+                           "free (the family in --free from the orbit); default: what the label's type implies"));
   run->add_flag("--resume", args->resume,
                 "continue the run interrupted in --out (killed, stopped, out of disk): the branches it traced are "
                 "taken as they are, the rest computed; the options must be those of that run");
@@ -123,6 +133,25 @@ StudyOptions StudyOptionsOf(const RunArguments& args) {
   o.out_dir = args.out_dir;
   o.overwrite = args.overwrite;
   o.resume = args.resume;
+  if (args.from.empty() != args.at.empty()) {
+    throw std::invalid_argument(args.from.empty() ? "--at '" + args.at + "': needs --from FOLDER (a saved study)"
+                                                  : "--from '" + args.from + "': needs --at LABEL (e.g. PD4, B5)");
+  }
+  if (!args.from.empty()) {
+    RestartSpec r{args.from, args.at, RestartSpec::Kind::kAuto};
+    bool known = false;
+    for (const RestartSpec::Kind k : {RestartSpec::Kind::kAuto, RestartSpec::Kind::kContinue, RestartSpec::Kind::kSwitch,
+                                      RestartSpec::Kind::kPeriodDoubled, RestartSpec::Kind::kCurve,
+                                      RestartSpec::Kind::kFree}) {
+      if (ToString(k) == args.as) r.kind = k, known = true;
+    }
+    if (!known) {
+      throw std::invalid_argument("--as '" + args.as + "': expected continue, switch, period-doubled, curve or free");
+    }
+    o.restart = r;
+  } else if (args.as != "auto") {
+    throw std::invalid_argument("--as '" + args.as + "': needs --from FOLDER --at LABEL");
+  }
   return o;
 }
 

@@ -430,18 +430,21 @@ def axis_label_of(names):
     return ", ".join(names)
 
 
-def special_point_style(kind, bracketed):
+def special_point_style(kind, bracketed, meanings=None):
+    """Marker of a special point; its legend name is the code and its meaning as summary.json's
+    "special_point_codes" gives it (the library's one definition of the codes)."""
     styles = {
-        "SB": dict(marker="o", s=42, facecolor="black", edgecolor="black", name="SB simple bifurcation"),
-        "TP": dict(marker="o", s=46, facecolor="white", edgecolor="black", name="TP turning point"),
-        "BP": dict(marker="s", s=40, facecolor="black", edgecolor="black", name="BP branch point"),
-        "PD": dict(marker="D", s=38, facecolor="#d62728", edgecolor="black", name="PD period doubling"),
-        "GR": dict(marker="v", s=46, facecolor="#17becf", edgecolor="black", name="GR grazing"),
-        "NS": dict(marker="h", s=48, facecolor="#9467bd", edgecolor="black", name="NS Neimark-Sacker"),
-        "start": dict(marker="*", s=120, facecolor="gold", edgecolor="black", name="start point"),
+        "SB": dict(marker="o", s=42, facecolor="black", edgecolor="black"),
+        "TP": dict(marker="o", s=46, facecolor="white", edgecolor="black"),
+        "BP": dict(marker="s", s=40, facecolor="black", edgecolor="black"),
+        "PD": dict(marker="D", s=38, facecolor="#d62728", edgecolor="black"),
+        "GR": dict(marker="v", s=46, facecolor="#17becf", edgecolor="black"),
+        "NS": dict(marker="h", s=48, facecolor="#9467bd", edgecolor="black"),
+        "start": dict(marker="*", s=120, facecolor="gold", edgecolor="black"),
     }
-    style = dict(styles.get(kind, dict(marker="X", s=46, facecolor="#9467bd", edgecolor="black",
-                                       name=str(kind))))
+    style = dict(styles.get(kind, dict(marker="X", s=46, facecolor="#9467bd", edgecolor="black")))
+    meaning = meanings.get(kind) if isinstance(meanings, dict) else None
+    style["name"] = "%s %s" % (kind, meaning) if isinstance(meaning, str) and meaning else str(kind)
     style["linewidth"] = 1.0
     if bracketed:
         style["edgecolor"] = "0.55"
@@ -651,7 +654,8 @@ def draw_special_points(ax, res, xname, yname, zname=None, annotate=True, only=N
         z = res.sp_value(sp, zname) if zname else 0.0
         if not finite(x, y, z):
             continue
-        style = special_point_style(kind, str(sp.get("status", "located")) != "located")
+        style = special_point_style(kind, str(sp.get("status", "located")) != "located",
+                                    res.summary.get("special_point_codes"))
         kw = dict(marker=style["marker"], s=style["s"], facecolors=style["facecolor"],
                   edgecolors=style["edgecolor"], linewidths=style["linewidth"], zorder=6)
         if zname:

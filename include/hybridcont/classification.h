@@ -38,6 +38,8 @@ enum class OrbitClass {
 };
 // Short hyphenated words used in the CSV files ("physical", "reversed-time", ...).
 std::string ToString(OrbitClass c);
+// The class of its word; false for anything else.
+bool FromString(const std::string& text, OrbitClass* c);
 
 struct ClassificationOptions {
   // |xi| above this is dissipative. Newton leaves |xi| ~ 1e-12 on orbits; branches at rest have |xi| ~ 1.

@@ -91,7 +91,11 @@ struct ExplorationOptions {
   // same problem with the same options: the diagram is then that of an uninterrupted exploration. Called on
   // the exploring thread.
   std::function<std::optional<Branch>(int id)> recorded_branch;
-  // Each branch as it is merged into the diagram, in the serial order, on the exploring thread.
+  // A regular start traces the direction of its given tangent only (a branch continued from its end, whose
+  // other side is known): Explore(problem, u0, tangent, options).
+  bool one_way_start = false;
+  // Each branch as it is merged into the diagram, in the serial order, on the exploring thread; not a branch
+  // merged while ContinuationOptions::cancel says true (it may have been cut short).
   std::function<void(const Branch& branch)> on_branch;
 
   std::string Validate() const;

@@ -32,6 +32,8 @@ constexpr internal::EnumName<OrbitClass> kOrbitClassNames[] = {
 
 std::string ToString(OrbitClass c) { return internal::EnumToString(kOrbitClassNames, c); }
 
+bool FromString(const std::string& text, OrbitClass* c) { return internal::EnumFromString(kOrbitClassNames, text, c); }
+
 namespace {
 
 Classification NonPhysical(OrbitClass reason, const std::string& detail) { return {false, reason, detail}; }

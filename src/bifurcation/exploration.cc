@@ -204,6 +204,7 @@ void Explorer::Merge(Group* group) {
 // d = +1, then d = −1 unless the first closed a loop or could not start.
 void Explorer::MergeRegularStart(Group* group) {
   for (const auto& half : group->halves) {
+    if (options_.one_way_start && half->d == -1) break;
     if (!branches_.empty() && (branches_.back().termination == TerminationReason::kClosedLoop ||
                                branches_.back().termination == TerminationReason::kStartFailed)) {
       break;
@@ -263,7 +264,9 @@ void Explorer::Trace(HalfBranch* half, int parent, int depth) {
     registry_.AddRay(parent, -branch.points.back().tangent);  // it returns to the point from this side
   }
   branches_.push_back(std::move(branch));
-  if (options_.on_branch) options_.on_branch(branches_.back());
+  // A branch merged once the exploration is cancelled may have been cut short: it is not handed on.
+  const auto& cancel = options_.continuation.cancel;
+  if (options_.on_branch && !(cancel && cancel())) options_.on_branch(branches_.back());
   // A half-branch with a parent starts at that special point, singular (also where it is a mapped image).
   if (parent >= 0 && !half->progress.empty() && half->progress.front().point_index == 0) {
     half->progress.front().at_singular_point = true;

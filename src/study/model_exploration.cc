@@ -578,6 +578,23 @@ BifurcationDiagram ModelExploration::RunFromStarts(const std::vector<Vector>& st
   return all;
 }
 
+BifurcationDiagram ModelExploration::RunFromPoint(const Vector& u, const Vector& tangent,
+                                                  const PointCallback& on_point) {
+  if (state_) throw std::invalid_argument("a restart from a point: the time-based formulation only");
+  ExplorationOptions options = EngineOptions(on_point);
+  options.one_way_start = true;
+  Vector start = u;
+  if (shooting_.layout().num_observables() > 0 && start.size() != shooting_.num_unknowns()) {
+    start = shooting_.CompleteUnknowns(start);
+  }
+  Vector direction = Vector::Zero(start.size());
+  direction.head(tangent.size()) = tangent;
+  BifurcationDiagram diagram =
+      Explore(scaled_.get(), scaled_->ToScaled(start), scaled_->ToScaled(direction).normalized(), options);
+  ToModelUnits(&diagram);
+  return diagram;
+}
+
 BifurcationDiagram ModelExploration::RunPeriodDoubled(const ShootingLayout& parent, const Vector& u_pd,
                                                       const PointCallback& on_point) {
   if (state_) throw std::invalid_argument("period-doubled families: the time-based formulation only");

@@ -88,6 +88,10 @@ class ModelExploration {
   BifurcationDiagram RunFromStarts(const std::vector<Vector>& starts, const PointCallback& on_point,
                                    int* skipped);
 
+  // The family through the regular point u (model units, time-based) in the direction of `tangent` only (a
+  // branch continued beyond its end), and every branch reachable from it.
+  BifurcationDiagram RunFromPoint(const Vector& u, const Vector& tangent, const PointCallback& on_point);
+
   // The period-doubled family born at the PD point u_pd (model units, the parent's layout `parent`) of the
   // parent of this exploration's model, RepeatedModel(parent, 2) (time-based formulation):
   // ExplorePeriodDoubled on the scaled problem, points reported and returned as by Run.

@@ -99,6 +99,7 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
       hooks_(hooks) {
   summary_["model"] = model.name();
   summary_["version"] = HYBRIDCONT_VERSION;
+  summary_["format"] = kResultsFormat;  // docs/results-format.md
   summary_["description"] = model.description();
   nlohmann::json params = nlohmann::json::object();
   for (const auto& info : model.parameters()) params[info.name] = model.parameter(info.name);
@@ -109,6 +110,14 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
   }
   summary_["phases"] = phases;
   summary_["unknowns"] = layout_.unknown_names();
+  // The special-point codes and what they mean, from their one definition (special_point.h).
+  nlohmann::json codes = nlohmann::json::object();
+  for (int t = 0; t <= static_cast<int>(SpecialPointType::kKreinCollision); ++t) {
+    std::string meaning = ToString(static_cast<SpecialPointType>(t));
+    std::replace(meaning.begin(), meaning.end(), '-', ' ');
+    codes[Code(static_cast<SpecialPointType>(t))] = meaning;
+  }
+  summary_["special_point_codes"] = codes;
   summary_["presentation"] = PresentationJson(model, presentation_, free);
   summary_["options"] = std::move(options);
   summary_["branches"] = nlohmann::json::array();
@@ -273,6 +282,8 @@ void ResultsWriter::EndBranch(const Branch& b) {
   // Its phase sequence: the modes of its word (a cyclic model's phases).
   const auto other = branch_models_.find(b.id);
   entry["word"] = other == branch_models_.end() ? model_.WordModeNames() : other->second.word;
+  // A branch of another layout (another word's, a period-doubled family's) names its unknowns, the order of u.
+  if (other != branch_models_.end()) entry["unknowns"] = other->second.layout.unknown_names();
   if (b.image_of >= 0) {  // mapped, not traced (exploration.h, "Symmetries")
     entry["image_of"] = b.image_of;
     entry["symmetry"] = b.symmetry;

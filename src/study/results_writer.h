@@ -47,6 +47,11 @@
 
 namespace hybridcont::study {
 
+// The version of the results folder's format (summary.json's "format"; docs/results-format.md): 2 adds
+// "format", "exploration", "special_point_codes", "restarted_from" and every branch of another layout's
+// "unknowns" to version 1 (no "format" key), whose folders LoadStudy reads as well.
+inline constexpr int kResultsFormat = 2;
+
 // What is known about one branch point beyond u.
 struct PointRecord {
   int index = 0;

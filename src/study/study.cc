@@ -37,6 +37,7 @@
 #include "parameter_starts.h"
 #include "period_doubled_families.h"
 #include "point_analysis.h"
+#include "restart.h"
 #include "results_writer.h"
 #include "run_setup.h"
 #include "scenario.h"
@@ -239,7 +240,7 @@ std::string RunReport(const BifurcationDiagram& diagram, const std::string& floq
 
 // ---- 2. compute, streaming every accepted point; 3. summary, key-frame orbits, report, figures
 void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridModel& model, const RunSetup& setup,
-             ModelExploration& exploration, ResultsWriter& writer, StudyResult* result) {
+             const RestartPlan* restart, ModelExploration& exploration, ResultsWriter& writer, StudyResult* result) {
   const Formulation formulation = options.formulation;
   const ShootingLayout& layout = exploration.shooting().layout();
   PointStream stream(model, setup, exploration, writer);
@@ -253,7 +254,39 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   const auto say = [&](const std::string& stage, const std::string& text) {
     if (hooks.on_progress) hooks.on_progress({stage, writer.next_branch_id(), 0, text});
   };
-  if (setup.free.empty()) {
+  // A restart's special point, for the stages that start from special points (period-doubled families, curves).
+  BifurcationDiagram restart_points;
+  using Kind = RestartSpec::Kind;
+  if (restart != nullptr) {
+    writer.Annotate("restarted_from", restart->where);
+    starts_report = "Restarted from " + restart->description + " (" + ToString(restart->kind) + ")\n";
+    say("start", starts_report);
+    diagram.unknown_names = layout.unknown_names();
+    int skipped = 0;
+    switch (restart->kind) {
+      case Kind::kContinue:
+        diagram = exploration.RunFromPoint(restart->u, restart->tangent, on_point);
+        break;
+      case Kind::kSwitch:
+        diagram = exploration.RunFromStarts({restart->u}, on_point, &skipped);
+        break;
+      case Kind::kFree: {
+        Vector start(restart->u.size() + layout.num_free_parameters());
+        start.head(restart->u.size()) = restart->u;
+        for (int i = 0; i < layout.num_free_parameters(); ++i) {
+          start(restart->u.size() + i) = model.parameter_value(layout.parameter_model_index(i));
+        }
+        diagram = exploration.RunFromStarts({start}, on_point, &skipped);
+        break;
+      }
+      case Kind::kPeriodDoubled:
+      case Kind::kCurve:
+      case Kind::kAuto:
+        restart_points.unknown_names = layout.unknown_names();
+        restart_points.special_points = {restart->point};
+        break;
+    }
+  } else if (setup.free.empty()) {
     starts_report = exploration.start_report();
     if (!starts_report.empty()) say("start", starts_report);  // how far Newton moved a guess
     diagram = exploration.Run(on_point);
@@ -278,16 +311,20 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
   result->status = diagram.status;
   result->message = diagram.message;
+  writer.Annotate("exploration", {{"status", ToString(diagram.status)}, {"message", diagram.message}});
   if (writer.failed()) return;  // the failed write is the result's write_error
   nlohmann::json special_points = SpecialPointsJson(diagram, layout, &model, setup.integrator);
   const std::string floquet_report = FloquetReport(diagram, layout);
   std::string period_doubled;
+  const bool from_pd = restart != nullptr && restart->kind == Kind::kPeriodDoubled;
+  const bool from_curve = restart != nullptr && restart->kind == Kind::kCurve;
   const std::unique_ptr<HybridModel> doubled =
-      options.period_doubling ? std::make_unique<HybridModel>(RepeatedModel(model, 2)) : nullptr;
+      options.period_doubling || from_pd ? std::make_unique<HybridModel>(RepeatedModel(model, 2)) : nullptr;
   const auto stopped = [&] { return writer.failed() || (hooks.stop_requested && hooks.stop_requested()); };
   if (doubled && !stopped()) {
     say("period-doubled families", "");
-    period_doubled = ExplorePeriodDoubledFamilies(model, *doubled, setup, diagram, &special_points, writer);
+    period_doubled =
+        ExplorePeriodDoubledFamilies(model, *doubled, setup, from_pd ? restart_points : diagram, &special_points, writer);
   }
   std::string words;
   if (options.follow_word_changes && !stopped()) {
@@ -297,7 +334,8 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   std::string curves_report;
   if (!setup.curve_parameter.empty() && !stopped()) {
     say("curves", "");
-    writer.Annotate("curves", TraceParameterCurves(model, setup, diagram, writer.dir(), &curves_report));
+    writer.Annotate("curves", TraceParameterCurves(model, setup, from_curve ? restart_points : diagram, writer.dir(),
+                                                   &curves_report));
   }
   writer.SetSpecialPoints(special_points);
   say("key frames", "");
@@ -551,10 +589,19 @@ std::vector<std::string> CheckStudyOptions(const StudyOptions& options) {
   return p.setup.notes;
 }
 
-StudyResult RunStudy(const StudyOptions& options, const StudyHooks& hooks) {
+StudyResult RunStudy(const StudyOptions& given, const StudyHooks& hooks) {
   using namespace study;
+  StudyOptions options = given;
+  // A restart in a free parameter from an orbit holds its H unless told otherwise.
+  if (options.restart && !options.free.empty() && !options.fix &&
+      (options.restart->kind == RestartSpec::Kind::kAuto || options.restart->kind == RestartSpec::Kind::kFree)) {
+    const double level = RestartLevel(*options.restart);
+    if (std::isfinite(level)) options.fix = NamedValue{"H", level};
+  }
   PreparedStudy p = Prepare(options, hooks);
   const HybridModel& model = *p.model;
+  std::optional<RestartPlan> restart;
+  if (options.restart) restart = PlanRestart(*options.restart, options, model);
   for (const std::string& note : p.setup.notes) {
     if (hooks.on_note) hooks.on_note(note);
   }
@@ -575,7 +622,7 @@ StudyResult RunStudy(const StudyOptions& options, const StudyHooks& hooks) {
   writer.set_resume_store(store.get());
   StudyResult result;
   try {
-    Compute(options, hooks, model, p.setup, *p.exploration, writer, &result);
+    Compute(options, hooks, model, p.setup, restart ? &*restart : nullptr, *p.exploration, writer, &result);
   } catch (const std::exception& e) {
     // The folder must not look complete: the summary says "failed" (or, if it cannot be written, the last
     // one written says "running").

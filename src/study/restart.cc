@@ -1,0 +1,164 @@
+#include "restart.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <regex>
+
+#include "hybridcont/shooting_layout.h"
+
+namespace hybridcont::study {
+
+namespace {
+
+[[noreturn]] void Refuse(const RestartSpec& spec, const std::string& why) {
+  throw StudyOptionError("restart", -1, "'" + spec.from + "' '" + spec.label + "': " + why);
+}
+
+StudyResult Saved(const RestartSpec& spec) {
+  try {
+    return LoadStudy(spec.from);
+  } catch (const std::invalid_argument& e) {
+    Refuse(spec, std::string("not a saved study: ") + e.what());
+  }
+}
+
+// "B5" or "B5:12": the branch and point (-1: its last point); false for another label.
+bool BranchLabel(const std::string& label, int* branch, int* point) {
+  static const std::regex kBranch(R"(B(\d{1,6})(?::(\d{1,7}))?)");
+  std::smatch m;
+  if (!std::regex_match(label, m, kBranch)) return false;
+  *branch = std::stoi(m[1].str());
+  *point = m[2].matched ? std::stoi(m[2].str()) : -1;
+  return true;
+}
+
+}  // namespace
+
+double RestartLevel(const RestartSpec& spec) {
+  const StudyResult saved = Saved(spec);
+  const auto H = std::find(saved.unknown_names.begin(), saved.unknown_names.end(), "H");
+  if (H == saved.unknown_names.end()) return std::nan("");
+  const Eigen::Index h = H - saved.unknown_names.begin();
+  int branch = -1, point = -1;
+  if (BranchLabel(spec.label, &branch, &point)) {
+    if (branch >= static_cast<int>(saved.branches.size()) || saved.branches[branch].points.empty()) return std::nan("");
+    const auto& points = saved.branches[branch].points;
+    const StudyPoint& p = point < 0 || point >= static_cast<int>(points.size()) ? points.back() : points[point];
+    return p.u.size() > h ? p.u(h) : std::nan("");
+  }
+  const StudySpecialPoint* sp = saved.FindSpecialPoint(spec.label);
+  return sp != nullptr && sp->u.size() > h ? sp->u(h) : std::nan("");
+}
+
+RestartPlan PlanRestart(const RestartSpec& spec, const StudyOptions& options, const HybridModel& model) {
+  if (options.formulation != Formulation::kTimeBased) Refuse(spec, "a restart needs the time-based formulation");
+  const StudyResult saved = Saved(spec);
+  if (saved.model != model.name()) {
+    Refuse(spec, "the saved study is of model '" + saved.model + "', not '" + model.name() + "'");
+  }
+  for (const NamedValue& p : saved.parameters) {
+    if (model.FindParameter(p.name) < 0) Refuse(spec, "the saved study's parameter '" + p.name + "' is not the model's");
+    const double here = model.parameter(p.name);
+    if (!(std::abs(here - p.value) <= 1e-12 * std::max(1.0, std::abs(p.value)))) {
+      Refuse(spec, fmt::format("the saved study has {} = {:g}, this study {:g}: its points are orbits at its own values "
+                               "(set them with parameters)", p.name, p.value, here));
+    }
+  }
+  const ShootingLayout layout(model);
+  if (saved.unknown_names != layout.unknown_names()) {
+    Refuse(spec, "the saved study's unknowns are not the model's own layout (a study with a free parameter or "
+                 "observables among the unknowns cannot be restarted from)");
+  }
+  RestartPlan plan;
+  plan.where = {{"folder", spec.from}, {"label", spec.label}};
+  int branch = -1, index = -1;
+  using Kind = RestartSpec::Kind;
+  if (BranchLabel(spec.label, &branch, &index)) {
+    if (branch >= static_cast<int>(saved.branches.size())) {
+      Refuse(spec, fmt::format("the saved study has branches 0 to {}", static_cast<int>(saved.branches.size()) - 1));
+    }
+    const StudyBranch& b = saved.branches[branch];
+    if (b.unknown_names != layout.unknown_names()) {
+      Refuse(spec, "branch " + std::to_string(branch) + " is a family of another layout (" +
+                       (b.origin.empty() ? b.model : b.origin) + "): restart from the model's own families");
+    }
+    if (b.points.size() < 2) Refuse(spec, "branch " + std::to_string(branch) + " has fewer than two points");
+    const int n = static_cast<int>(b.points.size());
+    if (index >= n) Refuse(spec, fmt::format("branch {} has points 0 to {}", branch, n - 1));
+    const int at = index < 0 ? n - 1 : index;
+    plan.kind = spec.kind == Kind::kAuto ? (options.free.empty() ? Kind::kContinue : Kind::kFree) : spec.kind;
+    if (plan.kind != Kind::kContinue && plan.kind != Kind::kFree) {
+      Refuse(spec, "a branch point restarts as 'continue' or 'free', not '" + ToString(plan.kind) + "'");
+    }
+    plan.u = b.points[at].u;
+    // The branch's direction at the point: towards its later points (from its last point: beyond its end).
+    plan.tangent = at + 1 < n ? Vector(b.points[at + 1].u - plan.u) : Vector(plan.u - b.points[at - 1].u);
+    if (!(plan.tangent.norm() > 0)) Refuse(spec, "the branch does not move at that point");
+    plan.where["branch"] = branch;
+    plan.where["point"] = at;
+    plan.description = fmt::format("point {} of branch {} of {}", at, branch, spec.from);
+  } else {
+    const StudySpecialPoint* sp = saved.FindSpecialPoint(spec.label);
+    if (sp == nullptr) {
+      std::string labels;
+      for (const StudySpecialPoint& p : saved.special_points) {
+        if (labels.size() < 200) labels += (labels.empty() ? "" : ", ") + p.Label();
+      }
+      Refuse(spec, "no such label in the saved study (branches B0 ..., points B<branch>:<point>, special points: " +
+                       (labels.empty() ? std::string("none") : labels) + ")");
+    }
+    if (sp->u.size() != layout.num_unknowns() || !sp->u.allFinite()) {
+      Refuse(spec, "the special point is not a point of the model's own layout (a family of another layout's?)");
+    }
+    const auto defaults = [&]() {
+      switch (sp->type) {
+        case SpecialPointType::kPeriodDoubling: return Kind::kPeriodDoubled;
+        case SpecialPointType::kSimpleBifurcation:
+        case SpecialPointType::kFloquetBranchPoint:
+        case SpecialPointType::kSingularStart: return options.curves.empty() ? Kind::kSwitch : Kind::kCurve;
+        case SpecialPointType::kTurningPoint: return options.curves.empty() ? Kind::kContinue : Kind::kCurve;
+        default: return options.free.empty() ? Kind::kContinue : Kind::kFree;
+      }
+    };
+    plan.kind = spec.kind == Kind::kAuto ? defaults() : spec.kind;
+    if (plan.kind == Kind::kPeriodDoubled && sp->type != SpecialPointType::kPeriodDoubling) {
+      Refuse(spec, "a period-doubled family starts at a PD point, not at a " + sp->code + " point");
+    }
+    if (plan.kind == Kind::kCurve && options.curves.empty()) {
+      Refuse(spec, "a curve of the point needs its second parameter (curves)");
+    }
+    if (plan.kind == Kind::kCurve && sp->type != SpecialPointType::kTurningPoint &&
+        sp->type != SpecialPointType::kSimpleBifurcation) {
+      Refuse(spec, "curves continue turning points and SB points, not " + sp->code + " points");
+    }
+    if (plan.kind == Kind::kContinue) {
+      // Along its branch's direction at the point.
+      const StudyBranch& b = saved.branch(sp->branch);
+      const int i = std::clamp(sp->index, 0, static_cast<int>(b.points.size()) - 2);
+      if (b.points.size() < 2) Refuse(spec, "its branch has fewer than two points");
+      plan.tangent = b.points[i + 1].u - b.points[i].u;
+    }
+    plan.u = sp->u;
+    plan.point.id = sp->id;
+    plan.point.type = sp->type;
+    plan.point.status = sp->status == "located" ? LocationStatus::kLocated : LocationStatus::kBracketed;
+    plan.point.branch_id = -1;
+    plan.point.index = sp->index;
+    plan.point.component = sp->component;
+    plan.point.u = sp->u;
+    plan.where["special_point"] = sp->id;
+    plan.description = fmt::format("{} of {}", sp->Label(), spec.from);
+  }
+  plan.where["kind"] = ToString(plan.kind);
+  const auto H = std::find(saved.unknown_names.begin(), saved.unknown_names.end(), "H");
+  if (H != saved.unknown_names.end()) {
+    const double level = plan.u(H - saved.unknown_names.begin());
+    plan.where["H"] = level;
+    plan.description += fmt::format(" (H = {:.12g})", level);
+  }
+  return plan;
+}
+
+}  // namespace hybridcont::study

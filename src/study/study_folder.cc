@@ -1,0 +1,188 @@
+// LoadStudy (study.h): a results folder read back into the typed study. The folder is untrusted input: its
+// summary.json and every branch file are checked, and an error names the file, the line and the field.
+//
+// Precision: u is written with 17 significant digits and read back exactly; the analysis columns
+// (multipliers, replay errors, test functions) with 10 and the residual with 4 (docs/results-format.md), so
+// a loaded analysis equals the computed one to that many digits. Key-frame orbits are listed (branch, point,
+// family, H, T) without their samples, which stay in orbit-<k>.csv.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "hybridcont/study.h"
+#include "results_writer.h"
+#include "study_document.h"
+
+namespace hybridcont {
+
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::vector<std::string> SplitRow(const std::string& line) {
+  std::vector<std::string> fields;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    fields.push_back(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return fields;
+}
+
+// A number of a CSV field: empty is NaN (undefined for this point), "nan" too.
+double Field(const std::string& text, const std::string& where) {
+  if (text.empty() || text == "nan" || text == "-nan") return kNaN;
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || used == 0) throw std::invalid_argument(where + ": '" + text + "' is not a number");
+  return value;
+}
+
+// The analysed points of one branch file.
+std::vector<StudyPoint> ReadBranchFile(const fs::path& file, const std::vector<std::string>& unknowns,
+                                       const std::vector<std::string>& observables) {
+  std::ifstream f(file);
+  if (!f) throw std::invalid_argument(file.string() + ": cannot be read");
+  std::string line;
+  if (!std::getline(f, line)) throw std::invalid_argument(file.string() + ": empty (no header)");
+  const std::vector<std::string> header = SplitRow(line);
+  std::map<std::string, std::size_t> first, last;
+  for (std::size_t i = 0; i < header.size(); ++i) first.emplace(header[i], i), last[header[i]] = i;
+  const auto column = [&](const std::string& name) {
+    const auto it = first.find(name);
+    if (it == first.end()) throw std::invalid_argument(file.string() + ": line 1: no column '" + name + "'");
+    return it->second;
+  };
+  std::vector<std::size_t> u_columns;
+  for (const std::string& name : unknowns) u_columns.push_back(column(name));
+  const std::size_t index = column("index"), T = column("T"), physical = column("physical"),
+                    reason = column("classification"), stability = column("stability"), residual = column("residual"),
+                    newton = column("newton_iterations"), step = column("step");
+  const auto optional_column = [&](const std::string& name) -> long {
+    const auto it = first.find(name);
+    return it == first.end() ? -1 : static_cast<long>(it->second);
+  };
+  std::vector<StudyPoint> points;
+  for (int row = 2; std::getline(f, line); ++row) {
+    const std::vector<std::string> fields = SplitRow(line);
+    const std::string where = file.string() + ": line " + std::to_string(row);
+    if (fields.size() != header.size()) {
+      throw std::invalid_argument(where + ": " + std::to_string(fields.size()) + " fields, the header has " +
+                                  std::to_string(header.size()));
+    }
+    const auto number = [&](std::size_t c) { return Field(fields[c], where + ", column '" + header[c] + "'"); };
+    const auto optional = [&](const std::string& name) {
+      const long c = optional_column(name);
+      return c < 0 ? kNaN : number(static_cast<std::size_t>(c));
+    };
+    StudyPoint p;
+    const double i = number(index);
+    if (!(i >= 0 && i == std::floor(i) && i < 1e9)) throw std::invalid_argument(where + ": index '" + fields[index] + "'");
+    p.index = static_cast<int>(i);
+    p.u.resize(static_cast<Eigen::Index>(unknowns.size()));
+    for (std::size_t k = 0; k < u_columns.size(); ++k) p.u(static_cast<Eigen::Index>(k)) = number(u_columns[k]);
+    p.T = number(T);
+    OrbitAnalysis& a = p.analysis;
+    a.classification.physical = fields[physical] == "1";
+    if (!FromString(fields[reason], &a.classification.reason)) {
+      throw std::invalid_argument(where + ": classification '" + fields[reason] + "' is no orbit class");
+    }
+    a.stability = fields[stability];
+    a.residual = number(residual);
+    p.newton_iterations = static_cast<int>(number(newton));
+    p.step = number(step);
+    a.replay_error = optional("replay_error");
+    a.automaton_replay_error = optional("automaton_replay_error");
+    const double stable = optional("stable");
+    a.floquet = std::isfinite(stable);
+    a.stable = stable == 1;
+    a.normal = optional("normal") == 1;
+    const double unit = optional("num_unit");
+    a.num_unit = std::isfinite(unit) ? static_cast<int>(unit) : 0;
+    a.max_multiplier = optional("max_multiplier");
+    a.bp_test = optional("bp_test");
+    a.pd_test = optional("pd_test");
+    for (int j = 1; optional_column("mu" + std::to_string(j) + "_re") >= 0; ++j) {
+      const double re = optional("mu" + std::to_string(j) + "_re"), im = optional("mu" + std::to_string(j) + "_im");
+      if (std::isfinite(re)) a.multipliers.emplace_back(re, im);
+    }
+    for (const std::string& name : observables) {
+      const auto it = last.find(name);
+      if (it != last.end()) a.observables.emplace_back(name, number(it->second));
+    }
+    points.push_back(std::move(p));
+  }
+  return points;
+}
+
+}  // namespace
+
+StudyResult LoadStudy(const std::string& dir_text) {
+  const fs::path dir = dir_text;
+  const fs::path summary_file = dir / "summary.json";
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw std::invalid_argument("'" + dir_text + "': not a folder");
+  std::ifstream f(summary_file);
+  if (!f) throw std::invalid_argument(summary_file.string() + ": cannot be read (not a results folder?)");
+  nlohmann::json summary;
+  try {
+    summary = nlohmann::json::parse(f);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw std::invalid_argument(summary_file.string() + ": not JSON (" + e.what() + ")");
+  }
+  if (summary.is_object() && summary.contains("format")) {
+    const nlohmann::json& format = summary["format"];
+    if (!format.is_number_integer() || format.get<long long>() < 1) {
+      throw std::invalid_argument(summary_file.string() + ": format: expected a positive integer, found " + format.dump());
+    }
+    if (format.get<long long>() > study::kResultsFormat) {
+      throw std::invalid_argument(summary_file.string() + ": format " + format.dump() + " is newer than this hybridcont's (" +
+                                  std::to_string(study::kResultsFormat) + "): read it with hybridcont " +
+                                  (summary.contains("version") ? summary["version"].dump() : std::string("of that version")));
+    }
+  }
+  try {
+    std::vector<std::string> observables;
+    if (summary.contains("presentation") && summary["presentation"].is_object() &&
+        summary["presentation"].contains("observables") && summary["presentation"]["observables"].is_array()) {
+      for (const nlohmann::json& o : summary["presentation"]["observables"]) {
+        if (o.is_object() && o.contains("name") && o["name"].is_string()) observables.push_back(o["name"]);
+      }
+    }
+    // The typed branches first (their layouts), then their files.
+    StudyResult shape = study::ResultFromSummary(summary, {});
+    std::map<int, std::vector<StudyPoint>> points;
+    for (const StudyBranch& b : shape.branches) {
+      const nlohmann::json& entry = summary["branches"][static_cast<std::size_t>(b.id)];
+      const std::string file = entry.contains("file") && entry["file"].is_string() ? entry["file"].get<std::string>()
+                                                                                      : "branch-" + std::to_string(b.id) + ".csv";
+      if (fs::path(file).filename().string() != file) {
+        throw std::invalid_argument("branches[" + std::to_string(b.id) + "].file: '" + file + "' is not a file name");
+      }
+      if (!fs::exists(dir / file, ec)) continue;  // listed before its first point was written
+      points[b.id] = ReadBranchFile(dir / file, b.unknown_names, observables);
+    }
+    StudyResult r = study::ResultFromSummary(summary, std::move(points));
+    return r;
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    if (what.rfind(dir.string(), 0) == 0) throw;
+    throw std::invalid_argument(summary_file.string() + ": " + what);
+  }
+}
+
+}  // namespace hybridcont

@@ -1,0 +1,333 @@
+// The study API (study.h): the whole run as one library call, its typed result, the saved study read back,
+// and restarts from labelled points of a saved study.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "hybridcont/study.h"
+
+namespace hybridcont {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path Scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("hybridcont_study_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+std::string Contents(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The rows of a CSV file without its header.
+std::string Rows(const fs::path& file) {
+  const std::string text = Contents(file);
+  return text.substr(text.find('\n') + 1);
+}
+
+StudyOptions Slip() {
+  StudyOptions o;
+  o.model = "slip";
+  return o;
+}
+
+// An analysis value read back from the folder: written with 10 significant digits (docs/results-format.md).
+void ExpectWritten(double saved, double computed, const std::string& what) {
+  if (std::isnan(computed)) {
+    EXPECT_TRUE(std::isnan(saved)) << what;
+  } else {
+    EXPECT_NEAR(saved, computed, 1e-9 * std::max(1.0, std::abs(computed))) << what;
+  }
+}
+
+TEST(Study, RunsWithoutAFolderAndItsFolderReadsBackAsTheSameStudy) {
+  const fs::path dir = Scratch("roundtrip");
+  StudyOptions options = Slip();
+  const StudyResult memory = RunStudy(options);  // nothing written
+  options.out_dir = dir.string();
+  const StudyResult written = RunStudy(options);
+  const StudyResult loaded = LoadStudy(dir.string());
+  EXPECT_EQ(memory.status, ExplorationStatus::kCompleted);
+  EXPECT_EQ(loaded.status, ExplorationStatus::kCompleted);
+  EXPECT_EQ(memory.model, "slip");
+  EXPECT_EQ(loaded.version, Version());
+  ASSERT_EQ(memory.branches.size(), 23u);  // the SLIP's diagram to H = 2
+  for (const StudyResult* other : {&written, &loaded}) {
+    ASSERT_EQ(other->branches.size(), memory.branches.size());
+    ASSERT_EQ(other->special_points.size(), memory.special_points.size());
+    EXPECT_EQ(other->unknown_names, memory.unknown_names);
+    for (std::size_t i = 0; i < memory.branches.size(); ++i) {
+      const StudyBranch& a = memory.branches[i];
+      const StudyBranch& b = other->branches[i];
+      EXPECT_EQ(b.id, a.id);
+      EXPECT_EQ(b.termination, a.termination);
+      EXPECT_EQ(b.family, a.family);
+      EXPECT_EQ(b.image_of, a.image_of);
+      EXPECT_EQ(b.ranges.physical.size(), a.ranges.physical.size());
+      EXPECT_EQ(b.ranges.stable.size(), a.ranges.stable.size());
+      ASSERT_EQ(b.points.size(), a.points.size()) << "branch " << i;
+      for (std::size_t k = 0; k < a.points.size(); ++k) {
+        const StudyPoint& p = a.points[k];
+        const StudyPoint& q = b.points[k];
+        EXPECT_EQ(q.u, p.u) << "branch " << i << " point " << k;  // 17 digits: exact
+        EXPECT_EQ(q.analysis.classification.reason, p.analysis.classification.reason);
+        EXPECT_EQ(q.analysis.stability, p.analysis.stability);
+        EXPECT_EQ(q.analysis.stable, p.analysis.stable);
+        ASSERT_EQ(q.analysis.multipliers.size(), p.analysis.multipliers.size());
+        for (std::size_t m = 0; m < p.analysis.multipliers.size(); ++m) {
+          ExpectWritten(q.analysis.multipliers[m].real(), p.analysis.multipliers[m].real(), "multiplier");
+        }
+        ExpectWritten(q.analysis.replay_error, p.analysis.replay_error, "replay error");
+      }
+    }
+    for (std::size_t i = 0; i < memory.special_points.size(); ++i) {
+      EXPECT_EQ(other->special_points[i].Label(), memory.special_points[i].Label());
+      EXPECT_EQ(other->special_points[i].u, memory.special_points[i].u);
+      EXPECT_EQ(other->special_points[i].status, memory.special_points[i].status);
+    }
+  }
+  // The typed ranges say what the report says: hopping in place is stable from its PD to its BP.
+  const StudyBranch& hopping = memory.branch(2);
+  EXPECT_EQ(hopping.family, "hopping in place");
+  ASSERT_EQ(hopping.ranges.stable.size(), 1u);
+  EXPECT_NEAR(hopping.ranges.stable[0].from.value, 1.282809324, 1e-9);
+  EXPECT_NEAR(hopping.ranges.stable[0].to.value, 1.614433285, 1e-9);
+  const StudySpecialPoint* pd = memory.FindSpecialPoint("PD4");
+  ASSERT_NE(pd, nullptr);
+  EXPECT_NEAR(pd->H, 1.282809323809, 1e-9);
+  EXPECT_EQ(memory.orbits.size(), loaded.orbits.size());
+  EXPECT_FALSE(memory.orbits.empty());
+  EXPECT_FALSE(memory.orbits.front().t.empty());  // sampled in memory
+  EXPECT_THROW(memory.branch(23), std::out_of_range);
+  EXPECT_THROW(memory.branch(-1), std::out_of_range);
+  fs::remove_all(dir);
+}
+
+TEST(Study, HooksSeeEveryPointAndBranchInOrder) {
+  int points = 0, branches = 0, last_branch = -1;
+  bool ordered = true;
+  StudyHooks hooks;
+  hooks.on_point = [&](const StudyPoint& p, const StudyBranch& b) {
+    ++points;
+    ordered = ordered && b.id >= last_branch && static_cast<int>(b.points.size()) == p.index + 1;
+    last_branch = b.id;
+  };
+  hooks.on_branch = [&](const StudyBranch& b) {
+    ++branches;
+    EXPECT_NE(b.termination, "running");
+  };
+  StudyOptions options;
+  options.model = "bouncing-ball";
+  const StudyResult r = RunStudy(options, hooks);
+  int total = 0;
+  for (const StudyBranch& b : r.branches) total += static_cast<int>(b.points.size());
+  EXPECT_EQ(points, total);
+  EXPECT_EQ(branches, static_cast<int>(r.branches.size()));
+  EXPECT_TRUE(ordered);
+}
+
+TEST(Study, AStopRequestEndsTheStudyWithTheWorkSoFar) {
+  const fs::path dir = Scratch("stop");
+  std::atomic<int> points{0};
+  StudyHooks hooks;
+  hooks.on_point = [&](const StudyPoint&, const StudyBranch&) { ++points; };
+  hooks.stop_requested = [&] { return points.load() >= 60; };
+  StudyOptions options = Slip();
+  options.out_dir = dir.string();
+  const StudyResult r = RunStudy(options, hooks);
+  EXPECT_EQ(r.status, ExplorationStatus::kCancelled);
+  EXPECT_GE(r.branches.size(), 2u);
+  EXPECT_LT(r.branches.size(), 23u);
+  EXPECT_TRUE(fs::exists(dir / ".resume"));  // it can be resumed
+  // Resumed: the whole diagram, the branches traced before the stop taken as they were.
+  options.resume = true;
+  const StudyResult resumed = RunStudy(options);
+  EXPECT_EQ(resumed.status, ExplorationStatus::kCompleted);
+  EXPECT_EQ(resumed.branches.size(), 23u);
+  EXPECT_GE(resumed.work.resumed_branches, 2);
+  fs::remove_all(dir);
+}
+
+TEST(Study, OptionErrorsNameTheFieldAndWriteNothing) {
+  const fs::path dir = Scratch("bad");
+  const auto refused = [&](StudyOptions o, const std::string& field, const std::string& text) {
+    o.out_dir = dir.string();
+    try {
+      RunStudy(o);
+      ADD_FAILURE() << "accepted: " << field;
+    } catch (const StudyOptionError& e) {
+      EXPECT_EQ(e.field(), field);
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir)) << field;
+  };
+  StudyOptions o = Slip();
+  o.until = {{"H", 2.5}};
+  o.bounds = {{"H", 0, 2}};
+  refused(o, "until", "until[0] 'H=2.5' lies outside bounds[0] 'H=0:2'");
+  o = Slip();
+  o.threads = 0;
+  refused(o, "threads", "threads 0: must be >= 1");
+  o = Slip();
+  o.parameters = {{"k", 20}, {"k", 30}};
+  refused(o, "parameters", "parameters[1] 'k=30': 'k' is given twice");
+  o = Slip();
+  o.fix = NamedValue{"H", 1.5};
+  refused(o, "fix", "needs a free parameter");
+  o = Slip();
+  o.bounds = {{"H", 2, 1}};
+  refused(o, "bounds", "the lower end must be below the upper end");
+  o = Slip();
+  o.restart = RestartSpec{dir.string() + "-none", "PD4", RestartSpec::Kind::kAuto};
+  refused(o, "restart", "not a saved study");
+}
+
+TEST(Study, OptionsArePlainData) {
+  StudyOptions a = Slip();
+  a.until = {{"H", 1.5}};
+  a.fix = NamedValue{"H", 1.2};
+  const StudyOptions b = a;  // copyable: no callbacks, no references
+  EXPECT_EQ(b.until.size(), 1u);
+  EXPECT_EQ(b.fix->value, 1.2);
+  EXPECT_EQ(StudyOptions().threads, 1);  // a library caller's study takes one core
+}
+
+// The period-doubled family restarted from PD4 of a saved study is the family a run with period doubling
+// traces from it: the same rows, without recomputing the rest of the diagram.
+TEST(Study, RestartFromAPdPointGivesThePeriodDoubledFamilyOfTheFullRun) {
+  const fs::path full = Scratch("pd_full"), saved = Scratch("pd_saved"), restarted = Scratch("pd_restarted");
+  StudyOptions o = Slip();
+  o.period_doubling = true;
+  o.out_dir = full.string();
+  const StudyResult whole = RunStudy(o);
+  o = Slip();
+  o.out_dir = saved.string();
+  RunStudy(o);
+  o = Slip();
+  o.out_dir = restarted.string();
+  o.restart = RestartSpec{saved.string(), "PD4", RestartSpec::Kind::kAuto};
+  const StudyResult r = RunStudy(o);
+  ASSERT_EQ(r.branches.size(), 2u);  // both halves of the family, nothing else
+  int matched = 0;
+  for (const StudyBranch& b : whole.branches) {
+    if (b.period_doubled_from != 4) continue;
+    const int k = matched++;
+    ASSERT_LT(k, 2);
+    EXPECT_EQ(r.branches[k].period_doubled_from, 4);
+    EXPECT_EQ(r.branches[k].origin, "period-doubled");
+    EXPECT_EQ(Rows(restarted / ("branch-" + std::to_string(k) + ".csv")),
+              Rows(full / ("branch-" + std::to_string(b.id) + ".csv")));
+  }
+  EXPECT_EQ(matched, 2);
+  const nlohmann::json summary = nlohmann::json::parse(Contents(restarted / "summary.json"));
+  EXPECT_EQ(summary["restarted_from"]["label"], "PD4");
+  EXPECT_EQ(summary["restarted_from"]["kind"], "period-doubled");
+  for (const fs::path& d : {full, saved, restarted}) fs::remove_all(d);
+}
+
+// A branch that ended at its bound, continued beyond it from its last point: it begins where the saved
+// branch ended and reaches the new target; its orbits are those of the same family.
+TEST(Study, RestartContinuesABranchPastItsBound) {
+  const fs::path saved = Scratch("continue_saved"), restarted = Scratch("continue_restarted");
+  StudyOptions o = Slip();
+  o.out_dir = saved.string();
+  const StudyResult before = RunStudy(o);
+  const StudyBranch& hopping = before.branch(2);
+  ASSERT_EQ(hopping.termination, "bound-reached");
+  o = Slip();
+  o.out_dir = restarted.string();
+  o.until = {{"H", 2.5}};
+  o.restart = RestartSpec{saved.string(), "B2", RestartSpec::Kind::kAuto};
+  const StudyResult r = RunStudy(o);
+  ASSERT_EQ(r.branches.size(), 1u);  // one way: beyond the end only
+  const StudyBranch& beyond = r.branches[0];
+  EXPECT_EQ(beyond.termination, "target-reached");
+  EXPECT_EQ(beyond.family, "hopping in place");
+  ASSERT_GE(beyond.points.size(), 2u);
+  EXPECT_LT((beyond.points.front().u - hopping.points.back().u).norm(), 1e-9);
+  const int H = static_cast<int>(std::find(r.unknown_names.begin(), r.unknown_names.end(), "H") - r.unknown_names.begin());
+  EXPECT_DOUBLE_EQ(beyond.points.back().u(H), 2.5);
+  // The wrong labels are refused with what the saved study has.
+  o.restart = RestartSpec{saved.string(), "B99", RestartSpec::Kind::kAuto};
+  EXPECT_THROW(RunStudy(o), StudyOptionError);
+  o.restart = RestartSpec{saved.string(), "PD99", RestartSpec::Kind::kAuto};
+  EXPECT_THROW(RunStudy(o), StudyOptionError);
+  o.restart = RestartSpec{saved.string(), "SB1", RestartSpec::Kind::kPeriodDoubled};
+  EXPECT_THROW(RunStudy(o), StudyOptionError);
+  o.restart = RestartSpec{saved.string(), "B2", RestartSpec::Kind::kAuto};
+  o.parameters = {{"k", 25}};
+  EXPECT_THROW(RunStudy(o), StudyOptionError);  // the saved orbits are orbits at the saved k
+  for (const fs::path& d : {saved, restarted}) fs::remove_all(d);
+}
+
+// A resume with other options than the interrupted study's is refused before anything is written.
+TEST(Study, ResumeRefusesOtherOptions) {
+  const fs::path dir = Scratch("resume_other");
+  StudyHooks stop;
+  stop.stop_requested = [] { return true; };
+  StudyOptions o = Slip();
+  o.out_dir = dir.string();
+  RunStudy(o, stop);
+  const std::string before = Contents(dir / "summary.json");
+  o.resume = true;
+  o.until = {{"H", 1.5}};
+  try {
+    RunStudy(o);
+    ADD_FAILURE() << "resumed with other options";
+  } catch (const StudyOptionError& e) {
+    EXPECT_EQ(e.field(), "resume");
+    EXPECT_NE(std::string(e.what()).find("'until'"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(Contents(dir / "summary.json"), before);
+  // A damaged stored branch is named.
+  std::ofstream(dir / ".resume" / "branch-0.json") << "{\"format\": 1, \"branch\": {\"id\": \"x\"}}";
+  o.until.clear();
+  try {
+    RunStudy(o);
+    ADD_FAILURE() << "resumed from a damaged store";
+  } catch (const StudyOptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("branch-0.json"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Study, LoadStudyNamesWhatIsWrongInAFolder) {
+  const fs::path dir = Scratch("load_bad");
+  fs::create_directories(dir);
+  EXPECT_THROW(LoadStudy(dir.string()), std::invalid_argument);  // no summary.json
+  std::ofstream(dir / "summary.json") << "{\"model\": \"slip\", \"branches\": [{\"id\": 0, \"termination\": 3}]}";
+  try {
+    LoadStudy(dir.string());
+    ADD_FAILURE();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("branches[0].termination: expected a string"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir / "summary.json") << "{\"model\": \"slip\", \"unknowns\": [\"H\"], \"branches\": [{\"id\": 0, "
+                                         "\"termination\": \"running\", \"file\": \"branch-0.csv\"}]}";
+  std::ofstream(dir / "branch-0.csv") << "index,H,T,physical,classification,stability,residual,newton_iterations,step\n"
+                                         "0,1.5,2,1,physical,,1e-12,2\n";
+  try {
+    LoadStudy(dir.string());
+    ADD_FAILURE();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("branch-0.csv: line 2: 8 fields, the header has 9"), std::string::npos)
+        << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace hybridcont
