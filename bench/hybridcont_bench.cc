@@ -17,6 +17,7 @@
 #include "hybridcont/corrector.h"
 #include "hybridcont/model_file.h"
 #include "hybridcont/models.h"
+#include "hybridcont/study.h"
 #include "model_exploration.h"
 
 namespace hybridcont::study {
@@ -154,6 +155,22 @@ void BM_FullRun(benchmark::State& state) {
 // (ExplorationOptions::threads); on one thread the RHS count is the algorithm's work alone, on two it also
 // counts the traces that the merge drops.
 BENCHMARK(BM_FullRun)->ArgsProduct({{0, 1, 2, 3}, {1, 2}})->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
+
+// The whole study of a model (study.h, what `hybridcont run` computes): the exploration and every point's
+// analysis (classification, replay, Floquet multipliers), ranges and key frames, without a folder.
+// BM_Study/<model>/<threads>; counters: the work of the study's parts (StudyResult::work).
+void BM_Study(benchmark::State& state) {
+  StudyOptions options;
+  options.model = kModels[state.range(0)];
+  options.threads = static_cast<int>(state.range(1));
+  StudyResult study;
+  for (auto _ : state) study = RunStudy(options);
+  state.counters["branches"] = static_cast<double>(study.branches.size());
+  state.counters["rhs_continuation"] = static_cast<double>(study.work.rhs_evaluations);
+  state.counters["rhs_analysis"] = static_cast<double>(study.work.analysis_rhs_evaluations);
+  state.counters["rhs_tests"] = static_cast<double>(study.work.test_rhs_evaluations);
+}
+BENCHMARK(BM_Study)->ArgsProduct({{0, 1, 2, 3}, {1, 2}})->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
 
 // The same model written as a model file (models/<name>.toml), in the same run as BM_FullRun:
 // BM_ModelFileFullRun/<model>/<variant>, variant 0 the built-in C++ model, 1 the file compiled (generated

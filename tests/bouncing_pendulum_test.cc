@@ -22,6 +22,7 @@
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/shooting_layout.h"
 #include "model_exploration.h"
+#include "study_fixture.h"
 #include "scenario.h"
 
 namespace hybridcont {
@@ -37,13 +38,7 @@ HybridModel LoadPendulum() {
   return LoadModelFile(std::filesystem::path(HYBRIDCONT_SOURCE_DIR) / "models" / "bouncing-pendulum.toml", options);
 }
 
-BifurcationDiagram Explore(const HybridModel& model) {
-  const study::Scenario scenario = study::DefaultScenario(model);
-  ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
-  options.threads = 1;
-  study::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
-  return exploration.Run();
-}
+BifurcationDiagram Explore(const HybridModel& model) { return StudyOf(model).diagram; }
 
 // ---- the independent simulation: state (y, theta, dy, dtheta)
 using State = std::array<double, 4>;

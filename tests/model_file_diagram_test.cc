@@ -23,6 +23,7 @@
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/shooting_layout.h"
 #include "model_exploration.h"
+#include "study_fixture.h"
 #include "scenario.h"
 
 namespace hybridcont {
@@ -40,13 +41,9 @@ struct Run {
 };
 
 Run Explore(const HybridModel& model) {
-  const study::Scenario scenario = study::DefaultScenario(model);
-  ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
-  options.threads = 1;  // the diagram is the serial one at any thread count; one core keeps the test cheap
-  study::ModelExploration exploration(model, scenario, IntegratorOptions{}, options);
   Run run;
   const auto start = std::chrono::steady_clock::now();
-  run.diagram = exploration.Run();
+  run.diagram = StudyOf(model).diagram;
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   run.H = ShootingLayout(model).H_index();
   return run;

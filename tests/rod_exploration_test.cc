@@ -9,7 +9,7 @@
 
 #include "hybridcont/exploration.h"
 #include "hybridcont/models.h"
-#include "model_exploration.h"
+#include "study_fixture.h"
 
 namespace hybridcont {
 namespace {
@@ -21,14 +21,9 @@ struct RodRun {
 
 RodRun ExploreRod(double rtol) {
   const HybridModel model = MakeBuiltinModel("bouncing-rod");
-  const study::Scenario scenario = study::DefaultScenario(model);
-  IntegratorOptions integrator;
-  integrator.rtol = rtol;
-  integrator.atol = rtol;
-  study::ModelExploration exploration(model, scenario, integrator, study::ScenarioExplorationOptions(scenario));
   RodRun run;
-  run.diagram = exploration.Run();
-  const TimeBasedShooting& shooting = exploration.shooting();
+  run.diagram = StudyOf(model, WithTolerance(rtol)).diagram;
+  const ShootingLayout shooting(model);
   run.t1 = shooting.UnknownIndex("t1");
   run.t2 = shooting.UnknownIndex("t2");
   run.t3 = shooting.UnknownIndex("t3");

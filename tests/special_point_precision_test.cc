@@ -14,7 +14,7 @@
 #include "hybridcont/corrector.h"
 #include "hybridcont/exploration.h"
 #include "hybridcont/models.h"
-#include "model_exploration.h"
+#include "study_fixture.h"
 #include "scenario.h"
 
 namespace hybridcont {
@@ -160,15 +160,7 @@ TEST(SpecialPointPrecision, ExactProblemsKeepTheBracket) {
 }
 
 BifurcationDiagram ExploreSlip(double tolerance_factor) {
-  const HybridModel model = MakeSlip();
-  const study::Scenario scenario = study::DefaultScenario(model);
-  ExplorationOptions options = study::ScenarioExplorationOptions(scenario);
-  options.threads = 1;
-  IntegratorOptions integrator;
-  integrator.rtol *= tolerance_factor;
-  integrator.atol *= tolerance_factor;
-  study::ModelExploration exploration(model, scenario, integrator, options);
-  return exploration.Run();
+  return StudyOf(MakeSlip(), WithTolerance(IntegratorOptions().rtol * tolerance_factor)).diagram;
 }
 
 // The independent check: the SLIP explored again at 10x tighter tolerances. Every special point of the

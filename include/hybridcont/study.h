@@ -224,6 +224,10 @@ struct StudyResult {
   // ("word_changes", "words"), curves ("curves"), starts, presentation. The typed fields above are read from
   // it and the point tables.
   std::string summary_json;
+  // The exploration of the study's own families as the engine gives it (time-based layout, model units): every
+  // branch's ContinuationPoint and SpecialPoint with tangents, interval widths and test values, the branch
+  // switches and the start's analysis. Not read back by LoadStudy (empty there).
+  BifurcationDiagram diagram;
 
   // The special point with this label ("PD4"), or null.
   const StudySpecialPoint* FindSpecialPoint(const std::string& label) const;
@@ -263,6 +267,9 @@ HybridModel MakeStudyModel(const std::string& model, const std::vector<NamedValu
 
 // Validates the options (throws StudyOptionError / ModelInputError), prepares out_dir, runs the study.
 StudyResult RunStudy(const StudyOptions& options, const StudyHooks& hooks = {});
+// The study of a model the caller built (a model of its own, a clone with edited parameters): run on a copy,
+// so `model` need not outlive the call; options.model is not read, options.parameters are set on the copy.
+StudyResult RunStudy(const HybridModel& model, const StudyOptions& options, const StudyHooks& hooks = {});
 
 // Validates the options against the model without computing or writing anything; returns the notes the
 // study would say (bound widened to a target, no bound).

@@ -18,6 +18,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -311,6 +312,7 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
   result->status = diagram.status;
   result->message = diagram.message;
+  result->diagram = diagram;
   writer.Annotate("exploration", {{"status", ToString(diagram.status)}, {"message", diagram.message}});
   if (writer.failed()) return;  // the failed write is the result's write_error
   nlohmann::json special_points = SpecialPointsJson(diagram, layout, &model, setup.integrator);
@@ -334,8 +336,13 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   std::string curves_report;
   if (!setup.curve_parameter.empty() && !stopped()) {
     say("curves", "");
-    writer.Annotate("curves", TraceParameterCurves(model, setup, from_curve ? restart_points : diagram, writer.dir(),
-                                                   &curves_report));
+    nlohmann::json curves =
+        TraceParameterCurves(model, setup, from_curve ? restart_points : diagram, writer.dir(), &curves_report);
+    if (from_curve && curves.empty()) {
+      curves_report += fmt::format("  from {}: not traced (curves start at physical orbits; this one is not)\n",
+                                   restart->where.value("label", std::string()));
+    }
+    writer.Annotate("curves", std::move(curves));
   }
   writer.SetSpecialPoints(special_points);
   say("key frames", "");
@@ -476,12 +483,33 @@ struct PreparedStudy {
   std::unique_ptr<ModelExploration> exploration;
 };
 
-PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks) {
+// `given`: the caller's model (copied; options.model and models_directory are then not read).
+PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, const HybridModel* given = nullptr) {
   PreparedStudy p;
   NoteBuffer notes(hooks);
   std::ostream log(&notes);
-  if (options.model.empty()) throw StudyOptionError("model", -1, "'': name a built-in model or a model file");
-  p.model = std::make_unique<HybridModel>(MakeStudyModel(options.model, options.parameters, options.models_directory, &log));
+  if (options.model.empty() && given == nullptr) {
+    throw StudyOptionError("model", -1, "'': name a built-in model or a model file");
+  }
+  if (given != nullptr) {
+    p.model = std::make_unique<HybridModel>(given->Clone());
+    std::set<std::string> assigned;
+    for (std::size_t i = 0; i < options.parameters.size(); ++i) {
+      const NamedValue& v = options.parameters[i];
+      const std::string text = fmt::format("'{}={:g}'", v.name, v.value);
+      if (!assigned.insert(v.name).second) {
+        throw StudyOptionError("parameters", static_cast<int>(i), text + ": '" + v.name + "' is given twice");
+      }
+      try {
+        p.model->SetParameter(v.name, v.value);
+      } catch (const std::invalid_argument& e) {
+        throw StudyOptionError("parameters", static_cast<int>(i), text + ": " + e.what());
+      }
+    }
+  } else {
+    p.model = std::make_unique<HybridModel>(
+        MakeStudyModel(options.model, options.parameters, options.models_directory, &log));
+  }
   log.flush();
   const HybridModel& model = *p.model;
   if (!options.free.empty() && options.formulation == Formulation::kStateBased) {
@@ -540,6 +568,10 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks) {
 }
 
 }  // namespace
+
+// The study of options.model, or of *given_model when not null (RunStudy).
+StudyResult Run(const StudyOptions& options, const StudyHooks& hooks, const HybridModel* given_model);
+
 }  // namespace hybridcont::study
 
 namespace hybridcont {
@@ -589,8 +621,19 @@ std::vector<std::string> CheckStudyOptions(const StudyOptions& options) {
   return p.setup.notes;
 }
 
-StudyResult RunStudy(const StudyOptions& given, const StudyHooks& hooks) {
-  using namespace study;
+StudyResult RunStudy(const StudyOptions& options, const StudyHooks& hooks) {
+  return study::Run(options, hooks, nullptr);
+}
+
+StudyResult RunStudy(const HybridModel& model, const StudyOptions& options, const StudyHooks& hooks) {
+  return study::Run(options, hooks, &model);
+}
+
+}  // namespace hybridcont
+
+namespace hybridcont::study {
+
+StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const HybridModel* given_model) {
   StudyOptions options = given;
   // A restart in a free parameter from an orbit holds its H unless told otherwise.
   if (options.restart && !options.free.empty() && !options.fix &&
@@ -598,7 +641,7 @@ StudyResult RunStudy(const StudyOptions& given, const StudyHooks& hooks) {
     const double level = RestartLevel(*options.restart);
     if (std::isfinite(level)) options.fix = NamedValue{"H", level};
   }
-  PreparedStudy p = Prepare(options, hooks);
+  PreparedStudy p = Prepare(options, hooks, given_model);
   const HybridModel& model = *p.model;
   std::optional<RestartPlan> restart;
   if (options.restart) restart = PlanRestart(*options.restart, options, model);
@@ -641,8 +684,9 @@ StudyResult RunStudy(const StudyOptions& given, const StudyHooks& hooks) {
   typed.report = result.report;
   typed.work = result.work;
   typed.orbits = writer.orbits();
+  typed.diagram = std::move(result.diagram);
   typed.write_error = writer.write_error();
   return typed;
 }
 
-}  // namespace hybridcont
+}  // namespace hybridcont::study

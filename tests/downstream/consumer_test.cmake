@@ -54,6 +54,9 @@ if(NOT EXISTS "${consumer}" AND EXISTS "${consumer_build}/${CONFIG}/consumer")
   set(consumer "${consumer_build}/${CONFIG}/consumer")  # multi-config generators
 endif()
 run_step("run the consumer" "${consumer}")
+if(EXISTS "${consumer_build}/study_consumer")
+  run_step("run the study consumer" "${consumer_build}/study_consumer")
+endif()
 message(STATUS "${step_output}")
 
 set(tool "${prefix}/${BINDIR}/hybridcont")
