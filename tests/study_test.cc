@@ -122,12 +122,13 @@ TEST(Study, HooksSeeEveryPointAndBranchInOrder) {
   StudyHooks hooks;
   hooks.on_point = [&](const StudyPoint& p, const StudyBranch& b) {
     ++points;
-    ordered = ordered && b.id >= last_branch && static_cast<int>(b.points.size()) == p.index + 1;
+    ordered = ordered && b.id >= last_branch && b.points.empty() && p.index >= 0;
     last_branch = b.id;
   };
   hooks.on_branch = [&](const StudyBranch& b) {
     ++branches;
     EXPECT_NE(b.termination, "running");
+    EXPECT_FALSE(b.points.empty());  // a finished branch comes with its points
   };
   StudyOptions options;
   options.model = "bouncing-ball";
@@ -193,6 +194,22 @@ TEST(Study, OptionErrorsNameTheFieldAndWriteNothing) {
   o = Slip();
   o.restart = RestartSpec{dir.string() + "-none", "PD4", RestartSpec::Kind::kAuto};
   refused(o, "restart", "not a saved study");
+}
+
+// Period doubling on a model with one phase: the doubled model has two phases of one name (copies), which its
+// drawing names once; the study completes (it failed as bad input after the whole run before).
+TEST(Study, PeriodDoublingOfAOnePhaseModelIsDrawn) {
+  StudyOptions o;
+  o.model = "rocking-block";
+  o.period_doubling = true;
+  const StudyResult r = RunStudy(o);
+  EXPECT_EQ(r.status, ExplorationStatus::kCompleted);
+  EXPECT_EQ(r.branches.size(), 4u);
+  o.model = "bouncing-rod";  // PD points: its period-doubled families are traced and drawn
+  const StudyResult rod = RunStudy(o);
+  int doubled = 0;
+  for (const StudyBranch& b : rod.branches) doubled += b.period_doubled_from >= 0;
+  EXPECT_GT(doubled, 0);
 }
 
 TEST(Study, OptionsArePlainData) {
@@ -300,6 +317,92 @@ TEST(Study, ResumeRefusesOtherOptions) {
     ADD_FAILURE() << "resumed from a damaged store";
   } catch (const StudyOptionError& e) {
     EXPECT_NE(std::string(e.what()).find("branch-0.json"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+// A stored branch that is not the one the resumed exploration is about to trace (another start's, moved under
+// another id) is not taken: that half-branch is traced, and the study is the uninterrupted one.
+TEST(Study, ResumeTakesOnlyTheBranchesItGaveBefore) {
+  const fs::path dir = Scratch("resume_swapped"), reference = Scratch("resume_reference");
+  StudyOptions o = Slip();
+  o.out_dir = reference.string();
+  const StudyResult whole = RunStudy(o);
+  std::atomic<int> points{0};
+  StudyHooks stop;
+  stop.on_point = [&](const StudyPoint&, const StudyBranch&) { ++points; };
+  stop.stop_requested = [&] { return points.load() >= 200; };
+  o.out_dir = dir.string();
+  RunStudy(o, stop);
+  ASSERT_TRUE(fs::exists(dir / ".resume" / "branch-2.json"));
+  ASSERT_TRUE(fs::exists(dir / ".resume" / "branch-3.json"));
+  fs::rename(dir / ".resume" / "branch-2.json", dir / ".resume" / "swap.tmp");
+  fs::rename(dir / ".resume" / "branch-3.json", dir / ".resume" / "branch-2.json");
+  fs::rename(dir / ".resume" / "swap.tmp", dir / ".resume" / "branch-3.json");
+  o.resume = true;
+  const StudyResult resumed = RunStudy(o);
+  ASSERT_EQ(resumed.branches.size(), whole.branches.size());
+  for (std::size_t i = 0; i < whole.branches.size(); ++i) {
+    ASSERT_EQ(resumed.branches[i].points.size(), whole.branches[i].points.size()) << i;
+    for (std::size_t k = 0; k < whole.branches[i].points.size(); ++k) {
+      EXPECT_EQ(resumed.branches[i].points[k].u, whole.branches[i].points[k].u) << i << " " << k;
+    }
+  }
+  for (const fs::path& d : {dir, reference}) fs::remove_all(d);
+}
+
+// A stop while the period-doubled families are explored ends the study as cancelled, resumable.
+TEST(Study, AStopAfterTheExplorationIsNotComplete) {
+  const fs::path dir = Scratch("stop_late");
+  int branches = 0;
+  StudyHooks hooks;
+  hooks.on_branch = [&](const StudyBranch&) { ++branches; };
+  hooks.stop_requested = [&] { return branches >= 23; };  // the run's own 23, then the families
+  StudyOptions o = Slip();
+  o.period_doubling = true;
+  o.out_dir = dir.string();
+  const StudyResult r = RunStudy(o, hooks);
+  EXPECT_EQ(r.status, ExplorationStatus::kCancelled);
+  EXPECT_TRUE(fs::exists(dir / ".resume"));
+  EXPECT_EQ(LoadStudy(dir.string()).status, ExplorationStatus::kCancelled);
+  fs::remove_all(dir);
+}
+
+// Damaged files are refused with their name, never a crash: a number out of double's range, a stored branch
+// whose vectors disagree in size.
+TEST(Study, DamagedFilesAreRefusedByName) {
+  const fs::path dir = Scratch("damaged");
+  StudyHooks stop;
+  stop.stop_requested = [] { return true; };
+  StudyOptions o = Slip();
+  o.out_dir = dir.string();
+  RunStudy(o, stop);
+  std::ofstream(dir / ".resume" / "branch-0.json") << "{\"format\": 1, \"branch\": 1e999}";
+  o.resume = true;
+  try {
+    RunStudy(o);
+    ADD_FAILURE() << "resumed from a damaged store";
+  } catch (const StudyOptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("branch-0.json"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir / ".resume" / "branch-0.json")
+      << "{\"format\": 1, \"branch\": {\"id\": 0, \"direction\": 1, \"parent_special_point\": -1, \"depth\": 0, "
+         "\"points\": [{\"u\": [1, 2], \"tangent\": [1], \"arclength\": 0, \"step\": 0, \"newton_iterations\": 0, "
+         "\"contraction\": 0, \"sb_test\": 0, \"test_values\": []}], \"special_points\": [], \"termination\": 1, "
+         "\"message\": \"\", \"newton_iterations\": 0, \"rejected_steps\": 0, \"located_iterations\": 0, "
+         "\"image_of\": -1, \"symmetry\": \"\", \"reflected_from\": -1}}";
+  try {
+    RunStudy(o);
+    ADD_FAILURE() << "resumed from a branch of mismatched sizes";
+  } catch (const StudyOptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("u and tangent must have the branch's one size"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir / "summary.json") << "{\"model\": \"slip\", \"branches\": [], \"x\": 1e999}";
+  try {
+    LoadStudy(dir.string());
+    ADD_FAILURE();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("summary.json: not JSON"), std::string::npos) << e.what();
   }
   fs::remove_all(dir);
 }

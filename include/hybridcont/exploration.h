@@ -87,15 +87,17 @@ struct ExplorationOptions {
   std::function<bool(const Vector& u, const Vector& v)> known_ray;
   // Half-branches this exploration traced before (an exploration resumed after an interruption): asked with
   // the id the next half-branch gets; a branch returned is taken as its trace (no integration; its points are
-  // reported as if traced). It must be the branch given to on_branch under that id by an exploration of the
-  // same problem with the same options: the diagram is then that of an uninterrupted exploration. Called on
-  // the exploring thread.
+  // reported as if traced) if it leaves the same special point in the same direction from the same point as
+  // the half-branch (else it is traced). It must be the branch given to on_branch under that id by an
+  // exploration of the same problem with the same options: the diagram is then that of an uninterrupted
+  // exploration. Called on the exploring thread.
   std::function<std::optional<Branch>(int id)> recorded_branch;
   // A regular start traces the direction of its given tangent only (a branch continued from its end, whose
   // other side is known): Explore(problem, u0, tangent, options).
   bool one_way_start = false;
   // Each branch as it is merged into the diagram, in the serial order, on the exploring thread; not a branch
-  // merged while ContinuationOptions::cancel says true (it may have been cut short).
+  // merged while ContinuationOptions::cancel says true (it may have been cut short), nor one that could not
+  // start.
   std::function<void(const Branch& branch)> on_branch;
 
   std::string Validate() const;

@@ -245,7 +245,8 @@ struct StudyProgress {
 // Callbacks of the calling process, kept apart from the options. Called on the calling thread, in the
 // serial order of the study (whatever options.threads); stop_requested may be called from worker threads.
 struct StudyHooks {
-  // Each accepted point, analysed, of branch `branch` (the id it has in the result).
+  // Each accepted point, analysed, of branch `branch` (the id it has in the result; its summary so far, without
+  // its points: they come one by one).
   std::function<void(const StudyPoint& point, const StudyBranch& branch)> on_point;
   // Each finished branch.
   std::function<void(const StudyBranch& branch)> on_branch;

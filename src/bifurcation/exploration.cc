@@ -82,6 +82,7 @@ std::unique_ptr<Explorer::Group> Explorer::RegularStart(const Vector& u0, const 
     half->options = options_.continuation;
     half->options.direction = d;
     half->d = d;
+    half->origin = u0;
     if (tangent != nullptr) {
       half->start = [u0, hint = Vector(d * *tangent)](ContinuationStepper* stepper) { return stepper->Start(u0, hint); };
     } else {
@@ -159,6 +160,7 @@ std::unique_ptr<HalfBranch> Explorer::FromPoint(const Vector& u, const Vector& d
   half->d = d;
   half->direction = direction;
   half->ray_point = u;
+  half->origin = u;
   half->symmetries = &reflecting_;
   half->start = [u, direction](ContinuationStepper* stepper) { return stepper->StartAtSingularPoint(u, direction); };
   return half;
@@ -265,8 +267,11 @@ void Explorer::Trace(HalfBranch* half, int parent, int depth) {
   }
   branches_.push_back(std::move(branch));
   // A branch merged once the exploration is cancelled may have been cut short: it is not handed on.
+  // A branch that could not start is not handed on either: it costs nothing to try again.
   const auto& cancel = options_.continuation.cancel;
-  if (options_.on_branch && !(cancel && cancel())) options_.on_branch(branches_.back());
+  if (options_.on_branch && branches_.back().termination != TerminationReason::kStartFailed && !(cancel && cancel())) {
+    options_.on_branch(branches_.back());
+  }
   // A half-branch with a parent starts at that special point, singular (also where it is a mapped image).
   if (parent >= 0 && !half->progress.empty() && half->progress.front().point_index == 0) {
     half->progress.front().at_singular_point = true;
@@ -284,7 +289,17 @@ void Explorer::Trace(HalfBranch* half, int parent, int depth) {
 Branch Explorer::Traced(HalfBranch* half, int id) {
   Unreserve(half);
   if (options_.recorded_branch) {
-    if (std::optional<Branch> recorded = options_.recorded_branch(id)) {
+    std::optional<Branch> recorded = options_.recorded_branch(id);
+    // Only the branch this half-branch gave before: leaving the same special point in the same direction d
+    // from the same point (a start corrected by Newton moves by far less than the distance between starts).
+    const auto same = [&](const Branch& b) {
+      if (b.parent_special_point != half->parent || b.direction != half->d || b.points.empty()) return false;
+      const Vector& first = b.points.front().u;
+      return half->origin.size() == first.size() &&
+             (first - half->origin).norm() <= 1e-3 * (1 + half->origin.norm());
+    };
+    if (recorded && same(*recorded)) {
+      recorded->id = id;
       Recall(half, /*wait=*/true);  // traced ahead for nothing
       half->progress.clear();
       if (options_.continuation.progress) images_.ReportImage(*recorded, &half->progress);

@@ -50,6 +50,7 @@ struct HalfBranch {
   int parent = -1;                                        // special point it leaves
   Vector direction;                                       // the ray it leaves `parent` along
   Vector ray_point;                                       // where it starts, once known (symmetries)
+  Vector origin;                                          // the point it is started from (a start's u0)
   // Symmetries usable for completing a self-symmetric loop by reflection (loop_reflection.h); may be null.
   const std::vector<Symmetry>* symmetries = nullptr;
   int id = 0;                              // branch id it is traced under

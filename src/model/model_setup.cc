@@ -132,11 +132,14 @@ int DrawnPhase(const HybridModel& model, const DrawingSpec::PhaseDrawing& pd, co
   return phase;
 }
 
-// The drawing's segments, 1-based in the file and 0-based here; each must be a segment of its phase.
-std::vector<int> DrawnSegments(const DrawingSpec::PhaseDrawing& pd, int m, int phase, const std::string& field) {
+// The drawing's segments, 1-based in the file and 0-based here; each must be a segment of a phase of the
+// drawing's name (a repeated model, period_doubling.h, has several copies of a phase under one name: the same
+// states, drawn alike).
+std::vector<int> DrawnSegments(const HybridModel& model, const DrawingSpec::PhaseDrawing& pd, const std::string& field) {
+  const int m = model.num_phases();
   std::vector<int> segments;
   for (int s : pd.segments) {
-    if (s < 1 || s > m + 1 || (s - 1) % m != phase) {
+    if (s < 1 || s > m + 1 || model.phase((s - 1) % m).name() != pd.phase) {
       throw ModelInputError(SourceLocation{"", 0, field + ".segments"},
                             "segment " + std::to_string(s) + " is not a segment of phase '" + pd.phase + "'");
     }
@@ -219,7 +222,7 @@ DrawingParts CompileDrawing(const HybridModel& model, const DrawingSpec::PhaseDr
   const std::string field = "drawing." + pd.phase;
   DrawingParts d;
   d.phase = DrawnPhase(model, pd, field);
-  d.segments = DrawnSegments(pd, model.num_phases(), d.phase, field);
+  d.segments = DrawnSegments(model, pd, field);
   std::vector<ExprPtr> outputs;
   std::vector<SourceLocation> where;
   const std::vector<std::string> names =

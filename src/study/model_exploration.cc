@@ -6,6 +6,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "family_boundaries.h"
 #include "hybridcont/classification.h"
 #include "hybridcont/branch_switching.h"
 #include "hybridcont/corrector.h"
@@ -521,11 +522,8 @@ int ModelExploration::BranchThrough(const BifurcationDiagram& d, const Vector& u
   for (const Branch& b : d.branches) {
     for (std::size_t i = 0; i + 1 < b.points.size(); ++i) {
       const Vector a = b.points[i].u.cwiseQuotient(s), c = b.points[i + 1].u.cwiseQuotient(s);
-      const Vector chord = c - a;
-      const double length2 = chord.squaredNorm();
-      const double t = length2 > 0 ? std::clamp((x - a).dot(chord) / length2, 0.0, 1.0) : 0.0;
-      const double distance = (x - a - t * chord).norm();
-      if (distance <= options_.known_branch_tolerance * (1 + x.norm()) + kSagFraction * std::sqrt(length2)) {
+      const double distance = DistanceToSegment<Vector>(x, a, c);
+      if (distance <= options_.known_branch_tolerance * (1 + x.norm()) + kSagFraction * (c - a).norm()) {
         return b.id;
       }
     }

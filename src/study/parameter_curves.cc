@@ -9,6 +9,7 @@
 #include "hybridcont/orbit_observables.h"
 #include "hybridcont/special_point_curve.h"
 #include "hybridcont/timebased_shooting.h"
+#include "family_boundaries.h"
 #include "point_analysis.h"
 
 namespace hybridcont::study {
@@ -100,9 +101,7 @@ std::vector<Vector> TraceBoundary(const HybridModel& model, const RunSetup& setu
 bool OnCurve(const std::vector<std::vector<Eigen::Vector2d>>& curves, const Eigen::Vector2d& x, double tol) {
   for (const auto& c : curves) {
     for (std::size_t i = 0; i + 1 < c.size(); ++i) {
-      const Eigen::Vector2d d = c[i + 1] - c[i];
-      const double s = d.squaredNorm() > 0 ? std::clamp((x - c[i]).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
-      if ((c[i] + s * d - x).norm() <= tol) return true;
+      if (DistanceToSegment<Eigen::Vector2d>(x, c[i], c[i + 1]) <= tol) return true;
     }
   }
   return false;
@@ -212,34 +211,18 @@ nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& se
     traced[boundary.name].push_back(std::move(polyline));
   };
   const double tol = 1e-3 * (1 + std::abs(p0));
-  for (const Branch& b : diagram.branches) {
-    if (b.image_of >= 0) continue;  // an image's boundaries are the images of its source's
-    for (std::size_t i = 0; i + 1 < b.points.size(); ++i) {
-      const Vector ua = b.points[i].u.head(layout.num_unknowns()), ub = b.points[i + 1].u.head(layout.num_unknowns());
-      for (int s = 0; s < layout.num_segments(); ++s) {
-        const double ta = ua(layout.time_index(s)), tb = ub(layout.time_index(s));
-        if (!(ta * tb < 0)) continue;
-        if (!IsPhysical(model, ua, setup.integrator) && !IsPhysical(model, ub, setup.integrator)) continue;
-        const Vector orbit = ua + (ta / (ta - tb)) * (ub - ua);
-        const std::string name = std::string("t").append(std::to_string(s + 1));
-        if (OnCurve(traced[name], Eigen::Vector2d(orbit(layout.H_index()), p0), tol)) continue;
-        trace({name, false}, orbit, fmt::format("branch {} between points {} and {}", b.id, i, i + 1));
-      }
-    }
+  for (const DurationCrossing& c : DurationCrossings(model, diagram, setup.integrator, /*zero_points=*/false)) {
+    const std::string name = std::string("t").append(std::to_string(c.segment + 1));
+    if (OnCurve(traced[name], Eigen::Vector2d(c.u(layout.H_index()), p0), tol)) continue;
+    trace({name, false}, c.u, fmt::format("branch {} between points {} and {}", c.branch, c.point, c.point + 1));
   }
   for (const SpecialPoint& sp : diagram.special_points) {
     if (sp.type != SpecialPointType::kConstraintBoundary || sp.duplicate_of >= 0 || sp.u.size() == 0) continue;
     // The constraint whose interior minimum vanishes there.
     ObservableEvaluator evaluator(model, layout, setup.integrator);
     const Vector u = sp.u.head(layout.num_unknowns());
-    int best = -1;
-    double smallest = 1e-6;
-    for (int j = 0; j < static_cast<int>(model.observables().size()); ++j) {
-      double v = 0;
-      if (!model.observables()[j].constraint || !evaluator.Evaluate(j, u, &v, nullptr).ok) continue;
-      const bool defined = model.observables()[j].kind == ObservableKind::kFinal || evaluator.last_extremum_interior();
-      if (defined && std::abs(v) < smallest) best = j, smallest = std::abs(v);
-    }
+    const int best = VanishingObservable(model, evaluator, u, [](const Observable& o) { return o.constraint; },
+                                         /*interior_only=*/true);
     if (best < 0) continue;
     const std::string& name = model.observables()[best].name;
     if (OnCurve(traced[name], Eigen::Vector2d(sp.u(layout.H_index()), p0), tol)) continue;

@@ -80,7 +80,7 @@ RestartPlan PlanRestart(const RestartSpec& spec, const StudyOptions& options, co
       Refuse(spec, fmt::format("the saved study has branches 0 to {}", static_cast<int>(saved.branches.size()) - 1));
     }
     const StudyBranch& b = saved.branches[branch];
-    if (b.unknown_names != layout.unknown_names()) {
+    if (b.unknown_names != layout.unknown_names() || (!b.word.empty() && b.word != model.WordModeNames())) {
       Refuse(spec, "branch " + std::to_string(branch) + " is a family of another layout (" +
                        (b.origin.empty() ? b.model : b.origin) + "): restart from the model's own families");
     }
@@ -109,7 +109,8 @@ RestartPlan PlanRestart(const RestartSpec& spec, const StudyOptions& options, co
       Refuse(spec, "no such label in the saved study (branches B0 ..., points B<branch>:<point>, special points: " +
                        (labels.empty() ? std::string("none") : labels) + ")");
     }
-    if (sp->u.size() != layout.num_unknowns() || !sp->u.allFinite()) {
+    if (sp->u.size() != layout.num_unknowns() || !sp->u.allFinite() ||
+        (!sp->word.empty() && sp->word != model.WordModeNames())) {
       Refuse(spec, "the special point is not a point of the model's own layout (a family of another layout's?)");
     }
     const auto defaults = [&]() {
@@ -135,9 +136,14 @@ RestartPlan PlanRestart(const RestartSpec& spec, const StudyOptions& options, co
     }
     if (plan.kind == Kind::kContinue) {
       // Along its branch's direction at the point.
-      const StudyBranch& b = saved.branch(sp->branch);
+      if (sp->branch < 0 || sp->branch >= static_cast<int>(saved.branches.size())) {
+        Refuse(spec, "the special point lies on no branch of the saved study");
+      }
+      const StudyBranch& b = saved.branches[sp->branch];
+      if (b.points.size() < 2 || b.points.front().u.size() != sp->u.size()) {
+        Refuse(spec, "its branch has fewer than two points of the model's own layout");
+      }
       const int i = std::clamp(sp->index, 0, static_cast<int>(b.points.size()) - 2);
-      if (b.points.size() < 2) Refuse(spec, "its branch has fewer than two points");
       plan.tangent = b.points[i + 1].u - b.points[i].u;
     }
     plan.u = sp->u;

@@ -198,7 +198,11 @@ void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
   points.push_back({p.index, p.u, layout.Period(p.u), p.analysis, p.newton_iterations, p.step, p.at_branch_point});
   if (points.size() == 1 && !writes_files()) StartBranchEntry(branch_id);
   WritePoint(branch_id, p, layout, other == branch_models_.end() ? presentation_ : other->second.presentation);
-  if (hooks_ && hooks_->on_point) hooks_->on_point(points.back(), BranchOf(branch_id));
+  if (hooks_ && hooks_->on_point) {
+    auto live = live_.find(branch_id);
+    if (live == live_.end()) live = live_.emplace(branch_id, BranchOf(branch_id, /*with_points=*/false)).first;
+    hooks_->on_point(points.back(), live->second);
+  }
 }
 
 void ResultsWriter::WritePoint(int branch_id, const PointRecord& p, const ShootingLayout& layout,
@@ -297,14 +301,17 @@ void ResultsWriter::EndBranch(const Branch& b) {
   const auto listed = std::find_if(branches.begin(), branches.end(), [&](const nlohmann::json& e) { return e["id"] == b.id; });
   if (listed != branches.end()) {
     *listed = std::move(entry);
-  } else {
-    branches.push_back(std::move(entry));
+  } else {  // a branch without points: listed in the order of the ids
+    const auto later = std::find_if(branches.begin(), branches.end(),
+                                    [&](const nlohmann::json& e) { return e["id"].get<int>() > b.id; });
+    branches.insert(later, std::move(entry));
   }
   WriteSummary();
-  if (hooks_ && hooks_->on_branch) hooks_->on_branch(BranchOf(b.id));
+  live_.erase(b.id);
+  if (hooks_ && hooks_->on_branch) hooks_->on_branch(BranchOf(b.id, /*with_points=*/true));
 }
 
-StudyBranch ResultsWriter::BranchOf(int branch_id) const {
+StudyBranch ResultsWriter::BranchOf(int branch_id, bool with_points) const {
   const nlohmann::json& branches = summary_["branches"];
   const auto entry = std::find_if(branches.begin(), branches.end(),
                                   [&](const nlohmann::json& e) { return e["id"] == branch_id; });
@@ -316,7 +323,7 @@ StudyBranch ResultsWriter::BranchOf(int branch_id) const {
   b.continued = layout.continued_name();
   if (other != branch_models_.end()) b.model = other->second.model_name, b.origin = other->second.origin;
   else b.model = model_.name();
-  if (points != points_.end()) b.points = points->second;
+  if (with_points && points != points_.end()) b.points = points->second;
   return b;
 }
 

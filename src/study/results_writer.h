@@ -110,7 +110,7 @@ class ResultsWriter {
 
   // Branch `branch_id` is one of another model (a period-doubled family's, RepeatedModel(model, 2)): its
   // CSV columns follow that model's layout and presentation. Call before its first point; `model` must
-  // outlive the writer.
+  // outlive the branch's last AddPoint (the presentation kept for it is not used after).
   // `origin` names the family's kind for the hooks (StudyBranch::origin): "period-doubled", a word's name.
   void SetBranchModel(int branch_id, const HybridModel& model, const std::string& origin = "");
   void AddPoint(int branch_id, const PointRecord& point);
@@ -138,6 +138,12 @@ class ResultsWriter {
   // Records why the run did not complete ("status": "failed") and tries to write the summary.
   void Fail(const std::string& message);
 
+  // A file written outside the writer (a curve's) could not be written: recorded as the writer's own failures
+  // are; nothing more is written.
+  void RecordWriteError(const std::string& message) {
+    if (write_error_.empty()) write_error_ = message;
+    failed_ = true;
+  }
   // Empty while every file has been written in full; else what failed (file and system message). After a
   // failure nothing more is written.
   const std::string& write_error() const { return write_error_; }
@@ -178,6 +184,7 @@ class ResultsWriter {
   std::map<int, std::vector<ClassifiedPoint>> classified_;
   std::map<int, std::vector<StudyPoint>> points_;
   std::vector<StudyOrbit> orbits_;
+  std::map<int, StudyBranch> live_;  // the branches being traced, as the point hook sees them (no points)
   const StudyHooks* hooks_ = nullptr;
   ResumeStore* resume_store_ = nullptr;
   std::map<int, std::ofstream> branch_files_;
@@ -191,8 +198,8 @@ class ResultsWriter {
   // The point's CSV row (and, first, the file's header and the branch's summary entry).
   void WritePoint(int branch_id, const PointRecord& p, const ShootingLayout& layout,
                   const OrbitPresentation& presentation);
-  // The branch as the study's result gives it: its summary entry so far and its points.
-  StudyBranch BranchOf(int branch_id) const;
+  // The branch as the study's result gives it: its summary entry so far and (with_points) its points.
+  StudyBranch BranchOf(int branch_id, bool with_points) const;
   // Lists branch `branch_id` in summary.json ("termination": "running") when its first point is written;
   // EndBranch completes the entry.
   void StartBranchEntry(int branch_id);

@@ -54,7 +54,9 @@ const nlohmann::json& At(const nlohmann::json& j, const char* key, const std::st
 int IntFrom(const nlohmann::json& j, const char* key, const std::string& where) {
   const nlohmann::json& v = At(j, key, where);
   if (!v.is_number_integer()) throw std::invalid_argument(where + "." + key + ": expected an integer");
-  return v.get<int>();
+  const long long x = v.get<long long>();
+  if (x < -1000000000LL || x > 1000000000LL) throw std::invalid_argument(where + "." + key + ": out of range");
+  return static_cast<int>(x);
 }
 
 std::string TextFrom(const nlohmann::json& j, const char* key, const std::string& where) {
@@ -135,7 +137,12 @@ bool WriteWhole(const fs::path& file, const std::string& text) {
 
 nlohmann::json ReadJson(const fs::path& file) {
   std::ifstream f(file);
-  nlohmann::json j = nlohmann::json::parse(f, nullptr, /*allow_exceptions=*/false);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(f, nullptr, /*allow_exceptions=*/false);
+  } catch (const nlohmann::json::exception& e) {  // a number out of range is an exception even so
+    throw std::invalid_argument(file.string() + ": not a JSON document (" + e.what() + ")");
+  }
   if (j.is_discarded()) throw std::invalid_argument(file.string() + ": not a JSON document");
   return j;
 }
@@ -192,15 +199,25 @@ Branch BranchFromJson(const nlohmann::json& j, const std::string& where) {
     p.contraction = NumberFrom(At(q, "contraction", at), at + ".contraction");
     p.sb_test = NumberFrom(At(q, "sb_test", at), at + ".sb_test");
     p.test_values = VectorFrom(At(q, "test_values", at), at + ".test_values");
-    if (!b.points.empty() && (p.u.size() != b.points.front().u.size() || p.tangent.size() != p.u.size())) {
-      throw std::invalid_argument(at + ": its size differs from the branch's first point");
+    if (p.u.size() == 0 || p.tangent.size() != p.u.size() ||
+        (!b.points.empty() && p.u.size() != b.points.front().u.size())) {
+      throw std::invalid_argument(at + ": u and tangent must have the branch's one size");
     }
     b.points.push_back(std::move(p));
   }
   const nlohmann::json& special = At(j, "special_points", where);
   if (!special.is_array()) throw std::invalid_argument(where + ".special_points: expected a list");
+  const Eigen::Index n = b.points.empty() ? 0 : b.points.front().u.size();
   for (std::size_t i = 0; i < special.size(); ++i) {
-    b.special_points.push_back(SpecialPointFrom(special[i], where + ".special_points[" + std::to_string(i) + "]"));
+    const std::string at = where + ".special_points[" + std::to_string(i) + "]";
+    SpecialPoint p = SpecialPointFrom(special[i], at);
+    for (const Vector* v : {&p.u, &p.tangent, &p.tangent_before, &p.tangent_after, &p.interval_width}) {
+      if (v->size() != 0 && v->size() != n) throw std::invalid_argument(at + ": a vector of another size than u");
+    }
+    if (p.index < -1 || p.index >= static_cast<int>(b.points.size())) {
+      throw std::invalid_argument(at + ".index: beyond the branch's points");
+    }
+    b.special_points.push_back(std::move(p));
   }
   b.termination = EnumFrom(j, "termination", where, TerminationReason::kStartFailed);
   b.message = TextFrom(j, "message", where);
@@ -210,9 +227,11 @@ Branch BranchFromJson(const nlohmann::json& j, const std::string& where) {
   b.image_of = IntFrom(j, "image_of", where);
   b.symmetry = TextFrom(j, "symmetry", where);
   b.reflected_from = IntFrom(j, "reflected_from", where);
-  if (b.reflected_from >= static_cast<int>(b.points.size())) {
+  if (b.reflected_from < -1 || b.reflected_from >= static_cast<int>(b.points.size())) {
     throw std::invalid_argument(where + ".reflected_from: beyond the branch's points");
   }
+  if (b.points.empty()) throw std::invalid_argument(where + ".points: empty (a stored branch has its points)");
+  if (b.direction != 1 && b.direction != -1) throw std::invalid_argument(where + ".direction: must be 1 or -1");
   return b;
 }
 
@@ -221,8 +240,8 @@ ResumeStore::ResumeStore(const fs::path& dir, const nlohmann::json& options, boo
   const fs::path study = dir_ / "study.json";
   if (resume && fs::exists(study, ec)) {
     const nlohmann::json saved = ReadJson(study);
-    const bool same_format = saved.is_object() && saved.value("format", 0) == kFormat &&
-                             saved.value("version", std::string()) == HYBRIDCONT_VERSION;
+    const auto field = [&](const char* key) { return saved.is_object() && saved.contains(key) ? saved[key] : nlohmann::json(); };
+    const bool same_format = field("format") == nlohmann::json(kFormat) && field("version") == nlohmann::json(HYBRIDCONT_VERSION);
     if (same_format) {
       const nlohmann::json& old = saved.contains("options") ? saved["options"] : nlohmann::json();
       if (old != options) {
@@ -243,7 +262,7 @@ ResumeStore::ResumeStore(const fs::path& dir, const nlohmann::json& options, boo
         const std::string name = entry.path().filename().string();
         if (name.rfind("branch-", 0) != 0 || entry.path().extension() != ".json") continue;
         const nlohmann::json j = ReadJson(entry.path());
-        if (!j.is_object() || j.value("format", 0) != kFormat || !j.contains("branch")) {
+        if (!j.is_object() || !j.contains("format") || j["format"] != nlohmann::json(kFormat) || !j.contains("branch")) {
           throw std::invalid_argument(entry.path().string() + ": not a stored branch of format " + std::to_string(kFormat));
         }
         int id = -1;
@@ -253,7 +272,8 @@ ResumeStore::ResumeStore(const fs::path& dir, const nlohmann::json& options, boo
           throw std::invalid_argument(entry.path().string() + ": the file name gives no branch id");
         }
         if (id < 0) throw std::invalid_argument(entry.path().string() + ": the file name gives no branch id");
-        loaded_.emplace(id, BranchFromJson(j["branch"], entry.path().string() + ": branch"));
+        Branch b = BranchFromJson(j["branch"], entry.path().string() + ": branch");
+        loaded_.emplace(id, std::move(b));
       }
     }
   }

@@ -336,13 +336,24 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   std::string curves_report;
   if (!setup.curve_parameter.empty() && !stopped()) {
     say("curves", "");
-    nlohmann::json curves =
-        TraceParameterCurves(model, setup, from_curve ? restart_points : diagram, writer.dir(), &curves_report);
+    nlohmann::json curves = nlohmann::json::array();
+    try {
+      curves = TraceParameterCurves(model, setup, from_curve ? restart_points : diagram, writer.dir(), &curves_report);
+    } catch (const std::runtime_error& e) {  // a curve file that could not be written (a full disk)
+      writer.RecordWriteError(e.what());
+    }
     if (from_curve && curves.empty()) {
       curves_report += fmt::format("  from {}: not traced (curves start at physical orbits; this one is not)\n",
                                    restart->where.value("label", std::string()));
     }
     writer.Annotate("curves", std::move(curves));
+  }
+  // A stop (or a failed write) during the stages after the exploration: what they did is kept, the study is
+  // not complete.
+  if (stopped() && result->status == ExplorationStatus::kCompleted) {
+    result->status = ExplorationStatus::kCancelled;
+    result->message = "stopped after the exploration, before the study's end";
+    writer.Annotate("exploration", {{"status", ToString(result->status)}, {"message", result->message}});
   }
   writer.SetSpecialPoints(special_points);
   say("key frames", "");
@@ -512,6 +523,9 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
   }
   log.flush();
   const HybridModel& model = *p.model;
+  if (options.resume && options.out_dir.empty()) {
+    throw StudyOptionError("resume", -1, ": needs the results folder to resume in (out_dir)");
+  }
   if (!options.free.empty() && options.formulation == Formulation::kStateBased) {
     throw StudyOptionError("formulation", -1, "state: free '" + options.free +
                            "' needs the time-based formulation (the state-based map has no free parameters)");
@@ -523,6 +537,8 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
     throw StudyOptionError("period_doubling", -1, ": not with a free parameter (free '" + options.free + "')");
   }
   p.setup = MakeRunSetup(options, model);
+  // The period-doubled families' model is drawn too: its presentation is checked before anything runs.
+  if (options.period_doubling) OrbitPresentation(RepeatedModel(model, 2), p.setup.free);
   p.exploration = MakeExploration(options, model, p.setup);
   CheckConservationAtStart(model, options.model, p.exploration->shooting().layout(), p.setup.scenario.start);
   // An automaton's starts in other words take transitions the file's word may not: their words are checked
@@ -663,6 +679,11 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
   }
   ResultsWriter writer(dir, model, options_json, p.setup.free, &hooks);
   writer.set_resume_store(store.get());
+  // Every exploration of the study (the period-doubled and word families', the starts' of a free parameter)
+  // stops at a stop request or a failed write.
+  const auto cancel = [&writer, &hooks] { return writer.failed() || (hooks.stop_requested && hooks.stop_requested()); };
+  p.setup.exploration.continuation.cancel = cancel;
+  p.setup.seed_exploration.continuation.cancel = cancel;
   StudyResult result;
   try {
     Compute(options, hooks, model, p.setup, restart ? &*restart : nullptr, *p.exploration, writer, &result);

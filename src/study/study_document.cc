@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 namespace hybridcont::study {
@@ -178,16 +179,28 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
   }
   const nlohmann::json* branches = Find(summary, "branches");
   if (branches == nullptr || !branches->is_array()) Malformed("branches", "expected a list");
+  std::map<int, StudyBranch> listed;
   for (std::size_t i = 0; i < branches->size(); ++i) {
-    StudyBranch b = BranchFromSummary((*branches)[i], r.unknown_names, "branches[" + std::to_string(i) + "]");
-    if (b.id != static_cast<int>(r.branches.size())) {
-      Malformed("branches[" + std::to_string(i) + "].id", "expected " + std::to_string(r.branches.size()) +
-                                                              " (ids run from 0 in order), found " + std::to_string(b.id));
-    }
+    const std::string where = "branches[" + std::to_string(i) + "]";
+    StudyBranch b = BranchFromSummary((*branches)[i], r.unknown_names, where);
+    if (b.id < 0 || b.id > 1000000) Malformed(where + ".id", "out of range: " + std::to_string(b.id));
     if (b.model.empty()) b.model = r.model;
     if (b.period_doubled_from >= 0) b.origin = "period-doubled";
     b.continued = continued;
     if (auto it = points.find(b.id); it != points.end()) b.points = std::move(it->second);
+    if (!listed.emplace(b.id, std::move(b)).second) Malformed(where + ".id", "listed twice");
+  }
+  // id == index: a branch an interrupted study had not listed yet (it had no point) is there, "unlisted".
+  for (auto& [id, b] : listed) {
+    while (static_cast<int>(r.branches.size()) < id) {
+      StudyBranch missing;
+      missing.id = static_cast<int>(r.branches.size());
+      missing.model = r.model;
+      missing.unknown_names = r.unknown_names;
+      missing.continued = continued;
+      missing.termination = "unlisted";
+      r.branches.push_back(std::move(missing));
+    }
     r.branches.push_back(std::move(b));
   }
   const nlohmann::json* special = Find(summary, "special_points");

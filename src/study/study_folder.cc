@@ -103,7 +103,11 @@ std::vector<StudyPoint> ReadBranchFile(const fs::path& file, const std::vector<s
     }
     a.stability = fields[stability];
     a.residual = number(residual);
-    p.newton_iterations = static_cast<int>(number(newton));
+    const double iterations = number(newton);
+    if (!(iterations >= 0 && iterations < 1e9 && iterations == std::floor(iterations))) {
+      throw std::invalid_argument(where + ": newton_iterations '" + fields[newton] + "'");
+    }
+    p.newton_iterations = static_cast<int>(iterations);
     p.step = number(step);
     a.replay_error = optional("replay_error");
     a.automaton_replay_error = optional("automaton_replay_error");
@@ -112,7 +116,7 @@ std::vector<StudyPoint> ReadBranchFile(const fs::path& file, const std::vector<s
     a.stable = stable == 1;
     a.normal = optional("normal") == 1;
     const double unit = optional("num_unit");
-    a.num_unit = std::isfinite(unit) ? static_cast<int>(unit) : 0;
+    a.num_unit = std::isfinite(unit) && unit >= 0 && unit < 1e6 ? static_cast<int>(unit) : 0;
     a.max_multiplier = optional("max_multiplier");
     a.bp_test = optional("bp_test");
     a.pd_test = optional("pd_test");
@@ -141,7 +145,7 @@ StudyResult LoadStudy(const std::string& dir_text) {
   nlohmann::json summary;
   try {
     summary = nlohmann::json::parse(f);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // not JSON, or a number out of range
     throw std::invalid_argument(summary_file.string() + ": not JSON (" + e.what() + ")");
   }
   if (summary.is_object() && summary.contains("format")) {
@@ -166,8 +170,12 @@ StudyResult LoadStudy(const std::string& dir_text) {
     // The typed branches first (their layouts), then their files.
     StudyResult shape = study::ResultFromSummary(summary, {});
     std::map<int, std::vector<StudyPoint>> points;
+    std::map<int, const nlohmann::json*> entries;  // by id (ResultFromSummary has checked them)
+    for (const nlohmann::json& entry : summary["branches"]) entries[entry["id"].get<int>()] = &entry;
     for (const StudyBranch& b : shape.branches) {
-      const nlohmann::json& entry = summary["branches"][static_cast<std::size_t>(b.id)];
+      const auto listed = entries.find(b.id);
+      if (listed == entries.end()) continue;  // not listed by an interrupted study
+      const nlohmann::json& entry = *listed->second;
       const std::string file = entry.contains("file") && entry["file"].is_string() ? entry["file"].get<std::string>()
                                                                                       : "branch-" + std::to_string(b.id) + ".csv";
       if (fs::path(file).filename().string() != file) {

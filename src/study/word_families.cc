@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "family_boundaries.h"
 #include "family_report.h"
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/corrector.h"
@@ -22,9 +23,6 @@
 
 namespace hybridcont::study {
 namespace {
-
-// A duration at most this is 0 (a branch point on a zero-duration family, a start with zero durations).
-constexpr double kZeroDuration = 1e-12;
 
 // One explored word: its model, an exploration of it (for BranchThrough) and its diagrams' branches (run ids).
 struct WordEntry {
@@ -55,32 +53,19 @@ void ZeroDurations(const HybridModel& model, const BifurcationDiagram& d, const 
   const int m = model.num_phases();
   TimeBasedShooting map(model, integrator);
   Corrector corrector(&map);
-  for (const Branch& b : d.branches) {
-    if (b.image_of >= 0) continue;  // an image's ends are the images of its source's
-    for (std::size_t i = 0; i + 1 < b.points.size(); ++i) {
-      const Vector ua = b.points[i].u.head(layout.num_unknowns()), ub = b.points[i + 1].u.head(layout.num_unknowns());
-      for (int s = 1; s < m; ++s) {
-        const double ta = ua(layout.time_index(s)), tb = ub(layout.time_index(s));
-        const bool za = std::abs(ta) <= kZeroDuration, zb = std::abs(tb) <= kZeroDuration;
-        if (za && zb) continue;  // a family with that duration 0 throughout: its crossings are branch points
-        if (!(ta * tb < 0 || za || zb)) continue;
-        if (!IsPhysical(model, ua, integrator) && !IsPhysical(model, ub, integrator)) continue;
-        Degeneracy g;
-        g.branch = b.id;
-        g.segment = s;
-        g.where = fmt::format("branch {} between points {} and {}", b.id, i, i + 1);
-        if (za || zb) {
-          g.u = za ? ua : ub;
-        } else {
-          const Vector guess = ua + (ta / (ta - tb)) * (ub - ua);
-          if (corrector.CorrectFixedComponent(guess, layout.time_index(s), 0.0, &g.u).status !=
-              CorrectorStatus::kConverged) {
-            continue;
-          }
-        }
-        out->push_back(std::move(g));
-      }
+  for (const DurationCrossing& c : DurationCrossings(model, d, integrator, /*zero_points=*/true)) {
+    if (c.segment < 1 || c.segment >= m) continue;  // phases 2..m: phase 1 holds the section
+    Degeneracy g;
+    g.branch = c.branch;
+    g.segment = c.segment;
+    g.where = fmt::format("branch {} between points {} and {}", c.branch, c.point, c.point + 1);
+    if (c.at_point) {
+      g.u = c.u;
+    } else if (corrector.CorrectFixedComponent(c.u, layout.time_index(c.segment), 0.0, &g.u).status !=
+               CorrectorStatus::kConverged) {
+      continue;
     }
+    out->push_back(std::move(g));
   }
 }
 
@@ -93,15 +78,11 @@ void TouchedGuards(const HybridModel& model, const BifurcationDiagram& d, const 
   for (const SpecialPoint& sp : d.special_points) {
     if (sp.type != SpecialPointType::kConstraintBoundary || sp.duplicate_of >= 0 || sp.u.size() == 0) continue;
     const Vector u = sp.u.head(layout.num_unknowns());
-    int best = -1, segment = -1;
-    double smallest = 1e-6, t = 0;
-    for (int j = 0; j < static_cast<int>(model.observables().size()); ++j) {
-      const Observable& o = model.observables()[j];
-      double v = 0;
-      if (!o.guard || !evaluator.Evaluate(j, u, &v, nullptr).ok || !(std::abs(v) < smallest)) continue;
-      best = j, smallest = std::abs(v), segment = evaluator.last_extremum_segment(), t = evaluator.last_extremum_time();
-    }
+    const int best = VanishingObservable(model, evaluator, u, [](const Observable& o) { return o.guard; },
+                                         /*interior_only=*/false);
     if (best < 0) continue;
+    const int segment = evaluator.last_extremum_segment();
+    const double t = evaluator.last_extremum_time();
     // Only where the orbit is physical but for this guard: a boundary crossed by a non-physical family hands
     // nothing over.
     const Classification c = ClassifyPoint(model, u, integrator);
