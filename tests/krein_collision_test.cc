@@ -9,6 +9,8 @@
 // computed here independently (a 4 x 4 eigenproblem) and the collisions located by bisection.
 #include <gtest/gtest.h>
 
+#include "hybridcont/study.h"
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -19,9 +21,7 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
 
-#include "cli_runner.h"
 #include "hybridcont/floquet.h"
 
 namespace hybridcont {
@@ -95,19 +95,18 @@ TEST(KreinCollision, LocatedWhereTheIndependentMultipliersLeaveTheUnitCircle) {
   fs::create_directories(dir);
   const fs::path file = dir / "krein.toml";
   std::ofstream(file) << KreinModelText();
-  const app::CliResult r = app::RunTool({"run", file.string(), "--out", (dir / "out").string(), "--quiet",
-                                         "--no-plots", "--threads", "1", "--overwrite"});
-  ASSERT_EQ(r.code, 0) << r.err;
-  std::ifstream f(dir / "out" / "summary.json");
-  const nlohmann::json summary = nlohmann::json::parse(f);
+  StudyOptions options;
+  options.model = file.string();
+  const StudyResult study = RunStudy(options);
+  ASSERT_EQ(study.status, ExplorationStatus::kCompleted) << study.message;
   std::vector<double> located;
-  for (const nlohmann::json& sp : summary["special_points"]) {
-    if (sp["type"] == "KC" && sp["duplicate_of"] == -1) located.push_back(sp["H"].get<double>());
+  for (const StudySpecialPoint& sp : study.special_points) {
+    if (sp.type == SpecialPointType::kKreinCollision && sp.duplicate_of == -1) located.push_back(sp.H);
   }
   std::sort(located.begin(), located.end());
   located.erase(std::unique(located.begin(), located.end(), [](double x, double y) { return std::abs(x - y) < 1e-7; }),
                 located.end());
-  ASSERT_EQ(located.size(), expected.size()) << summary["special_points"].dump();
+  ASSERT_EQ(located.size(), expected.size()) << study.report;
   double worst = 0;
   for (std::size_t i = 0; i < expected.size(); ++i) worst = std::max(worst, std::abs(located[i] - expected[i]));
   // The bisection on |mu| > 1 + 1e-9 sees the collision late by the square root of that threshold's

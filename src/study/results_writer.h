@@ -160,6 +160,12 @@ class ResultsWriter {
   const nlohmann::json& summary() const { return summary_; }
   // The analysed points of every branch so far, by branch id.
   const std::map<int, std::vector<StudyPoint>>& points() const { return points_; }
+  // The points added so far, over every branch.
+  int num_points() const {
+    int n = 0;
+    for (const auto& [id, list] : points_) n += static_cast<int>(list.size());
+    return n;
+  }
   // The key-frame orbits added so far, sampled.
   const std::vector<StudyOrbit>& orbits() const { return orbits_; }
   static std::string BranchFileName(int id) { return "branch-" + std::to_string(id) + ".csv"; }

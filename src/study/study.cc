@@ -253,7 +253,7 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   // more is computed, and the run says which file could not be written.
   exploration.set_cancel([&writer, &hooks] { return writer.failed() || (hooks.stop_requested && hooks.stop_requested()); });
   const auto say = [&](const std::string& stage, const std::string& text) {
-    if (hooks.on_progress) hooks.on_progress({stage, writer.next_branch_id(), 0, text});
+    if (hooks.on_progress) hooks.on_progress({stage, writer.next_branch_id(), writer.num_points(), text});
   };
   // A restart's special point, for the stages that start from special points (period-doubled families, curves).
   BifurcationDiagram restart_points;
