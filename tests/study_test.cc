@@ -212,6 +212,19 @@ TEST(Study, PeriodDoublingOfAOnePhaseModelIsDrawn) {
   EXPECT_GT(doubled, 0);
 }
 
+// The options checked without running: the notes a study would say, nothing computed or written.
+TEST(Study, CheckStudyOptionsSaysWhatTheStudyWouldChange) {
+  StudyOptions o = Slip();
+  o.until = {{"H", 2.5}};
+  const std::vector<std::string> notes = CheckStudyOptions(o);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("until H=2.5 lies outside the bound [0, 2] of H: the bound is widened to [0, 2.5]"),
+            std::string::npos)
+      << notes[0];
+  o.until = {{"H", 2.5}, {"H", 3}};
+  EXPECT_THROW(CheckStudyOptions(o), StudyOptionError);
+}
+
 TEST(Study, OptionsArePlainData) {
   StudyOptions a = Slip();
   a.until = {{"H", 1.5}};
