@@ -8,9 +8,10 @@
 //   StudyOptions options;                 // plain data: copy it, send it to another process
 //   options.model = "slip";
 //   options.until = {{"H", 1.6}};
-//   options.out_dir = "results/slip";     // optional: the results folder (results_folder.h), written as it grows
+//   options.out_dir = "results/slip";     // optional: the results folder (docs/results-format.md), written as
+//                                         // it grows; options.resume continues one that was interrupted
 //   StudyHooks hooks;                     // kept apart from the options: callbacks of this process
-//   hooks.on_point = [](const StudyPoint& p, int branch) { ... };
+//   hooks.on_point = [](const StudyPoint& p, const StudyBranch& b) { ... };
 //   StudyResult study = RunStudy(options, hooks);
 //   for (const StudyBranch& b : study.branches) ... b.family, b.ranges, b.points[i].analysis.stability
 //
@@ -63,7 +64,7 @@ std::string ToString(Formulation f);
 // "time" / "state"; false for anything else.
 bool FromString(const std::string& text, Formulation* f);
 
-// Where a restarted study begins: a labelled point of a saved study (results_folder.h).
+// Where a restarted study begins: a labelled point of a saved study (docs/results-format.md, "Labels").
 //   label "PD4"  (a special point: its code and id)  — kind kPeriodDoubled: the period-doubled family born there;
 //                                                      kind kSwitch: every branch through the SB/BP point;
 //                                                      kind kCurve: the point continued in (H, curve_parameter);
@@ -101,10 +102,10 @@ struct StudyOptions {
   std::optional<NamedValue> fix;       // the unknown held fixed while `free` varies (H=1.5, t2=0, speed=1)
   std::string curves;                  // a parameter: special points continued in (H, it) after the run
   std::optional<RestartSpec> restart;  // begin at a labelled point of a saved study instead of the model's start
-  // The results folder (results_folder.h), written as the study grows; empty: nothing is written.
+  // The results folder (docs/results-format.md), written as the study grows; empty: nothing is written.
   std::string out_dir;
   bool overwrite = false;  // replace another model's results in out_dir (refused otherwise)
-  // Continue the study saved (possibly interrupted) in out_dir: branches traced there are taken as they
+  // Continue the study saved (possibly interrupted) in out_dir (src/study/resume_store.h): branches traced there are taken as they
   // are, the rest computed. The options must be those of the saved study.
   bool resume = false;
 };
@@ -276,7 +277,7 @@ StudyResult RunStudy(const HybridModel& model, const StudyOptions& options, cons
 // study would say (bound widened to a target, no bound).
 std::vector<std::string> CheckStudyOptions(const StudyOptions& options);
 
-// The study saved in a results folder (results_folder.h; a folder of an interrupted study too). Throws
+// The study saved in a results folder (docs/results-format.md; a folder of an interrupted study too). Throws
 // std::invalid_argument naming the file, line and field for a folder that is not a saved study.
 StudyResult LoadStudy(const std::string& dir);
 
