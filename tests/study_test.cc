@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "hybridcont/study.h"
+#include "hybridcont/timebased_shooting.h"
 
 namespace hybridcont {
 namespace {
@@ -223,6 +224,32 @@ TEST(Study, CheckStudyOptionsSaysWhatTheStudyWouldChange) {
       << notes[0];
   o.until = {{"H", 2.5}, {"H", 3}};
   EXPECT_THROW(CheckStudyOptions(o), StudyOptionError);
+}
+
+// Each accepted point is integrated for its analysis no more: its class, replay, multipliers and residual are
+// those the Floquet test functions found there (at the study's tolerances), equal to an analysis of its own.
+TEST(Study, APointsAnalysisIsTheTestFunctionsAndEqualsItsOwn) {
+  const StudyResult study = RunStudy(Slip());
+  int points = 0;
+  for (const StudyBranch& b : study.branches) points += static_cast<int>(b.points.size());
+  // Only the starts at singular points are evaluated again (their multipliers classified as at a branch point).
+  EXPECT_LE(study.work.analysis_map_evaluations, 8);
+  EXPECT_GT(points, 1000);
+  const HybridModel model = MakeStudyModel("slip");
+  TimeBasedShooting map(model, IntegratorOptions{});
+  int compared = 0;
+  for (const StudyPoint& p : study.branch(2).points) {  // hopping in place: physical, stable and unstable
+    if (p.at_branch_point) continue;
+    const OrbitAnalysis own = AnalyzeOrbit(model, map, p.u, OrbitAnalysisOptions::For(IntegratorOptions{}));
+    EXPECT_EQ(p.analysis.classification.reason, own.classification.reason);
+    EXPECT_EQ(p.analysis.stability, own.stability);
+    EXPECT_EQ(p.analysis.replay_error, own.replay_error);
+    ASSERT_EQ(p.analysis.multipliers.size(), own.multipliers.size());
+    for (std::size_t j = 0; j < own.multipliers.size(); ++j) EXPECT_EQ(p.analysis.multipliers[j], own.multipliers[j]);
+    EXPECT_NEAR(p.analysis.residual, own.residual, 1e-12);
+    ++compared;
+  }
+  EXPECT_GE(compared, 30);
 }
 
 TEST(Study, OptionsArePlainData) {

@@ -33,12 +33,14 @@
 
 #include <initializer_list>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "hybridcont/classification.h"
 #include "hybridcont/floquet.h"
 #include "hybridcont/orbit_observables.h"
 #include "hybridcont/orbit_trace.h"
+#include "hybridcont/replay.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/test_function.h"
 #include "hybridcont/timebased_shooting.h"
@@ -104,6 +106,21 @@ class FloquetTestFunctions : public TestFunctions {
   // The map the multipliers and PeriodDoublingTest are computed with: its counters are this object's work
   // (the classification and replay of branch points not included).
   const TimeBasedShooting& shooting() const { return shooting_; }
+  // What the last Evaluate at a branch point learnt of its orbit, for the analysis of that point
+  // (orbit_analysis.h, OrbitAnalysisOptions::known), so that the point is not integrated again: its class,
+  // and for an orbit that is physical (or beyond a constraint's boundary) its replay, its multipliers (default
+  // FloquetOptions); and the residual |r(u)| of the map's evaluation there. Empty before the first branch point.
+  struct BranchPointAnalysis {
+    Vector u;                     // the point, as given to Evaluate
+    Classification classification;
+    bool replayed = false;        // replay holds the event-driven replay
+    ReplayResult replay;
+    bool floquet_known = false;   // floquet holds the multipliers
+    FloquetResult floquet;
+    bool residual_known = false;  // residual holds |r(u)| (the map could be evaluated at u)
+    double residual = 0;
+  };
+  const std::optional<BranchPointAnalysis>& last_branch_point() const { return last_branch_point_; }
   // The integrations of the own events' minima (not the map's).
   FlowCounters own_event_counters() const {
     return own_event_evaluator_ ? own_event_evaluator_->counters() : FlowCounters();
@@ -124,6 +141,7 @@ class FloquetTestFunctions : public TestFunctions {
   int first_own_event() const;
   // The event-driven replay of u (the model's own layout) returns (replay.h).
   bool Replays(const HybridModel& model, const Vector& u) const;
+  ReplayResult Replay(const HybridModel& model, const Vector& u) const;
 
   const HybridModel* model_;
   IntegratorOptions integrator_;
@@ -133,10 +151,12 @@ class FloquetTestFunctions : public TestFunctions {
   int base_unknowns_;                            // u without the free parameters
   std::unique_ptr<HybridModel> point_model_;     // with free parameters: set to u's values to classify
   Matrix dr_;
+  Vector r_;
   // The own events' minima, on the shooting map's model (at u's parameter values), made at first use.
   std::unique_ptr<ObservableEvaluator> own_event_evaluator_;
   std::vector<Observable> own_events_;
   std::vector<char> own_defined_;  // per phase: whether the last branch point had a value
+  std::optional<BranchPointAnalysis> last_branch_point_;
 };
 
 }  // namespace hybridcont

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "hybridcont/classification.h"
+#include "hybridcont/floquet_test_functions.h"
 #include "hybridcont/replay.h"
 #include "hybridcont/timebased_shooting.h"
 
@@ -28,6 +29,11 @@ struct OrbitAnalysisOptions {
   // The point is a located branch point or a branch's start at one: its multipliers near 1 are classified
   // as at a branch point (FloquetOptions::at_branch_point).
   bool at_branch_point = false;
+  // What the Floquet test functions learnt of this point at the same integrator tolerances (its class, replay,
+  // multipliers and residual; floquet_test_functions.h): taken instead of integrating the orbit again. Null:
+  // everything is computed here. Its multipliers are used only where at_branch_point is false (they were
+  // classified without that option).
+  const FloquetTestFunctions::BranchPointAnalysis* known = nullptr;
   // Replay tolerances equal to the integrator's.
   static OrbitAnalysisOptions For(const IntegratorOptions& integrator);
 };

@@ -167,7 +167,11 @@ bool FloquetTestFunctions::Physical(const Vector& u_free) const {
 }
 
 bool FloquetTestFunctions::Replays(const HybridModel& model, const Vector& u) const {
-  return ReplayOrbit(model, u, OrbitAnalysisOptions::For(integrator_).replay).physical();
+  return Replay(model, u).physical();
+}
+
+ReplayResult FloquetTestFunctions::Replay(const HybridModel& model, const Vector& u) const {
+  return ReplayOrbit(model, u, OrbitAnalysisOptions::For(integrator_).replay);
 }
 
 bool FloquetTestFunctions::GrazingEndsPhysicalFamily(const Vector& u_free) const {
@@ -179,13 +183,20 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
   const int ns = 2 + m;  // the Neimark–Sacker function, then (conservative) the Krein one
   const bool krein = model_->num_first_integrals() > 0;
   *values = Vector::Constant(ns + 1 + (krein ? 1 : 0) + m, std::numeric_limits<double>::quiet_NaN());
-  const bool evaluated = shooting_.Evaluate(u, nullptr, &dr_).ok;
+  // r comes with dr at no cost: a branch point's residual, for its analysis.
+  const bool evaluated = shooting_.Evaluate(u, branch_point ? &r_ : nullptr, &dr_).ok;
   // A branch point's class: it decides whether the Floquet functions are defined there (physical_only) and,
   // for a conservative model, whether the crossing speeds are (see below).
   const HybridModel* model_at_u = branch_point ? ModelAt(u) : model_;
   Classification c;
   std::unique_ptr<OrbitTrace> trace;
   if (branch_point && model_at_u != nullptr) c = Classify(*model_at_u, u.head(base_unknowns_), &trace);
+  if (branch_point) {
+    last_branch_point_.reset();
+    if (model_at_u != nullptr) {
+      last_branch_point_ = BranchPointAnalysis{u, c, false, {}, false, {}, evaluated, evaluated ? r_.norm() : 0.0};
+    }
+  }
   // A phase's own event touched inside it: at branch points where a physical family may end so (physical
   // or missed-event) and the trace shows an interior minimum of the event; at trial points always.
   if (evaluated && (!branch_point || (trace && (c.physical || c.reason == OrbitClass::kMissedEvent)))) {
@@ -214,11 +225,17 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
   // crossing between a family's last physical point and a boundary the next step jumped over is bracketed;
   // its zero is kept only where the orbit is physical (Keep).
   const bool defined = c.physical || c.reason == OrbitClass::kConstraintViolated;
-  if (branch_point && physical_only_ &&
-      !(model_at_u != nullptr && defined && Replays(*model_at_u, u.head(base_unknowns_)))) {
-    return;
+  if (branch_point && physical_only_) {
+    if (model_at_u == nullptr || !defined) return;
+    last_branch_point_->replay = Replay(*model_at_u, u.head(base_unknowns_));
+    last_branch_point_->replayed = true;
+    if (!last_branch_point_->replay.physical()) return;
   }
   const FloquetResult floquet = ComputeFloquet(shooting_, u);
+  if (branch_point && last_branch_point_) {
+    last_branch_point_->floquet = floquet;
+    last_branch_point_->floquet_known = true;
+  }
   if (!floquet.ok()) return;
   (*values)(0) = floquet.bp_test;
   if (evaluated) (*values)(1) = PeriodDoublingTest(dr_, shooting_.layout());  // dr_ from the evaluation above

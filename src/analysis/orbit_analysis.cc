@@ -22,7 +22,8 @@ namespace {
 // The replays and the multipliers of a physical orbit (a replay that does not return demotes it).
 void AnalyzePhysical(const HybridModel& model, TimeBasedShooting& floquet_map, const Vector& u, const Vector& orbit,
                      const OrbitAnalysisOptions& options, OrbitAnalysis* a) {
-  const ReplayResult replay = ReplayOrbit(model, orbit, options.replay);
+  const FloquetTestFunctions::BranchPointAnalysis* known = options.known;
+  const ReplayResult replay = known != nullptr && known->replayed ? known->replay : ReplayOrbit(model, orbit, options.replay);
   a->replay_error = replay.error;
   if (!replay.physical()) {
     a->classification = {false, OrbitClass::kReplayFailed, replay.message};
@@ -39,7 +40,8 @@ void AnalyzePhysical(const HybridModel& model, TimeBasedShooting& floquet_map, c
   }
   FloquetOptions floquet_options;
   floquet_options.at_branch_point = options.at_branch_point;
-  const FloquetResult floquet = ComputeFloquet(floquet_map, u, floquet_options);
+  const bool reuse = known != nullptr && known->floquet_known && !options.at_branch_point;
+  const FloquetResult floquet = reuse ? known->floquet : ComputeFloquet(floquet_map, u, floquet_options);
   if (!floquet.ok()) return;
   a->floquet = true;
   a->stability = floquet.stability.ToString();
@@ -59,7 +61,9 @@ OrbitAnalysis AnalyzeOrbit(const HybridModel& model, TimeBasedShooting& floquet_
   OrbitAnalysis a;
   const ShootingLayout& layout = floquet_map.layout();
   const Vector orbit = u.head(layout.num_orbit_unknowns());
-  if (!ClassifyByUnknowns(model, orbit, ClassificationOptions{}, &a.classification)) {  // no trace needed
+  if (options.known != nullptr) {
+    a.classification = options.known->classification;
+  } else if (!ClassifyByUnknowns(model, orbit, ClassificationOptions{}, &a.classification)) {  // no trace needed
     const OrbitTrace trace(model, orbit, options.integrator);
     a.classification = ClassifyOrbit(model, orbit, trace, ClassificationOptions{});
   }
@@ -80,9 +84,16 @@ OrbitAnalysis AnalyzeOrbit(const HybridModel& model, TimeBasedShooting& floquet_
       a.observables.push_back({observables[j].name, value});
     }
   }
-  Vector r;
-  const EvaluationStatus status = floquet_map.Evaluate(u, &r, nullptr);
-  a.residual = status.ok ? r.norm() : OrbitAnalysis::kUndefined;
+  if (options.known != nullptr && options.known->residual_known) {
+    a.residual = options.known->residual;  // from the test functions' evaluation at u
+  } else {
+    // With dr, as the corrector and the test functions evaluate the map: r of the same integration (one
+    // without sensitivities takes other steps, and its |r| of a converged point is that difference, ~1e-11).
+    Vector r;
+    Matrix dr;
+    const EvaluationStatus status = floquet_map.Evaluate(u, &r, &dr);
+    a.residual = status.ok ? r.norm() : OrbitAnalysis::kUndefined;
+  }
   return a;
 }
 

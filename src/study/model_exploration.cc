@@ -3,7 +3,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <map>
 #include <mutex>
+#include <optional>
+#include <string>
 #include <stdexcept>
 
 #include "family_boundaries.h"
@@ -62,6 +65,24 @@ class ModelExploration::TestWorkSink {
     const std::lock_guard<std::mutex> lock(mutex_);
     work_.counters += work;
   }
+  // What a copy learnt of an accepted point's orbit (FloquetTestFunctions::BranchPointAnalysis), kept until
+  // the exploration ends (ModelExploration::KnownBranchPointAnalysis), found by u's exact bits.
+  void Publish(const FloquetTestFunctions::BranchPointAnalysis& analysis) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    known_.insert_or_assign(Key(analysis.u), analysis);
+  }
+  // Kept after it is found: two half-branches that leave one point report it both (whichever copy evaluated
+  // it, the values are those of the one map at that u), so the analysis is that of one thread at any count.
+  std::optional<FloquetTestFunctions::BranchPointAnalysis> Find(const Vector& u) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = known_.find(Key(u));
+    if (it == known_.end()) return std::nullopt;
+    return it->second;
+  }
+  void ForgetPoints() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    known_.clear();
+  }
   TestFunctionWork work() {
     const std::lock_guard<std::mutex> lock(mutex_);
     const auto& curve = dynamic_cast<const ShootingProblem&>(*inner_);  // a clone of a shooting map
@@ -73,7 +94,11 @@ class ModelExploration::TestWorkSink {
   }
 
  private:
+  static std::string Key(const Vector& u) {
+    return std::string(reinterpret_cast<const char*>(u.data()), sizeof(double) * static_cast<std::size_t>(u.size()));
+  }
   std::mutex mutex_;
+  std::map<std::string, FloquetTestFunctions::BranchPointAnalysis> known_;
   std::unique_ptr<ZeroProblem> inner_;
   ScaledProblem curve_;
   TestFunctionWork work_;
@@ -120,6 +145,8 @@ class EngineFloquetTests : public TestFunctions {
       return;
     }
     floquet_->Evaluate(u, branch_point, values);
+    // An accepted point (a refined copy's tolerances are not the study's): what it learnt, for the analysis.
+    if (branch_point && !refined_ && floquet_->last_branch_point()) sink_->Publish(*floquet_->last_branch_point());
     if (!observables_) return;
     Vector more;
     observables_->Evaluate(u, branch_point, &more);
@@ -137,9 +164,11 @@ class EngineFloquetTests : public TestFunctions {
                                                 scales_, state_ ? state_->Clone() : nullptr, sink_);
   }
   std::unique_ptr<TestFunctions> Refined(double factor) const override {
-    return std::make_unique<EngineFloquetTests>(floquet_->Refined(factor),
-                                                observables_ ? observables_->Refined(factor) : nullptr, scales_,
-                                                state_ ? state_->Refined(factor) : nullptr, sink_);
+    auto refined = std::make_unique<EngineFloquetTests>(floquet_->Refined(factor),
+                                                        observables_ ? observables_->Refined(factor) : nullptr, scales_,
+                                                        state_ ? state_->Refined(factor) : nullptr, sink_);
+    refined->refined_ = true;
+    return refined;
   }
   void AddCurveWork(const ZeroProblem& copy) override { sink_->AddCurveWork(copy); }
 
@@ -155,6 +184,7 @@ class EngineFloquetTests : public TestFunctions {
   Vector scales_;
   std::unique_ptr<StateBasedShooting> state_;
   std::shared_ptr<ModelExploration::TestWorkSink> sink_;
+  bool refined_ = false;  // evaluates at other tolerances than the study's (error estimates)
 };
 
 }  // namespace
@@ -278,6 +308,12 @@ long ModelExploration::num_evaluations() const {
 }
 
 TestFunctionWork ModelExploration::test_function_work() const { return test_work_->work(); }
+
+std::optional<FloquetTestFunctions::BranchPointAnalysis> ModelExploration::KnownBranchPointAnalysis(const Vector& u) {
+  return test_work_->Find(u);
+}
+
+void ModelExploration::ForgetBranchPointAnalyses() { test_work_->ForgetPoints(); }
 
 Vector ModelExploration::FindPhysicalStart(std::string* why) {
   // Trace the time-based scenario's branches from its start until a point is physical.

@@ -14,6 +14,7 @@
 #include <memory>
 
 #include "hybridcont/exploration.h"
+#include "hybridcont/floquet_test_functions.h"
 #include "hybridcont/scaled_problem.h"
 #include "hybridcont/statebased_shooting.h"
 #include "hybridcont/timebased_shooting.h"
@@ -110,6 +111,14 @@ class ModelExploration {
   // (scaled); -1 for none.
   int BranchThrough(const BifurcationDiagram& d, const Vector& u) const;
   bool OnBranch(const BifurcationDiagram& d, const Vector& u) const { return BranchThrough(d, u) >= 0; }
+
+  // What the Floquet test functions learnt of the orbit at the accepted point u (time-based layout, model
+  // units, the exact u the point callback got): its class, replay, multipliers and residual (the point's
+  // analysis then integrates nothing again). Empty where they did not evaluate that point (a mapped
+  // image's, a state-based point's, a start at a singular point's).
+  std::optional<FloquetTestFunctions::BranchPointAnalysis> KnownBranchPointAnalysis(const Vector& u);
+  // Drops them all (after an exploration: the points of its traces are analysed).
+  void ForgetBranchPointAnalyses();
 
   FlowCounters counters() const;
   long num_evaluations() const;

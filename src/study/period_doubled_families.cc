@@ -86,7 +86,8 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
       if (log.H.find(id) == log.H.end()) writer.SetBranchModel(id, doubled, "period-doubled");
       PointRecord record = RecordOf(info, u);
       SetFreeParameters(layout, u, &at_point);
-      AnalyzePoint(at_point, setup.integrator, floquet_map, replay, &record);
+      const auto known = exploration.KnownBranchPointAnalysis(u);
+      AnalyzePoint(at_point, setup.integrator, floquet_map, replay, &record, known ? &*known : nullptr);
       log.stable[id].push_back(record.extra[1].second);
       log.H[id].push_back(u(layout.continued_index()));
       writer.AddPoint(id, record);

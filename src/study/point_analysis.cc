@@ -10,8 +10,10 @@ namespace hybridcont::study {
 ReplayOptions ReplayOptionsFor(const IntegratorOptions& integrator) { return OrbitAnalysisOptions::For(integrator).replay; }
 
 void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator, TimeBasedShooting& floquet_map,
-                  const ReplayOptions& replay_options, PointRecord* record) {
+                  const ReplayOptions& replay_options, PointRecord* record,
+                  const FloquetTestFunctions::BranchPointAnalysis* known) {
   OrbitAnalysisOptions options;
+  options.known = known;
   options.integrator = integrator;
   options.replay = replay_options;
   options.at_branch_point = record->at_branch_point;

@@ -25,8 +25,11 @@ ReplayOptions ReplayOptionsFor(const IntegratorOptions& integrator);
 // (SetFreeParameters); without, `model` is the map's model.
 // AnalyzeOrbit at record->u (with record->at_branch_point), into the record: classification, stability,
 // residual, observables and the extra columns.
+// `known`: what the exploration's Floquet test functions learnt of the point (ModelExploration::
+// KnownBranchPointAnalysis), used instead of integrating it again; null for none.
 void AnalyzePoint(const HybridModel& model, const IntegratorOptions& integrator, TimeBasedShooting& floquet_map,
-                  const ReplayOptions& replay_options, PointRecord* record);
+                  const ReplayOptions& replay_options, PointRecord* record,
+                  const FloquetTestFunctions::BranchPointAnalysis* known = nullptr);
 
 // Whether the time-based point u (the model's own layout) is a physical orbit of the model (classified by
 // its unknowns, or else along its trace).

@@ -73,7 +73,9 @@ class PointStream {
     }
     PointRecord record = RecordOf(info, u);
     if (point_model_) SetFreeParameters(floquet_map_.layout(), u, point_model_.get());
-    AnalyzePoint(point_model_ ? *point_model_ : model_, setup_.integrator, floquet_map_, replay_options_, &record);
+    const auto known = exploration_.KnownBranchPointAnalysis(u);
+    AnalyzePoint(point_model_ ? *point_model_ : model_, setup_.integrator, floquet_map_, replay_options_, &record,
+                 known ? &*known : nullptr);
     writer_.AddPoint(info.branch_id, record);
     log_.physical[info.branch_id].push_back(record.classification.physical);
   }
@@ -310,6 +312,7 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   }
   if (formulation == Formulation::kStateBased) ConvertToTimeBased(exploration, layout, &diagram);
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
+  exploration.ForgetBranchPointAnalyses();  // every point of the exploration has been analysed
   result->status = diagram.status;
   result->message = diagram.message;
   result->diagram = diagram;

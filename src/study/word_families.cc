@@ -242,7 +242,8 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
       const int branch = info.branch_id + offset;
       if (info.point_index == 0) writer.SetBranchModel(branch, *w.model, automaton.WordName(w.word));
       PointRecord record = RecordOf(info, v);
-      AnalyzePoint(*w.model, integrator, floquet_map, replay, &record);
+      const auto known = w.exploration->KnownBranchPointAnalysis(v);
+      AnalyzePoint(*w.model, integrator, floquet_map, replay, &record, known ? &*known : nullptr);
       writer.AddPoint(branch, record);
     }, &skipped);
     if (d.status == ExplorationStatus::kStartFailed) return d;
