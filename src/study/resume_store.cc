@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "hybridcont/version.h"
+#include "json_fields.h"
 
 namespace hybridcont::study {
 
@@ -22,17 +23,6 @@ nlohmann::json NumberJson(double x) {
   return x;
 }
 
-double NumberFrom(const nlohmann::json& j, const std::string& where) {
-  if (j.is_number()) return j.get<double>();
-  if (j.is_string()) {
-    const std::string s = j.get<std::string>();
-    if (s == "nan") return std::numeric_limits<double>::quiet_NaN();
-    if (s == "inf") return std::numeric_limits<double>::infinity();
-    if (s == "-inf") return -std::numeric_limits<double>::infinity();
-  }
-  throw std::invalid_argument(where + ": expected a number, found " + j.dump());
-}
-
 nlohmann::json VectorJson(const Vector& v) {
   nlohmann::json a = nlohmann::json::array();
   for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(NumberJson(v(i)));
@@ -42,32 +32,13 @@ nlohmann::json VectorJson(const Vector& v) {
 Vector VectorFrom(const nlohmann::json& j, const std::string& where) {
   if (!j.is_array()) throw std::invalid_argument(where + ": expected a list of numbers");
   Vector v(static_cast<Eigen::Index>(j.size()));
-  for (std::size_t i = 0; i < j.size(); ++i) v(static_cast<Eigen::Index>(i)) = NumberFrom(j[i], where + "[" + std::to_string(i) + "]");
+  for (std::size_t i = 0; i < j.size(); ++i) v(static_cast<Eigen::Index>(i)) = JsonNumberValue(j[i], where + "[" + std::to_string(i) + "]");
   return v;
-}
-
-const nlohmann::json& At(const nlohmann::json& j, const char* key, const std::string& where) {
-  if (!j.is_object() || !j.contains(key)) throw std::invalid_argument(where + "." + key + ": missing");
-  return j.at(key);
-}
-
-int IntFrom(const nlohmann::json& j, const char* key, const std::string& where) {
-  const nlohmann::json& v = At(j, key, where);
-  if (!v.is_number_integer()) throw std::invalid_argument(where + "." + key + ": expected an integer");
-  const long long x = v.get<long long>();
-  if (x < -1000000000LL || x > 1000000000LL) throw std::invalid_argument(where + "." + key + ": out of range");
-  return static_cast<int>(x);
-}
-
-std::string TextFrom(const nlohmann::json& j, const char* key, const std::string& where) {
-  const nlohmann::json& v = At(j, key, where);
-  if (!v.is_string()) throw std::invalid_argument(where + "." + key + ": expected a string");
-  return v.get<std::string>();
 }
 
 template <typename Enum>
 Enum EnumFrom(const nlohmann::json& j, const char* key, const std::string& where, Enum last) {
-  const int v = IntFrom(j, key, where);
+  const int v = JsonInt(j, key, where);
   if (v < 0 || v > static_cast<int>(last)) throw std::invalid_argument(where + "." + key + ": out of range");
   return static_cast<Enum>(v);
 }
@@ -97,26 +68,26 @@ nlohmann::json SpecialPointJson(const SpecialPoint& p) {
 
 SpecialPoint SpecialPointFrom(const nlohmann::json& j, const std::string& where) {
   SpecialPoint p;
-  p.id = IntFrom(j, "id", where);
+  p.id = JsonInt(j, "id", where);
   p.type = EnumFrom(j, "type", where, SpecialPointType::kKreinCollision);
   p.status = EnumFrom(j, "status", where, LocationStatus::kBracketed);
-  p.branch_id = IntFrom(j, "branch_id", where);
-  p.index = IntFrom(j, "index", where);
-  p.arclength = NumberFrom(At(j, "arclength", where), where + ".arclength");
-  p.component = TextFrom(j, "component", where);
-  p.component_index = IntFrom(j, "component_index", where);
-  p.u = VectorFrom(At(j, "u", where), where + ".u");
-  p.tangent = VectorFrom(At(j, "tangent", where), where + ".tangent");
-  p.tangent_before = VectorFrom(At(j, "tangent_before", where), where + ".tangent_before");
-  p.tangent_after = VectorFrom(At(j, "tangent_after", where), where + ".tangent_after");
-  p.test_value = NumberFrom(At(j, "test_value", where), where + ".test_value");
-  p.interval_lo = NumberFrom(At(j, "interval_lo", where), where + ".interval_lo");
-  p.interval_hi = NumberFrom(At(j, "interval_hi", where), where + ".interval_hi");
-  p.interval_width = VectorFrom(At(j, "interval_width", where), where + ".interval_width");
-  p.residual_norm = NumberFrom(At(j, "residual_norm", where), where + ".residual_norm");
-  p.iterations = IntFrom(j, "iterations", where);
-  p.duplicate_of = IntFrom(j, "duplicate_of", where);
-  p.message = TextFrom(j, "message", where);
+  p.branch_id = JsonInt(j, "branch_id", where);
+  p.index = JsonInt(j, "index", where);
+  p.arclength = JsonNumber(j, "arclength", where);
+  p.component = JsonText(j, "component", where);
+  p.component_index = JsonInt(j, "component_index", where);
+  p.u = VectorFrom(JsonField(j, "u", where), where + ".u");
+  p.tangent = VectorFrom(JsonField(j, "tangent", where), where + ".tangent");
+  p.tangent_before = VectorFrom(JsonField(j, "tangent_before", where), where + ".tangent_before");
+  p.tangent_after = VectorFrom(JsonField(j, "tangent_after", where), where + ".tangent_after");
+  p.test_value = JsonNumber(j, "test_value", where);
+  p.interval_lo = JsonNumber(j, "interval_lo", where);
+  p.interval_hi = JsonNumber(j, "interval_hi", where);
+  p.interval_width = VectorFrom(JsonField(j, "interval_width", where), where + ".interval_width");
+  p.residual_norm = JsonNumber(j, "residual_norm", where);
+  p.iterations = JsonInt(j, "iterations", where);
+  p.duplicate_of = JsonInt(j, "duplicate_of", where);
+  p.message = JsonText(j, "message", where);
   return p;
 }
 
@@ -181,31 +152,31 @@ nlohmann::json BranchToJson(const Branch& b) {
 
 Branch BranchFromJson(const nlohmann::json& j, const std::string& where) {
   Branch b;
-  b.id = IntFrom(j, "id", where);
-  b.direction = IntFrom(j, "direction", where);
-  b.parent_special_point = IntFrom(j, "parent_special_point", where);
-  b.depth = IntFrom(j, "depth", where);
-  const nlohmann::json& points = At(j, "points", where);
+  b.id = JsonInt(j, "id", where);
+  b.direction = JsonInt(j, "direction", where);
+  b.parent_special_point = JsonInt(j, "parent_special_point", where);
+  b.depth = JsonInt(j, "depth", where);
+  const nlohmann::json& points = JsonField(j, "points", where);
   if (!points.is_array()) throw std::invalid_argument(where + ".points: expected a list");
   for (std::size_t i = 0; i < points.size(); ++i) {
     const std::string at = where + ".points[" + std::to_string(i) + "]";
     const nlohmann::json& q = points[i];
     ContinuationPoint p;
-    p.u = VectorFrom(At(q, "u", at), at + ".u");
-    p.tangent = VectorFrom(At(q, "tangent", at), at + ".tangent");
-    p.arclength = NumberFrom(At(q, "arclength", at), at + ".arclength");
-    p.step = NumberFrom(At(q, "step", at), at + ".step");
-    p.newton_iterations = IntFrom(q, "newton_iterations", at);
-    p.contraction = NumberFrom(At(q, "contraction", at), at + ".contraction");
-    p.sb_test = NumberFrom(At(q, "sb_test", at), at + ".sb_test");
-    p.test_values = VectorFrom(At(q, "test_values", at), at + ".test_values");
+    p.u = VectorFrom(JsonField(q, "u", at), at + ".u");
+    p.tangent = VectorFrom(JsonField(q, "tangent", at), at + ".tangent");
+    p.arclength = JsonNumber(q, "arclength", at);
+    p.step = JsonNumber(q, "step", at);
+    p.newton_iterations = JsonInt(q, "newton_iterations", at);
+    p.contraction = JsonNumber(q, "contraction", at);
+    p.sb_test = JsonNumber(q, "sb_test", at);
+    p.test_values = VectorFrom(JsonField(q, "test_values", at), at + ".test_values");
     if (p.u.size() == 0 || p.tangent.size() != p.u.size() ||
         (!b.points.empty() && p.u.size() != b.points.front().u.size())) {
       throw std::invalid_argument(at + ": u and tangent must have the branch's one size");
     }
     b.points.push_back(std::move(p));
   }
-  const nlohmann::json& special = At(j, "special_points", where);
+  const nlohmann::json& special = JsonField(j, "special_points", where);
   if (!special.is_array()) throw std::invalid_argument(where + ".special_points: expected a list");
   const Eigen::Index n = b.points.empty() ? 0 : b.points.front().u.size();
   for (std::size_t i = 0; i < special.size(); ++i) {
@@ -220,13 +191,13 @@ Branch BranchFromJson(const nlohmann::json& j, const std::string& where) {
     b.special_points.push_back(std::move(p));
   }
   b.termination = EnumFrom(j, "termination", where, TerminationReason::kStartFailed);
-  b.message = TextFrom(j, "message", where);
-  b.newton_iterations = IntFrom(j, "newton_iterations", where);
-  b.rejected_steps = IntFrom(j, "rejected_steps", where);
-  b.located_iterations = IntFrom(j, "located_iterations", where);
-  b.image_of = IntFrom(j, "image_of", where);
-  b.symmetry = TextFrom(j, "symmetry", where);
-  b.reflected_from = IntFrom(j, "reflected_from", where);
+  b.message = JsonText(j, "message", where);
+  b.newton_iterations = JsonInt(j, "newton_iterations", where);
+  b.rejected_steps = JsonInt(j, "rejected_steps", where);
+  b.located_iterations = JsonInt(j, "located_iterations", where);
+  b.image_of = JsonInt(j, "image_of", where);
+  b.symmetry = JsonText(j, "symmetry", where);
+  b.reflected_from = JsonInt(j, "reflected_from", where);
   if (b.reflected_from < -1 || b.reflected_from >= static_cast<int>(b.points.size())) {
     throw std::invalid_argument(where + ".reflected_from: beyond the branch's points");
   }
