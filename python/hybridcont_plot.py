@@ -444,7 +444,13 @@ def special_point_style(kind, bracketed, meanings=None):
     }
     style = dict(styles.get(kind, dict(marker="X", s=46, facecolor="#9467bd", edgecolor="black")))
     meaning = meanings.get(kind) if isinstance(meanings, dict) else None
-    style["name"] = "%s %s" % (kind, meaning) if isinstance(meaning, str) and meaning else str(kind)
+    if not (isinstance(meaning, str) and meaning):
+        style["name"] = str(kind)
+    elif meaning.replace(" ", "-").endswith(kind):  # "start": its meaning alone ("singular start")
+        style["name"] = meaning
+    else:
+        style["name"] = "%s %s" % (kind, meaning.replace("floquet", "Floquet").replace("neimark sacker", "Neimark-Sacker")
+                                   .replace("krein", "Krein"))
     style["linewidth"] = 1.0
     if bracketed:
         style["edgecolor"] = "0.55"
