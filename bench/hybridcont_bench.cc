@@ -13,12 +13,14 @@
 #include <map>
 
 #include <filesystem>
+#include <fstream>
 
 #include "hybridcont/corrector.h"
 #include "hybridcont/model_file.h"
 #include "hybridcont/models.h"
 #include "hybridcont/study.h"
 #include "model_exploration.h"
+#include "../tests/mass_chain_text.h"
 
 namespace hybridcont::study {
 namespace {
@@ -296,34 +298,19 @@ void BM_ScalingNewtonStep(benchmark::State& state) {
 }
 BENCHMARK(BM_ScalingNewtonStep)->Arg(1)->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// A chain of `masses` masses on springs with an elastic stop (models/mass-chain.toml has 12): one phase of
-// 2·masses states, on the fixed-capacity jets up to 16 states and on the dynamic-size path above.
-std::string MassChainText(int masses) {
-  std::string states, ode, kinetic, potential = "x1^2", reset, flip;
-  for (int i = 1; i <= masses; ++i) {
-    const std::string x = "x" + std::to_string(i), v = "v" + std::to_string(i);
-    const std::string left = i > 1 ? "x" + std::to_string(i - 1) : "0";
-    const std::string acc = i < masses ? "k/m*(" + left + " - 2*" + x + " + x" + std::to_string(i + 1) + ")"
-                                       : "k/m*(" + left + " - " + x + ")";
-    states += (i > 1 ? ", \"" : "\"") + x + "\"";
-    ode += (i > 1 ? ", " : "") + x + " = \"" + v + "\", " + v + " = \"" + acc + "\"";
-    kinetic += (i > 1 ? " + " : "") + v + "^2";
-    if (i > 1) potential += " + (" + x + " - x" + std::to_string(i - 1) + ")^2";
-    reset += (i > 1 ? ", " : "") + x + " = \"" + x + "\", " + v + " = \"" + (i < masses ? v : "-" + v) + "\"";
-  }
-  for (int i = 1; i <= masses; ++i) states += ", \"v" + std::to_string(i) + "\"";
-  const std::string last = std::to_string(masses);
-  return "hybridcont = 1\nname = \"mass-chain\"\n[parameters]\nm = { value = 1.0 }\nk = { value = 1.0 }\n"
-         "[[phases]]\nname = \"free\"\nstates = [" + states + "]\node = { " + ode + " }\nenergy = \"0.5*m*(" +
-         kinetic + ") + 0.5*k*(" + potential + ")\"\nevent = \"-x" + last + "\"\nanchor = \"-v" + last +
-         "\"\nreset = { " + reset + " }\n[start]\nkind = \"singular\"\n";
-}
-
-// One r + dr evaluation of the time-based map of the mass chain against its state dimension (interpreted,
-// both paths): the cost of a continuation point is 3–4 of them.
+// One r + dr evaluation of the time-based map of the mass chain against its state dimension:
+// BM_LargeModelEvaluate/<masses>/<variant>, variant 0 interpreted, 1 compiled (generated code, cache warm).
+// A continuation point costs 2–3 of them (bench/README.md).
 void BM_LargeModelEvaluate(benchmark::State& state) {
   const int masses = static_cast<int>(state.range(0));
-  const HybridModel model = BuildExpressionModel(ParseModelText(MassChainText(masses), "mass-chain.toml"), nullptr);
+  const bool compiled = state.range(1) == 1;
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("hybridcont-bench-mass-chain-" + std::to_string(masses) + ".toml");
+  std::ofstream(file) << test_models::MassChainText(masses);
+  ModelFileOptions options;
+  options.compile = compiled;
+  options.cache_dir = std::filesystem::temp_directory_path() / "hybridcont-bench-cache";
+  const HybridModel model = LoadModelFile(file, options);
   TimeBasedShooting shooting(model, IntegratorOptions{});
   shooting.set_threads(1);
   const ShootingLayout& layout = shooting.layout();
@@ -343,7 +330,9 @@ void BM_LargeModelEvaluate(benchmark::State& state) {
   state.counters["rhs_per_eval"] =
       static_cast<double>(shooting.counters().rhs_evaluations) / static_cast<double>(shooting.num_evaluations());
 }
-BENCHMARK(BM_LargeModelEvaluate)->Arg(2)->Arg(4)->Arg(6)->Arg(8)->Arg(9)->Arg(12)->Arg(16)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LargeModelEvaluate)
+    ->ArgsProduct({{2, 4, 6, 8, 9, 12, 16, 20, 24}, {0, 1}})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace hybridcont::study

@@ -201,5 +201,67 @@ TEST(FloquetTestFunctions, WorkIsCountedApartFromTheContinuations) {
   EXPECT_GT(run.evaluations, 0);
 }
 
+// An accepted point's values from the corrector's last evaluation (FloquetTestFunctions::
+// EvaluateAtBranchPoint): the map that continuation evaluated at an iterate 1e-9 from the point serves every
+// Floquet function without an integration of the test functions' own, with the values of an own evaluation
+// at the point to the iterate's distance, and the point's residual extrapolated to the point (|r| at the
+// iterate is ~|dr|·1e-9, at the point ~1e-15). A map that evaluated elsewhere is not taken.
+TEST(FloquetTestFunctions, AcceptedPointValuedFromTheCorrectorsEvaluation) {
+  const ExplorationRun run = Explore("slip");
+  EXPECT_GT(run.tests.reused_points, 0);
+  TimeBasedShooting continued(run.model, IntegratorOptions{});
+  const int iH = continued.UnknownIndex("H");
+  const Branch* hopping = nullptr;  // the family through the first PD point: physical, with multipliers
+  const std::vector<const SpecialPoint*> pd = PdPoints(run.diagram);
+  ASSERT_FALSE(pd.empty());
+  hopping = &run.diagram.branches.at(pd.front()->branch_id);
+  const Vector u = hopping->points.at(pd.front()->index).u;
+  Vector direction = Vector::Ones(u.size()).normalized();
+  const Vector at = u + 1e-9 * direction;
+  Vector r;
+  Matrix dr;
+  ASSERT_TRUE(continued.Evaluate(at, &r, &dr).ok);
+  const long continued_evaluations = continued.num_evaluations();
+
+  FloquetTestFunctions reusing(run.model, IntegratorOptions{}), own(run.model, IntegratorOptions{});
+  Vector from_corrector, from_own;
+  reusing.EvaluateAtBranchPoint(u, &continued, at, &from_corrector);
+  own.Evaluate(u, true, &from_own);
+  EXPECT_EQ(reusing.reused_evaluations(), 1);
+  EXPECT_EQ(reusing.shooting().num_evaluations(), 0);
+  EXPECT_EQ(continued.num_evaluations(), continued_evaluations);  // its cache served
+  EXPECT_EQ(own.shooting().num_evaluations(), 1);
+  ASSERT_EQ(from_corrector.size(), from_own.size());
+  for (Eigen::Index j = 0; j < from_own.size(); ++j) {
+    if (std::isnan(from_own(j))) {
+      EXPECT_TRUE(std::isnan(from_corrector(j))) << j;
+    } else {
+      EXPECT_NEAR(from_corrector(j), from_own(j), 1e-6 * (1 + std::abs(from_own(j)))) << j << " at H " << u(iH);
+    }
+  }
+  ASSERT_TRUE(reusing.last_branch_point() && own.last_branch_point());
+  const auto& a = *reusing.last_branch_point();
+  const auto& b = *own.last_branch_point();
+  EXPECT_TRUE(a.classification.physical);
+  ASSERT_TRUE(a.floquet_known && b.floquet_known);
+  ASSERT_EQ(a.floquet.nontrivial.size(), b.floquet.nontrivial.size());
+  for (std::size_t j = 0; j < a.floquet.nontrivial.size(); ++j) {
+    EXPECT_LT(std::abs(a.floquet.nontrivial[j] - b.floquet.nontrivial[j]), 1e-6) << j;
+  }
+  ASSERT_TRUE(a.residual_known && b.residual_known);
+  EXPECT_GT(r.norm(), 1e-11);      // the iterate's own residual
+  EXPECT_LT(a.residual, 1e-12);    // extrapolated to the point
+  EXPECT_LT(b.residual, 1e-12);
+
+  // The map evaluated elsewhere since: the functions integrate u themselves.
+  ASSERT_TRUE(continued.Evaluate(u + 1e-3 * direction, &r, &dr).ok);
+  FloquetTestFunctions fallback(run.model, IntegratorOptions{});
+  Vector values;
+  fallback.EvaluateAtBranchPoint(u, &continued, at, &values);
+  EXPECT_EQ(fallback.reused_evaluations(), 0);
+  EXPECT_EQ(fallback.shooting().num_evaluations(), 1);
+  EXPECT_NEAR(values(1), from_own(1), 1e-12 * (1 + std::abs(from_own(1))));
+}
+
 }  // namespace
 }  // namespace hybridcont

@@ -227,7 +227,9 @@ TEST(Study, CheckStudyOptionsSaysWhatTheStudyWouldChange) {
 }
 
 // Each accepted point is integrated for its analysis no more: its class, replay, multipliers and residual are
-// those the Floquet test functions found there (at the study's tolerances), equal to an analysis of its own.
+// those the Floquet test functions found there (at the study's tolerances), equal to an analysis of its own:
+// the class, stability and replay to the bit (they are u's own), the multipliers to 1e-6 (they are those of
+// the corrector's last evaluation, at an iterate within 1e-8 (1 + |u|) of u), the residual to 1e-12.
 TEST(Study, APointsAnalysisIsTheTestFunctionsAndEqualsItsOwn) {
   const StudyResult study = RunStudy(Slip());
   int points = 0;
@@ -245,7 +247,9 @@ TEST(Study, APointsAnalysisIsTheTestFunctionsAndEqualsItsOwn) {
     EXPECT_EQ(p.analysis.stability, own.stability);
     EXPECT_EQ(p.analysis.replay_error, own.replay_error);
     ASSERT_EQ(p.analysis.multipliers.size(), own.multipliers.size());
-    for (std::size_t j = 0; j < own.multipliers.size(); ++j) EXPECT_EQ(p.analysis.multipliers[j], own.multipliers[j]);
+    for (std::size_t j = 0; j < own.multipliers.size(); ++j) {
+      EXPECT_LE(std::abs(p.analysis.multipliers[j] - own.multipliers[j]), 1e-6) << j << " " << own.multipliers[j];
+    }
     EXPECT_NEAR(p.analysis.residual, own.residual, 1e-12);
     ++compared;
   }

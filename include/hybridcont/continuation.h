@@ -105,6 +105,10 @@ struct ContinuationPoint {
   double sb_test = 0;
   // ContinuationOptions::test_functions at u (NaN where undefined); empty without test functions.
   Vector test_values;
+  // Where the test functions took their values from the corrector's last evaluation
+  // (TestFunctions::EvaluateAtBranchPoint): that iterate, within CorrectorOptions::max_jacobian_distance of u;
+  // empty where they are u's own.
+  Vector evaluated_at;
 };
 
 // What the progress callback sees after every accepted point (the library itself never prints).

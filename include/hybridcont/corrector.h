@@ -154,9 +154,12 @@ class Corrector {
   // Dispatches on type (pseudo-arclength or Moore–Penrose) with τ as hyperplane normal / tangent guess.
   CorrectorResult Correct(CorrectorType type, const Vector& u_pred, const Vector& tau, Vector* u);
 
-  // r and dr at the u returned by the last call (valid when it converged): the stepper reuses dr for the
-  // tangent, so a converged point costs no extra evaluation.
+  // r and dr of the last call's last evaluation, at evaluated_point(): the returned u itself, or, for a point
+  // accepted after a full Newton step or on an error estimate, the iterate before it, at most
+  // max_jacobian_distance·(1 + ||u||) away (CorrectorOptions). The stepper takes the tangent from this dr and
+  // the test functions their values (test_function.h), so a converged point costs no extra evaluation.
   const Vector& residual() const;
+  const Vector& evaluated_point() const;
   const Matrix& jacobian() const;
   // The same as a sparse matrix (no dense copy for problems that prefer sparse Jacobians).
   const SparseMatrix& sparse_jacobian() const;

@@ -82,8 +82,19 @@ enum class ProgramKind { kVectorField = 0, kIntegrals = 1, kEvent = 2, kReset = 
 
 // Scalar types a program runs over: double, the fixed-size first-order jet of the phase's dimension,
 // the fixed-size second-order jet (HessianJet), and the bounded-dynamic jets used above kMaxFixedJetDim.
-enum class ScalarKind { kDouble = 0, kFixedJet = 1, kHessianJet = 2, kDynamicJet = 3, kDynamicJet2 = 4 };
-inline constexpr int kNumScalarKinds = 5;
+// kValueJacobian is no scalar type but an entry of phases above kMaxPhaseDim (the dynamic-size path,
+// which has no jets of a fixed capacity to pass): fn(x, p, out) with x the n states and out the k outputs
+// followed by their k x n Jacobian, row-major, all doubles; generated code evaluates it over jets of the
+// phase's exact dimension on the stack.
+enum class ScalarKind {
+  kDouble = 0,
+  kFixedJet = 1,
+  kHessianJet = 2,
+  kDynamicJet = 3,
+  kDynamicJet2 = 4,
+  kValueJacobian = 5
+};
+inline constexpr int kNumScalarKinds = 6;
 
 namespace internal {
 template <class T> struct IsHessianJet : std::false_type {};

@@ -85,6 +85,21 @@ class FloquetTestFunctions : public TestFunctions {
 
   std::vector<SpecialPointType> types() const override;
   void Evaluate(const Vector& u, bool branch_point, Vector* values) override;
+  // At a branch point u, from `map`'s evaluation at `at` (a point within the corrector's distance,
+  // TestFunctions::EvaluateAtBranchPoint) where map is this object's map in layout and integrator and holds
+  // that evaluation (TimeBasedShooting::HoldsEvaluation): the multipliers, the BP, PD, NS and Krein tests and
+  // the crossing speeds are then `at`'s, r's norm too (BranchPointAnalysis::residual), and nothing of the map
+  // is integrated again; the class, the replay and the own events' minima are u's; returns true. Otherwise
+  // Evaluate(u, true, values), false.
+  bool EvaluateAtBranchPoint(const Vector& u, TimeBasedShooting* map, const Vector& at, Vector* values);
+  // At a branch point u that is the image of another under a symmetry of the map (TestFunctions::
+  // EvaluateAtImage), whose residual is `preimage_residual` (null: not known): the map is evaluated only where
+  // a value needs it (the Floquet functions of a physical orbit, the crossing speeds); elsewhere, e.g. on a
+  // time-reversed image of a physical family, the point is classified alone and its residual is the
+  // preimage's (the symmetry maps r(u) to r of the image up to signs: the same norm).
+  void EvaluateAtImage(const Vector& u, const double* preimage_residual, Vector* values);
+  // Branch points whose values came from another map's evaluation (EvaluateAtBranchPoint).
+  long reused_evaluations() const { return reused_evaluations_; }
   // A zero of the Neimark–Sacker function is kept where a complex pair lies on the unit circle (within
   // kUnitPairTolerance); a zero from two real multipliers of product 1 (a neutral saddle) is dropped.
   bool Keep(int function, const Vector& u, std::string* note) override;
@@ -117,7 +132,7 @@ class FloquetTestFunctions : public TestFunctions {
     ReplayResult replay;
     bool floquet_known = false;   // floquet holds the multipliers
     FloquetResult floquet;
-    bool residual_known = false;  // residual holds |r(u)| (the map could be evaluated at u)
+    bool residual_known = false;  // residual holds |r| of the map's evaluation (at u, or EvaluateAtBranchPoint's `at`)
     double residual = 0;
   };
   const std::optional<BranchPointAnalysis>& last_branch_point() const { return last_branch_point_; }
@@ -129,6 +144,12 @@ class FloquetTestFunctions : public TestFunctions {
  private:
   // The model at u's free-parameter values (nullptr outside a parameter's range).
   const HybridModel* ModelAt(const Vector& u_free) const;
+  // Evaluate's work at u, with the map's values from map's evaluation at `at` (at = u on shooting_); with
+  // image_residual, the map is evaluated only where a value needs it (EvaluateAtImage).
+  void EvaluateOn(TimeBasedShooting* map, const Vector& at, const Vector& u, bool branch_point, Vector* values,
+                  const double* image_residual = nullptr);
+  // map has shooting_'s unknowns, equations and integrator options.
+  bool SameMap(const TimeBasedShooting& map) const;
   // The class of u; with `trace`, the integrated orbit too (null where the unknowns alone decide).
   Classification Classify(const HybridModel& model, const Vector& u,
                           std::unique_ptr<OrbitTrace>* trace = nullptr) const;
@@ -157,6 +178,7 @@ class FloquetTestFunctions : public TestFunctions {
   std::vector<Observable> own_events_;
   std::vector<char> own_defined_;  // per phase: whether the last branch point had a value
   std::optional<BranchPointAnalysis> last_branch_point_;
+  long reused_evaluations_ = 0;
 };
 
 }  // namespace hybridcont

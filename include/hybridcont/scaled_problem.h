@@ -48,6 +48,8 @@ class ScaledProblem : public ZeroProblem {
   Vector ToScaled(const Vector& u) const { return u.cwiseQuotient(scales_); }
   Vector FromScaled(const Vector& v) const { return v.cwiseProduct(scales_); }
   const Vector& scales() const { return scales_; }
+  // The problem in model units this scaling wraps.
+  ZeroProblem* wrapped() const { return problem_; }
 
  private:
   // This scaling around `inner` (owned); nullptr for a null inner.

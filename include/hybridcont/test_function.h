@@ -51,12 +51,36 @@ class TestFunctions {
   // branch_point: u is an accepted branch point (a provider checks there what must hold along a whole step,
   // e.g. that the orbit is physical); otherwise u is a trial point of the root finder between two of them.
   virtual void Evaluate(const Vector& u, bool branch_point, Vector* values) = 0;
+  // The continued problem as the corrector left it at an accepted branch point u: `problem` (the stepper's
+  // own copy) last evaluated r and dr at `at`, the corrector's last iterate, at most
+  // CorrectorOptions::max_jacobian_distance·(1 + ||u||) from u (corrector.h, evaluated_point()). A provider
+  // whose values come from the same map may take them from that evaluation instead of integrating u again:
+  // they are then those of a point within that distance, equal to u's to the map's precision, and it returns
+  // true (the point records `at`, ContinuationPoint::evaluated_at). The default evaluates at u (Evaluate(u,
+  // true, values)) and returns false. The stepper calls it instead of Evaluate at every branch point it
+  // corrected; at others (a singular start, a mapped branch) it calls Evaluate.
+  struct CorrectorEvaluation {
+    ZeroProblem* problem = nullptr;
+    Vector at;
+  };
+  virtual bool EvaluateAtBranchPoint(const Vector& u, const CorrectorEvaluation& evaluation, Vector* values) {
+    (void)evaluation;
+    Evaluate(u, true, values);
+    return false;
+  }
   // Called once for each zero of function `function` located at u: false drops it (a zero that marks no
   // special point of its type, e.g. a neutral saddle of a Neimark–Sacker test); *note is added to its
   // message. The default keeps every zero.
   virtual bool Keep(int function, const Vector& u, std::string* note) {
     (void)function, (void)u, (void)note;
     return true;
+  }
+  // At a branch point u of a branch mapped by a symmetry of the continued problem (exploration.h), the image
+  // of the branch point `preimage` whose values were taken before: a provider may take what the symmetry
+  // leaves invariant from what it learnt there. The default evaluates at u (Evaluate(u, true, values)).
+  virtual void EvaluateAtImage(const Vector& u, const Vector& preimage, Vector* values) {
+    (void)preimage;
+    Evaluate(u, true, values);
   }
   // An independent copy for another stepper (another thread): its own scratch space.
   virtual std::unique_ptr<TestFunctions> Clone() const = 0;

@@ -94,6 +94,14 @@ class TimeBasedShooting : public ShootingProblem {
     HYBRIDCONT_DEMAND(i >= 0 && i < static_cast<int>(flows_.size()));
     return flows_[i];
   }
+  // Whether the last integration was at exactly u (same bits), succeeded, and holds the sensitivities at
+  // least as exact as `jacobian_tolerance` asks (set_jacobian_tolerance): Evaluate(u, r, dr) then integrates
+  // nothing and counts no evaluation, and segment_flow(i) is u's. A caller that finds the map a continuation
+  // has just evaluated takes its r, dr and flows without integrating again (FloquetTestFunctions).
+  bool HoldsEvaluation(const Vector& u, double jacobian_tolerance) const {
+    return cache_valid_ && cached_status_.ok && cached_sensitivities_ && cached_u_.size() == u.size() &&
+           cached_u_ == u && cached_jacobian_tolerance_ <= jacobian_tolerance;
+  }
   // Threads integrating the segments of one evaluation, the calling thread included; 1 integrates on the
   // calling thread alone. Only as many as get the minimum number of segments below take part (waking a
   // thread costs more than it saves on fewer). Default: the machine's cores. Throws

@@ -141,7 +141,10 @@ bool HasArmedEventMinimum(const HybridModel& model, const OrbitTrace& trace, int
 
 void FloquetTestFunctions::EvaluateOwnEvents(const Vector& u, const OrbitTrace* trace, Vector* values) {
   const int m = model_->num_phases();
-  const HybridModel& model = shooting_.model();  // at u's parameter values (after shooting_.Evaluate)
+  // The evaluator reads the parameter values of the model it is made on: the model at u's (ModelAt).
+  const HybridModel* at_u = ModelAt(u);
+  if (at_u == nullptr) return;
+  const HybridModel& model = *at_u;
   if (!own_event_evaluator_) {
     own_event_evaluator_ = std::make_unique<ObservableEvaluator>(model, shooting_.layout(), integrator_);
     for (int i = 0; i < m; ++i) own_events_.push_back(OwnEventObservable(model, i));
@@ -179,29 +182,44 @@ bool FloquetTestFunctions::GrazingEndsPhysicalFamily(const Vector& u_free) const
 }
 
 void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* values) {
+  EvaluateOn(&shooting_, u, u, branch_point, values);
+}
+
+void FloquetTestFunctions::EvaluateAtImage(const Vector& u, const double* preimage_residual, Vector* values) {
+  EvaluateOn(&shooting_, u, u, true, values, preimage_residual);
+}
+
+bool FloquetTestFunctions::SameMap(const TimeBasedShooting& map) const {
+  const IntegratorOptions& o = map.integrator_options();
+  return map.num_equations() == shooting_.num_equations() && map.unknown_names() == shooting_.unknown_names() &&
+         o.method == integrator_.method && o.rtol == integrator_.rtol && o.atol == integrator_.atol &&
+         o.initial_step == integrator_.initial_step && o.min_step == integrator_.min_step &&
+         o.max_steps == integrator_.max_steps;
+}
+
+bool FloquetTestFunctions::EvaluateAtBranchPoint(const Vector& u, TimeBasedShooting* map, const Vector& at,
+                                                 Vector* values) {
+  if (map != nullptr && SameMap(*map) && map->HoldsEvaluation(at, shooting_.jacobian_tolerance())) {
+    EvaluateOn(map, at, u, true, values);
+    ++reused_evaluations_;
+    return true;
+  }
+  Evaluate(u, true, values);
+  return false;
+}
+
+void FloquetTestFunctions::EvaluateOn(TimeBasedShooting* map, const Vector& at, const Vector& u, bool branch_point,
+                                      Vector* values, const double* image_residual) {
   const int m = model_->num_phases();
   const int ns = 2 + m;  // the Neimark–Sacker function, then (conservative) the Krein one
   const bool krein = model_->num_first_integrals() > 0;
   *values = Vector::Constant(ns + 1 + (krein ? 1 : 0) + m, std::numeric_limits<double>::quiet_NaN());
-  // r comes with dr at no cost: a branch point's residual, for its analysis.
-  const bool evaluated = shooting_.Evaluate(u, branch_point ? &r_ : nullptr, &dr_).ok;
   // A branch point's class: it decides whether the Floquet functions are defined there (physical_only) and,
   // for a conservative model, whether the crossing speeds are (see below).
   const HybridModel* model_at_u = branch_point ? ModelAt(u) : model_;
   Classification c;
   std::unique_ptr<OrbitTrace> trace;
   if (branch_point && model_at_u != nullptr) c = Classify(*model_at_u, u.head(base_unknowns_), &trace);
-  if (branch_point) {
-    last_branch_point_.reset();
-    if (model_at_u != nullptr) {
-      last_branch_point_ = BranchPointAnalysis{u, c, false, {}, false, {}, evaluated, evaluated ? r_.norm() : 0.0};
-    }
-  }
-  // A phase's own event touched inside it: at branch points where a physical family may end so (physical
-  // or missed-event) and the trace shows an interior minimum of the event; at trial points always.
-  if (evaluated && (!branch_point || (trace && (c.physical || c.reason == OrbitClass::kMissedEvent)))) {
-    EvaluateOwnEvents(u, branch_point ? trace.get() : nullptr, values);
-  }
   // The crossing speeds of every orbit of a model without first integral; of a conservative model, at
   // branch points that are physical or fail only by an event's direction (wrong-direction, grazing): where
   // a physical family ends at grazing its next point is of that class, and the zeros elsewhere, on orbits
@@ -209,10 +227,38 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
   const bool speeds = !krein || !branch_point ||
                       (model_at_u != nullptr && (c.physical || c.reason == OrbitClass::kWrongDirection ||
                                                  c.reason == OrbitClass::kGrazing));
+  // The Floquet functions are defined on physical orbits, and on those beyond a constraint boundary that are
+  // otherwise physical (a competing guard touched: the family goes on as orbits of the same phase sequence),
+  // so that a multiplier crossing between a family's last physical point and a boundary the next step jumped
+  // over is bracketed; its zero is kept only where the orbit is physical (Keep).
+  const bool defined = c.physical || c.reason == OrbitClass::kConstraintViolated;
+  // The map's evaluation: r comes with dr at no cost (a branch point's residual, for its analysis); on a map
+  // that holds the evaluation at `at` (HoldsEvaluation) nothing is integrated. An image's is made only where
+  // a value needs it: its residual is its preimage's (EvaluateAtImage).
+  const bool needs_map = image_residual == nullptr || !physical_only_ || speeds || (defined && model_at_u != nullptr);
+  const bool evaluated = needs_map && map->Evaluate(at, branch_point ? &r_ : nullptr, &dr_).ok;
+  if (branch_point) {
+    last_branch_point_.reset();
+    if (model_at_u != nullptr) {
+      // From an evaluation at a nearby iterate (EvaluateAtBranchPoint): u's residual extrapolated linearly,
+      // r(at) + dr(at)(u − at), exact up to ω|u − at|²/2 (ω bounds the second derivative of r): the
+      // corrector's last step makes that linear model vanish to rounding, as Newton's r(u) does.
+      double residual = 0.0;
+      if (evaluated) residual = &at == &u ? r_.norm() : (r_ + dr_ * (u - at)).norm();
+      else if (image_residual != nullptr) residual = *image_residual;
+      last_branch_point_ = BranchPointAnalysis{u, c, false, {}, false, {}, evaluated || image_residual != nullptr,
+                                               residual};
+    }
+  }
+  // A phase's own event touched inside it: at branch points where a physical family may end so (physical
+  // or missed-event) and the trace shows an interior minimum of the event; at trial points always.
+  if ((evaluated || !needs_map) && (!branch_point || (trace && (c.physical || c.reason == OrbitClass::kMissedEvent)))) {
+    EvaluateOwnEvents(u, branch_point ? trace.get() : nullptr, values);
+  }
   if (evaluated && speeds) {  // the crossing speed changes sign at grazing
-    const HybridModel& model = shooting_.model();  // at u's parameter values
+    const HybridModel& model = map->model();  // at u's parameter values
     for (int i = 0; i < m; ++i) {
-      const Vector& x = shooting_.segment_flow(i).x;
+      const Vector& x = map->segment_flow(i).x;
       RowVector de;
       Vector f;
       model.phase(i).Event(x, &de);
@@ -220,25 +266,20 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
       (*values)(2 + i) = de.dot(f) / std::max(de.norm() * f.norm(), 1e-300);
     }
   }
-  // Defined on physical orbits, and on those beyond a constraint boundary that are otherwise physical (a
-  // competing guard touched: the family goes on as orbits of the same phase sequence), so that a multiplier
-  // crossing between a family's last physical point and a boundary the next step jumped over is bracketed;
-  // its zero is kept only where the orbit is physical (Keep).
-  const bool defined = c.physical || c.reason == OrbitClass::kConstraintViolated;
   if (branch_point && physical_only_) {
     if (model_at_u == nullptr || !defined) return;
     last_branch_point_->replay = Replay(*model_at_u, u.head(base_unknowns_));
     last_branch_point_->replayed = true;
     if (!last_branch_point_->replay.physical()) return;
   }
-  const FloquetResult floquet = ComputeFloquet(shooting_, u);
+  const FloquetResult floquet = ComputeFloquet(*map, at);
   if (branch_point && last_branch_point_) {
     last_branch_point_->floquet = floquet;
     last_branch_point_->floquet_known = true;
   }
   if (!floquet.ok()) return;
   (*values)(0) = floquet.bp_test;
-  if (evaluated) (*values)(1) = PeriodDoublingTest(dr_, shooting_.layout());  // dr_ from the evaluation above
+  if (evaluated) (*values)(1) = PeriodDoublingTest(dr_, map->layout());  // dr_ from the evaluation above
   // On a symplectic map ns_test is 0 up to the multipliers' errors everywhere: no sign there (NaN) at
   // branch points, so that noise marks no point; a crossing elsewhere has |ns_test| of order 1 at the
   // branch points around it and keeps its values in between.

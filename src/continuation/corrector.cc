@@ -66,6 +66,7 @@ using internal::JacobianToleranceScope;
 // first call.
 struct Corrector::Workspace {
   Vector r, F, delta, kernel, unit_last, border, correction;
+  Vector evaluated;  // the iterate r and dr are at
   Matrix dr;
   // Sparse channel (ZeroProblem::prefers_sparse_jacobian): dr is evaluated and factorized sparse, and
   // the dense copy is made only when jacobian() is asked for.
@@ -92,6 +93,7 @@ Corrector::Corrector(Corrector&&) noexcept = default;
 Corrector& Corrector::operator=(Corrector&&) noexcept = default;
 
 const Vector& Corrector::residual() const { return workspace_->r; }
+const Vector& Corrector::evaluated_point() const { return workspace_->evaluated; }
 const Matrix& Corrector::jacobian() const {
   Workspace& w = *workspace_;
   if (w.sparse && w.dense_stale) {
@@ -194,6 +196,7 @@ bool Corrector::EvaluateAt(const Newton& newton, int k, const Vector& u, Correct
     return w.sparse ? problem_->EvaluateSparse(u, &w.r, &w.dr_sparse) : problem_->Evaluate(u, &w.r, &w.dr);
   }();
   w.dense_stale = w.sparse;
+  w.evaluated = u;
   ++result->evaluations;
   if (!evaluation.ok) {
     result->status = CorrectorStatus::kEvaluationFailed;

@@ -48,9 +48,19 @@ SpecialPointDetector::Curve SpecialPointDetector::TestCurve() {
   return {test_problem_.get(), test_corrector_.get(), &test_solver_};
 }
 
-void SpecialPointDetector::Sample(ContinuationPoint* point) {
+void SpecialPointDetector::Sample(ContinuationPoint* point, bool corrected) {
   if (!functions_) return;
-  functions_->Evaluate(point->u, true, &point->test_values);
+  const Vector& at = corrector_->evaluated_point();
+  const double distance = corrector_->options().max_jacobian_distance * (1.0 + point->u.norm());
+  point->evaluated_at.resize(0);
+  if (corrected && at.size() == point->u.size() && (at - point->u).norm() <= distance) {
+    if (functions_->EvaluateAtBranchPoint(point->u, TestFunctions::CorrectorEvaluation{problem_, at},
+                                          &point->test_values)) {
+      point->evaluated_at = at;
+    }
+  } else {
+    functions_->Evaluate(point->u, true, &point->test_values);
+  }
   HYBRIDCONT_DEMAND(point->test_values.size() == static_cast<Eigen::Index>(function_types_.size()));
 }
 
@@ -571,10 +581,21 @@ void SpecialPointDetector::RedetectTestFunctions(size_t from, Branch* branch) {
   // Sampled anew; where every value is the mapped one (the symmetry leaves the functions invariant, e.g.
   // a mirror that keeps the multipliers), the mapped zeros stand.
   bool invariant = true;
+  // The symmetry that mapped the branch (an involution: it maps each point back onto its preimage).
+  const Symmetry* symmetry = nullptr;
+  const std::vector<Symmetry> symmetries = problem_->symmetries();
+  for (const Symmetry& s : symmetries) {
+    if (s.name == branch->symmetry) symmetry = &s;
+  }
   for (size_t i = from; i < branch->points.size(); ++i) {
     ContinuationPoint& p = branch->points[i];
     const Vector mapped = p.test_values;
-    Sample(&p);
+    p.evaluated_at.resize(0);
+    if (symmetry != nullptr && symmetry->signs.size() == p.u.size()) {
+      functions_->EvaluateAtImage(p.u, symmetry->Apply(p.u), &p.test_values);
+    } else {
+      Sample(&p);
+    }
     if (mapped.size() != p.test_values.size()) {
       invariant = false;
       continue;

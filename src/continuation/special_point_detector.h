@@ -39,7 +39,10 @@ class SpecialPointDetector {
   SpecialPointDetector& operator=(const SpecialPointDetector&) = delete;
 
   // The test functions at a branch point into point->test_values (left empty without test functions).
-  void Sample(ContinuationPoint* point);
+  // corrected: the corrector's last evaluation of the problem belongs to this point (its iterate within
+  // CorrectorOptions::max_jacobian_distance), and the test functions may take their values from it
+  // (TestFunctions::EvaluateAtBranchPoint).
+  void Sample(ContinuationPoint* point, bool corrected = false);
   // Locates the sign changes between branch->points[index] and [index + 1] and inserts the special points
   // into branch->special_points in arclength order (ids renumbered: the position). from_singular: the
   // step starts at a bifurcation point, whose SB and turning tests vanish there (not searched), and

@@ -94,7 +94,7 @@ class ContinuationStepper::Impl {
       start.tangent *= sign;
       start.sb_test *= sign;
     }
-    return Begin(std::move(start), false);
+    return Begin(std::move(start), false, options_.correct_start_point);
   }
 
   StepStatus StartAtSingularPoint(const Vector& u0, const Vector& tangent) {
@@ -105,7 +105,7 @@ class ContinuationStepper::Impl {
     start.u = u0;
     start.tangent = tangent.normalized();
     start.sb_test = 0;
-    return Begin(std::move(start), true);
+    return Begin(std::move(start), true, false);
   }
 
   // Predictor and corrector until a step is accepted; then the stops, the closed loop, the special
@@ -130,7 +130,7 @@ class ContinuationStepper::Impl {
         reason = TerminationReason::kClosedLoop;
         message = "the branch returned to its start point";
       }
-      if (reason != TerminationReason::kClosedLoop) detector_.Sample(&b);  // a closed loop's b is its start
+      if (reason != TerminationReason::kClosedLoop) detector_.Sample(&b, true);  // a closed loop's b is its start
       const bool may_retry = reason == TerminationReason::kNotFinished && retry < kOneCurveRetries &&
                              !controller_.at_min_step();
       std::vector<SpecialPoint> before;
@@ -173,10 +173,11 @@ class ContinuationStepper::Impl {
   }
 
  private:
-  StepStatus Begin(ContinuationPoint start, bool singular) {
+  // corrected: the corrector's last evaluation is the start's (SpecialPointDetector::Sample).
+  StepStatus Begin(ContinuationPoint start, bool singular, bool corrected) {
     HYBRIDCONT_DEMAND(branch_.points.empty());  // one Start* per stepper
     start_singular_ = singular;
-    detector_.Sample(&start);
+    detector_.Sample(&start, corrected);
     branch_.points.push_back(std::move(start));
     Report();
     for (const LinearStop& stop : stops_.stops()) {

@@ -1,5 +1,7 @@
 #include "large_expression_phase.h"
 
+#include <vector>
+
 #include <unsupported/Eigen/AutoDiff>
 
 #include "hybridcont/invariant.h"
@@ -21,15 +23,34 @@ const ExpressionProgram& Program(const ExpressionPhaseData& d, ProgramKind kind)
   return *d.programs[static_cast<int>(kind)];
 }
 
+// The compiled entry of program `kind` for scalar kind `scalar`, or null (interpreted).
+CompiledProgramFn CompiledEntry(const ExpressionPhaseData& d, ProgramKind kind, ScalarKind scalar) {
+  const auto* entries = d.compiled[static_cast<int>(kind)];
+  return entries != nullptr ? (*entries)[static_cast<int>(scalar)] : nullptr;
+}
+
 // Values of program `kind` at x, and with J != nullptr its Jacobian (outputs × n), by one evaluation over
-// jets with n directions.
+// jets with n directions: generated code's (ScalarKind::kValueJacobian, jets of the exact dimension on the
+// stack) where the model was compiled, else the interpreter's over heap-allocated jets.
 void ValueAndJacobian(const ExpressionPhaseData& d, ProgramKind kind, const Eigen::Ref<const Vector>& x, Vector* values,
                       Matrix* J) {
   const ExpressionProgram& program = Program(d, kind);
   const int n = static_cast<int>(x.size()), k = program.num_outputs();
   values->resize(k);
   if (J == nullptr) {
-    program.Evaluate<double>(x.data(), d.parameters, values->data());
+    if (CompiledProgramFn fn = CompiledEntry(d, kind, ScalarKind::kDouble)) {
+      fn(x.data(), d.parameters, values->data());
+    } else {
+      program.Evaluate<double>(x.data(), d.parameters, values->data());
+    }
+    return;
+  }
+  if (CompiledProgramFn fn = CompiledEntry(d, kind, ScalarKind::kValueJacobian)) {
+    thread_local std::vector<double> out;
+    out.resize(static_cast<std::size_t>(k) * (n + 1));
+    fn(x.data(), d.parameters, out.data());
+    *values = Eigen::Map<const Vector>(out.data(), k);
+    *J = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(out.data() + k, k, n);
     return;
   }
   std::vector<DynJet> xs(n), out(k);
@@ -53,7 +74,11 @@ Vector ParameterColumn(const ExpressionPhaseData& d, ProgramKind kind, const Eig
   for (int j = 0; j < num_parameters; ++j) {
     p[j] = ParamJet(d.parameters[j], Eigen::Matrix<double, 1, 1>::Constant(j == parameter ? 1.0 : 0.0));
   }
-  program.EvaluateWithParameterJets<ParamJet>(xs.data(), p.data(), out.data());
+  if (CompiledParamJetFn fn = d.compiled_param_jets[static_cast<int>(kind)]) {
+    fn(xs.data(), p.data(), out.data());
+  } else {
+    program.EvaluateWithParameterJets<ParamJet>(xs.data(), p.data(), out.data());
+  }
   Vector column(program.num_outputs());
   for (int j = 0; j < column.size(); ++j) column(j) = out[j].derivatives().size() ? out[j].derivatives()(0) : 0.0;
   return column;

@@ -153,9 +153,12 @@ void EmitParamJetProgram(std::ostringstream& s, const std::string& id, const Exp
                 [&](const ExpressionProgram::Operand& o) { return is_literal(o) ? Operand(o) : as_t(o); });
 }
 
-// Scalar types per kind for a phase of dimension n (expression_model.h, ScalarKind).
+// Scalar types per kind for a phase of dimension n (expression_model.h, ScalarKind). Above kMaxPhaseDim
+// the first-order jets are emitted as the kValueJacobian entry (EmitValueJacobianEntry) and the second
+// order runs interpreted (∇²H: only where ξ·∇²H matters, timebased_shooting.h).
 std::vector<std::pair<int, std::string>> ScalarTypes(int n, bool second_order) {
   std::vector<std::pair<int, std::string>> types = {{0, "double"}};
+  if (n > kMaxPhaseDim) return types;
   if (n <= kMaxFixedJetDim) {
     types.push_back({1, "JetTypes<" + std::to_string(n) + ">::J"});
     if (second_order) types.push_back({2, "HessianJet<" + std::to_string(n) + ">"});
@@ -164,6 +167,23 @@ std::vector<std::pair<int, std::string>> ScalarTypes(int n, bool second_order) {
     if (second_order) types.push_back({4, "Jet2"});
   }
   return types;
+}
+
+// The kValueJacobian entry of program P<id> with n inputs and k outputs: one evaluation over forward jets of
+// exactly n directions (stack storage), values and the row-major Jacobian written as doubles.
+void EmitValueJacobianEntry(std::ostringstream& entries, const std::string& name, const std::string& id, int n, int k) {
+  const std::string jet = "Eigen::AutoDiffScalar<Eigen::Matrix<double, " + std::to_string(n) + ", 1>>";
+  entries << "void " << name << "(const void* x, const double* p, void* out) {\n"
+          << "  using J = " << jet << ";\n"
+          << "  const double* xd = static_cast<const double*>(x);\n"
+          << "  double* o = static_cast<double*>(out);\n"
+          << "  J xs[" << n << "], ys[" << std::max(k, 1) << "];\n"
+          << "  for (int i = 0; i < " << n << "; ++i) xs[i] = J(xd[i], J::DerType::Unit(i));\n"
+          << "  P" << id << "<J>(xs, p, ys);\n"
+          << "  for (int j = 0; j < " << k << "; ++j) {\n"
+          << "    o[j] = ys[j].value();\n"
+          << "    for (int i = 0; i < " << n << "; ++i) o[" << k << " + j * " << n << " + i] = ys[j].derivatives()(i);\n"
+          << "  }\n}\n";
 }
 
 std::string EntryName(int slot, int kind) { return "hybridcont_model_" + std::to_string(slot) + "_" + std::to_string(kind); }
@@ -290,6 +310,10 @@ std::string GenerateModelSource(const ExpressionModelSpec& spec) {
     for (const auto& [kind, type] : ScalarTypes(n, second_order)) {
       entries << "void " << EntryName(slot, kind) << "(const void* x, const double* p, void* out) { P" << id << "<"
               << type << ">(static_cast<const " << type << "*>(x), p, static_cast<" << type << "*>(out)); }\n";
+    }
+    if (n > kMaxPhaseDim) {
+      EmitValueJacobianEntry(entries, EntryName(slot, static_cast<int>(ScalarKind::kValueJacobian)), id, n,
+                             program.num_outputs());
     }
     EmitParamJetProgram(s, id, program);
     entries << "void " << ParamJetEntryName(slot) << "(const void* x, const void* p, void* out) { Q" << id

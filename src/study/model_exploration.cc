@@ -60,6 +60,10 @@ class ModelExploration::TestWorkSink {
     work_.counters += map.counters();
     work_.evaluations += map.num_evaluations();
   }
+  void AddReusedPoints(long points) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    work_.reused_points += points;
+  }
   // Integrations outside a map (the own events' minima, FloquetTestFunctions::own_event_counters).
   void AddIntegrationWork(const FlowCounters& work) {
     const std::lock_guard<std::mutex> lock(mutex_);
@@ -124,6 +128,7 @@ class EngineFloquetTests : public TestFunctions {
         sink_(std::move(sink)) {}
   ~EngineFloquetTests() override {
     sink_->AddMapWork(floquet_->shooting());
+    sink_->AddReusedPoints(floquet_->reused_evaluations());
     sink_->AddIntegrationWork(floquet_->own_event_counters());
     if (state_) sink_->AddMapWork(*state_);
   }
@@ -139,14 +144,49 @@ class EngineFloquetTests : public TestFunctions {
     return types;
   }
   void Evaluate(const Vector& v, bool branch_point, Vector* values) override {
+    EvaluateWith(v, branch_point, nullptr, values);
+  }
+  // The time-based image's residual is its preimage's, as this exploration's copies published it.
+  void EvaluateAtImage(const Vector& v, const Vector& preimage, Vector* values) override {
+    Vector u, u_preimage;
+    // The state-based formulation's points are expanded by an integration each: evaluated as they are.
+    if (state_ || !TimeBased(v, &u) || !TimeBased(preimage, &u_preimage)) {
+      EvaluateWith(v, true, nullptr, values);
+      return;
+    }
+    const auto known = sink_->Find(u_preimage);
+    const double* residual = known && known->residual_known ? &known->residual : nullptr;
+    floquet_->EvaluateAtImage(u, residual, values);
+    if (!refined_ && floquet_->last_branch_point()) sink_->Publish(*floquet_->last_branch_point());
+    AppendObservables(u, true, values);
+  }
+  // The time-based formulation's continued map is the scaling of a copy of the Floquet functions' map: the
+  // corrector's last evaluation serves them (FloquetTestFunctions::EvaluateAtBranchPoint).
+  bool EvaluateAtBranchPoint(const Vector& v, const CorrectorEvaluation& evaluation, Vector* values) override {
+    return EvaluateWith(v, true, &evaluation, values);
+  }
+  // Whether the Floquet values came from the corrector's evaluation.
+  bool EvaluateWith(const Vector& v, bool branch_point, const CorrectorEvaluation* evaluation, Vector* values) {
     Vector u;
     if (!TimeBased(v, &u)) {
       *values = Vector::Constant(static_cast<Eigen::Index>(types().size()), std::nan(""));
-      return;
+      return false;
     }
-    floquet_->Evaluate(u, branch_point, values);
+    auto* scaled = evaluation != nullptr && !state_ ? dynamic_cast<ScaledProblem*>(evaluation->problem) : nullptr;
+    auto* map = scaled != nullptr ? dynamic_cast<TimeBasedShooting*>(scaled->wrapped()) : nullptr;
+    bool reused = false;
+    if (map != nullptr) {
+      reused = floquet_->EvaluateAtBranchPoint(u, map, scaled->FromScaled(evaluation->at), values);
+    } else {
+      floquet_->Evaluate(u, branch_point, values);
+    }
     // An accepted point (a refined copy's tolerances are not the study's): what it learnt, for the analysis.
     if (branch_point && !refined_ && floquet_->last_branch_point()) sink_->Publish(*floquet_->last_branch_point());
+    AppendObservables(u, branch_point, values);
+    return reused;
+  }
+  // The observables' functions (monitors and constraints) after the Floquet ones.
+  void AppendObservables(const Vector& u, bool branch_point, Vector* values) {
     if (!observables_) return;
     Vector more;
     observables_->Evaluate(u, branch_point, &more);
@@ -351,10 +391,56 @@ ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point
   }
   if (store_ != nullptr) {
     const int offset = store_offset_ + branch_offset;
-    options.recorded_branch = [store = store_, offset](int id) { return store->Lookup(offset + id); };
+    options.recorded_branch = [this, store = store_, offset](int id) {
+      std::optional<Branch> branch = store->Lookup(offset + id);
+      if (branch) RelearnRecordedPoints(*branch);
+      return branch;
+    };
     options.on_branch = [store = store_, offset](const Branch& b) { store->Save(offset + b.id, b); };
   }
   return options;
+}
+
+void ModelExploration::RelearnRecordedPoints(const Branch& branch) {
+  if (state_) return;  // the state-based formulation's test functions evaluate every point at it
+  std::unique_ptr<ZeroProblem> copy = shooting_.Clone();  // one thread, the engine's tolerances
+  auto& map = static_cast<TimeBasedShooting&>(*copy);
+  FloquetTestFunctions tests(model_, integrator_, true, shooting_.free_parameters());
+  Vector values, r;
+  Matrix dr;
+  // A mapped branch's points from `mapped` on (exploration.h: an image, or a loop's reflected half): as
+  // EngineFloquetTests::EvaluateAtImage learnt them, from their preimages'.
+  const Symmetry* symmetry = nullptr;
+  const std::vector<Symmetry> symmetries = scaled_->symmetries();
+  for (const Symmetry& s : symmetries) {
+    if (s.name == branch.symmetry) symmetry = &s;
+  }
+  const std::size_t mapped = symmetry == nullptr          ? branch.points.size()
+                             : branch.image_of >= 0       ? 0
+                             : branch.reflected_from >= 1 ? static_cast<std::size_t>(branch.reflected_from - 1)
+                                                          : branch.points.size();
+  for (std::size_t i = 0; i < std::min(mapped, branch.points.size()); ++i) {
+    const ContinuationPoint& p = branch.points[i];
+    if (p.evaluated_at.size() != p.u.size()) {  // the point's own evaluation (a mapped branch's preimage)
+      tests.Evaluate(scaled_->FromScaled(p.u), true, &values);
+      if (tests.last_branch_point()) test_work_->Publish(*tests.last_branch_point());
+      continue;
+    }
+    const Vector at = scaled_->FromScaled(p.evaluated_at);  // as the engine's scaling passed it to the map
+    if (!map.Evaluate(at, &r, &dr).ok) continue;
+    if (tests.EvaluateAtBranchPoint(scaled_->FromScaled(p.u), &map, at, &values) && tests.last_branch_point()) {
+      test_work_->Publish(*tests.last_branch_point());
+    }
+  }
+  for (std::size_t i = mapped; i < branch.points.size(); ++i) {
+    const Vector& v = branch.points[i].u;
+    if (symmetry->signs.size() != v.size()) break;
+    const auto known = test_work_->Find(scaled_->FromScaled(symmetry->Apply(v)));
+    tests.EvaluateAtImage(scaled_->FromScaled(v), known && known->residual_known ? &known->residual : nullptr, &values);
+    if (tests.last_branch_point()) test_work_->Publish(*tests.last_branch_point());
+  }
+  test_work_->AddMapWork(map);
+  test_work_->AddMapWork(tests.shooting());
 }
 
 void ModelExploration::ToModelUnits(BifurcationDiagram* diagram) const {
@@ -362,6 +448,7 @@ void ModelExploration::ToModelUnits(BifurcationDiagram* diagram) const {
     for (ContinuationPoint& p : b.points) {
       p.u = scaled_->FromScaled(p.u);
       p.tangent = scaled_->FromScaled(p.tangent).normalized();
+      if (p.evaluated_at.size()) p.evaluated_at = scaled_->FromScaled(p.evaluated_at);
     }
     for (SpecialPoint& sp : b.special_points) {
       if (sp.u.size()) sp.u = scaled_->FromScaled(sp.u);

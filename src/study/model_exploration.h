@@ -33,6 +33,7 @@ struct TestFunctionWork {
   FlowCounters counters;
   long evaluations = 0;        // map evaluations, both kinds
   long curve_evaluations = 0;  // of which of the copies of the engine's problem
+  long reused_points = 0;      // branch points valued from the corrector's evaluation (none of the above)
 };
 
 // Ids of a diagram explored on its own, moved after the run's: branches by branch_offset, special points by
@@ -126,6 +127,11 @@ class ModelExploration {
   TestFunctionWork test_function_work() const;
 
   class TestWorkSink;  // where the test functions' copies leave their work (model_exploration.cc)
+  // A branch taken from the store (ExplorationOptions::recorded_branch), in the engine's units: what the test
+  // functions learnt at each of its points is learnt again where it was not the point's own evaluation
+  // (KnownBranchPointAnalysis then gives what it gave for the traced branch): from the map at the corrector's
+  // iterate (evaluated_at), and on a mapped branch's images from their preimages (EvaluateAtImage).
+  void RelearnRecordedPoints(const Branch& branch);
 
  private:
   // The run's options in scaled units with the callbacks converting to model units.

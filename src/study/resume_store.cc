@@ -130,7 +130,8 @@ nlohmann::json BranchToJson(const Branch& b) {
                       {"newton_iterations", p.newton_iterations},
                       {"contraction", NumberJson(p.contraction)},
                       {"sb_test", NumberJson(p.sb_test)},
-                      {"test_values", VectorJson(p.test_values)}});
+                      {"test_values", VectorJson(p.test_values)},
+                      {"evaluated_at", VectorJson(p.evaluated_at)}});
   }
   nlohmann::json special = nlohmann::json::array();
   for (const SpecialPoint& p : b.special_points) special.push_back(SpecialPointJson(p));
@@ -170,6 +171,10 @@ Branch BranchFromJson(const nlohmann::json& j, const std::string& where) {
     p.contraction = JsonNumber(q, "contraction", at);
     p.sb_test = JsonNumber(q, "sb_test", at);
     p.test_values = VectorFrom(JsonField(q, "test_values", at), at + ".test_values");
+    if (q.contains("evaluated_at")) p.evaluated_at = VectorFrom(q["evaluated_at"], at + ".evaluated_at");
+    if (p.evaluated_at.size() != 0 && p.evaluated_at.size() != p.u.size()) {
+      throw std::invalid_argument(at + ".evaluated_at: must be empty or of u's size");
+    }
     if (p.u.size() == 0 || p.tangent.size() != p.u.size() ||
         (!b.points.empty() && p.u.size() != b.points.front().u.size())) {
       throw std::invalid_argument(at + ": u and tangent must have the branch's one size");

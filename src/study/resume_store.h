@@ -6,7 +6,9 @@
 // store holds instead of tracing them (ExplorationOptions::recorded_branch) and traces the rest. Branches are
 // stored at full precision (JSON numbers round-trip exactly), so the resumed study's decisions, special
 // points and results are those of an uninterrupted one. The analysis of each point (classification, Floquet
-// multipliers) is computed again; the continuation, its test functions and the location of special points
+// multipliers) is computed again, for a point whose test functions took the corrector's evaluation from the
+// map at that same iterate (ContinuationPoint::evaluated_at, stored), so that its numbers are the
+// uninterrupted run's to the bit; the continuation, its test functions and the location of special points
 // are not. A study that completes removes the folder.
 //
 // Format (private to the resume; a version mismatch makes the study start afresh): .resume/study.json

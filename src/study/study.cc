@@ -235,10 +235,11 @@ std::string RunReport(const BifurcationDiagram& diagram, const std::string& floq
          fmt::format("\nwall time {:.3f} s, {} right-hand-side evaluations in {} map evaluations; Floquet multipliers "
                      "of the accepted points: {} right-hand-side evaluations in {} map evaluations\n"
                      "Floquet test functions (BP and PD): {} right-hand-side evaluations in {} map evaluations, {} of "
-                     "them for curve points between branch points and the location of their zeros\n",
+                     "them for curve points between branch points and the location of their zeros; {} accepted "
+                     "points valued from the corrector's last evaluation\n",
                      seconds, exploration.counters().rhs_evaluations, exploration.num_evaluations(),
                      floquet_map.counters().rhs_evaluations, floquet_map.num_evaluations(),
-                     tests.counters.rhs_evaluations, tests.evaluations, tests.curve_evaluations);
+                     tests.counters.rhs_evaluations, tests.evaluations, tests.curve_evaluations, tests.reused_points);
 }
 
 // ---- 2. compute, streaming every accepted point; 3. summary, key-frame orbits, report, figures
