@@ -82,19 +82,21 @@ enum class ProgramKind { kVectorField = 0, kIntegrals = 1, kEvent = 2, kReset = 
 
 // Scalar types a program runs over: double, the fixed-size first-order jet of the phase's dimension,
 // the fixed-size second-order jet (HessianJet), and the bounded-dynamic jets used above kMaxFixedJetDim.
-// kValueJacobian is no scalar type but an entry of phases above kMaxPhaseDim (the dynamic-size path,
-// which has no jets of a fixed capacity to pass): fn(x, p, out) with x the n states and out the k outputs
-// followed by their k x n Jacobian, row-major, all doubles; generated code evaluates it over jets of the
-// phase's exact dimension on the stack.
+// kValueJacobian and kValueHessian are no scalar types but entries of phases above kMaxPhaseDim (the
+// dynamic-size path, which has no jets of a fixed capacity to pass), all doubles: fn(x, p, out) with x the n
+// states and out the k outputs followed by their k x n Jacobian, row-major, and for kValueHessian then the k
+// Hessians, n x n each, row-major. Generated code evaluates them over jets of the phase's exact dimension on
+// the stack (the Hessian row by row: a one-direction jet over the n-direction one).
 enum class ScalarKind {
   kDouble = 0,
   kFixedJet = 1,
   kHessianJet = 2,
   kDynamicJet = 3,
   kDynamicJet2 = 4,
-  kValueJacobian = 5
+  kValueJacobian = 5,
+  kValueHessian = 6
 };
-inline constexpr int kNumScalarKinds = 6;
+inline constexpr int kNumScalarKinds = 7;
 
 namespace internal {
 template <class T> struct IsHessianJet : std::false_type {};

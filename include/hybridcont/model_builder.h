@@ -28,6 +28,12 @@
 // A phase functor may define `FirstIntegrals` (returning a StateVector<T> of k values) instead of
 // `FirstIntegral` when the system has k > 1 hybrid first integrals (the paper's remark on N_H > 1).
 //
+// Templated phases have at most kMaxPhaseDim states: their StateVector<T> and jets are stack storage of that
+// capacity, which keeps small models free of heap allocation. A larger phase is written as a model file or
+// model text (ParseModelText + BuildExpressionModel, or LoadModelFile: generated code of any size, values,
+// Jacobians and Hessians over jets of the phase's exact dimension) or as a hand-written Phase subclass added
+// with AddPhase(std::unique_ptr<Phase>) (any size, its derivatives the caller's).
+//
 // A functor (phase or anchor) may declare its state dimension, `static constexpr int kDimension = 2;`:
 // its derivatives are then compiled for that dimension only, not for every dimension up to the jets'
 // capacity (several times faster to compile; the numbers are the same). AddPhase throws
@@ -152,7 +158,10 @@ class ModelBuilder {
         if (dims[i] < 1 || dims[i] > kMaxPhaseDim) {
           throw std::invalid_argument("model '" + name_ + "', phase '" + pending_[i].name + "': dimension " +
                                       std::to_string(dims[i]) + " outside [1, kMaxPhaseDim = " +
-                                      std::to_string(kMaxPhaseDim) + "]");
+                                      std::to_string(kMaxPhaseDim) +
+                                      "] of templated phases; a larger phase is a model file or model text "
+                                      "(generated code of any size, model_file.h) or a hand-written Phase "
+                                      "(AddPhase(std::unique_ptr<Phase>))");
         }
         phases[i] = pending_[i].make(pending_[i], dims[(i + 1) % m], block, i);
       }

@@ -102,9 +102,20 @@ void LargeExpressionPhase::VectorField(const Eigen::Ref<const Vector>& x, Vector
 void LargeExpressionPhase::FirstIntegrals(const Eigen::Ref<const Vector>& x, Vector* H, Matrix* dH,
                                           std::vector<Matrix>* d2H) const {
   if (d2H == nullptr) return ValueAndJacobian(*data_, ProgramKind::kIntegrals, x, H, dH);
-  // Second order: jets of jets, outer and inner over the n states.
   const ExpressionProgram& program = Program(*data_, ProgramKind::kIntegrals);
   const int n = static_cast<int>(x.size()), k = program.num_outputs();
+  if (CompiledProgramFn fn = CompiledEntry(*data_, ProgramKind::kIntegrals, ScalarKind::kValueHessian)) {
+    thread_local std::vector<double> out;
+    out.resize(static_cast<std::size_t>(k) * (1 + n + n * n));
+    fn(x.data(), data_->parameters, out.data());
+    *H = Eigen::Map<const Vector>(out.data(), k);
+    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    if (dH) *dH = Eigen::Map<const RowMajor>(out.data() + k, k, n);
+    d2H->resize(k);
+    for (int j = 0; j < k; ++j) (*d2H)[j] = Eigen::Map<const RowMajor>(out.data() + k * (1 + n) + j * n * n, n, n);
+    return;
+  }
+  // Interpreted, second order: jets of jets, outer and inner over the n states.
   std::vector<DynJet2> xs(n), out(k);
   for (int i = 0; i < n; ++i) {
     Eigen::Matrix<DynJet, Eigen::Dynamic, 1> outer(n);

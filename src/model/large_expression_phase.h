@@ -5,8 +5,8 @@
 // one-direction jet for derivatives in a parameter (∂²H/∂x∂p from HessianJet<2> per state, as
 // AutoDiffPhase does). The numbers are those of the same forward-mode differentiation; only the storage
 // differs. A compiled model file (model_compiler.h) gives them generated code for values and Jacobians
-// (ScalarKind::kValueJacobian: jets of the phase's exact dimension on the stack) and for the parameter
-// jets; the second order (∇²H) runs interpreted.
+// (ScalarKind::kValueJacobian: jets of the phase's exact dimension on the stack), for ∇²H
+// (ScalarKind::kValueHessian) and for the parameter jets.
 #ifndef HYBRIDCONT_SRC_MODEL_LARGE_EXPRESSION_PHASE_H_
 #define HYBRIDCONT_SRC_MODEL_LARGE_EXPRESSION_PHASE_H_
 

@@ -154,8 +154,8 @@ void EmitParamJetProgram(std::ostringstream& s, const std::string& id, const Exp
 }
 
 // Scalar types per kind for a phase of dimension n (expression_model.h, ScalarKind). Above kMaxPhaseDim
-// the first-order jets are emitted as the kValueJacobian entry (EmitValueJacobianEntry) and the second
-// order runs interpreted (∇²H: only where ξ·∇²H matters, timebased_shooting.h).
+// the jets are emitted as the kValueJacobian and kValueHessian entries instead (EmitValueJacobianEntry,
+// EmitValueHessianEntry).
 std::vector<std::pair<int, std::string>> ScalarTypes(int n, bool second_order) {
   std::vector<std::pair<int, std::string>> types = {{0, "double"}};
   if (n > kMaxPhaseDim) return types;
@@ -183,6 +183,39 @@ void EmitValueJacobianEntry(std::ostringstream& entries, const std::string& name
           << "  for (int j = 0; j < " << k << "; ++j) {\n"
           << "    o[j] = ys[j].value();\n"
           << "    for (int i = 0; i < " << n << "; ++i) o[" << k << " + j * " << n << " + i] = ys[j].derivatives()(i);\n"
+          << "  }\n}\n";
+}
+
+// The kValueHessian entry of program P<id> (n inputs, k outputs): values and Jacobian as above, then row i
+// of every Hessian from one evaluation over a jet in direction e_i whose value and derivative are n-direction
+// jets (forward over forward), n evaluations in all.
+void EmitValueHessianEntry(std::ostringstream& entries, const std::string& name, const std::string& id, int n, int k) {
+  const std::string jet = "Eigen::AutoDiffScalar<Eigen::Matrix<double, " + std::to_string(n) + ", 1>>";
+  const std::string N = std::to_string(n), K = std::to_string(k);
+  entries << "void " << name << "(const void* x, const double* p, void* out) {\n"
+          << "  using J = " << jet << ";\n"
+          << "  using J1 = Eigen::AutoDiffScalar<Eigen::Matrix<J, 1, 1>>;\n"
+          << "  const double* xd = static_cast<const double*>(x);\n"
+          << "  double* o = static_cast<double*>(out);\n"
+          << "  J1 xs[" << N << "], ys[" << std::max(k, 1) << "];\n"
+          << "  for (int i = 0; i < " << N << "; ++i) {\n"
+          << "    for (int a = 0; a < " << N << "; ++a) {\n"
+          << "      Eigen::Matrix<J, 1, 1> d;\n"
+          << "      d(0) = J(a == i ? 1.0 : 0.0, J::DerType::Zero());\n"
+          << "      xs[a] = J1(J(xd[a], J::DerType::Unit(a)), d);\n"
+          << "    }\n"
+          << "    P" << id << "<J1>(xs, p, ys);\n"
+          << "    for (int j = 0; j < " << K << "; ++j) {\n"
+          << "      if (i == 0) {\n"
+          << "        o[j] = ys[j].value().value();\n"
+          << "        for (int b = 0; b < " << N << "; ++b) o[" << K << " + j * " << N << " + b] = ys[j].value().derivatives()(b);\n"
+          << "      }\n"
+          << "      const bool constant = ys[j].derivatives().size() == 0;\n"
+          << "      for (int b = 0; b < " << N << "; ++b) {\n"
+          << "        o[" << K << " * (1 + " << N << ") + (j * " << N << " + i) * " << N << " + b] =\n"
+          << "            constant ? 0.0 : ys[j].derivatives()(0).derivatives()(b);\n"
+          << "      }\n"
+          << "    }\n"
           << "  }\n}\n";
 }
 
@@ -314,6 +347,10 @@ std::string GenerateModelSource(const ExpressionModelSpec& spec) {
     if (n > kMaxPhaseDim) {
       EmitValueJacobianEntry(entries, EntryName(slot, static_cast<int>(ScalarKind::kValueJacobian)), id, n,
                              program.num_outputs());
+      if (second_order) {
+        EmitValueHessianEntry(entries, EntryName(slot, static_cast<int>(ScalarKind::kValueHessian)), id, n,
+                              program.num_outputs());
+      }
     }
     EmitParamJetProgram(s, id, program);
     entries << "void " << ParamJetEntryName(slot) << "(const void* x, const void* p, void* out) { Q" << id
