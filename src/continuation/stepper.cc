@@ -1,7 +1,6 @@
 // ContinuationStepper: one branch point per Step() (continuation.h). The mechanisms live apart:
 // predictor.h (tangent, secant, Hermite), step_controller.h (step length), linear_stop.h (stops),
 // special_point_detector.h (special points); this file sequences them.
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <memory>

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "expression_phases.h"
 #include "large_expression_phase.h"
 
 #include <stdexcept>
@@ -246,8 +247,6 @@ HybridModel BuildExpressionModel(ExpressionModelSpec spec, std::shared_ptr<const
   ExpressionModelData* view = data.get();
   auto block = std::make_unique<ExpressionParameterBlock>(std::move(data));
 
-  using ExpressionPhase = internal::AutoDiffPhase<internal::ExpressionFunctions, internal::ExpressionPhaseData>;
-  using ExpressionAnchor = internal::AutoDiffAnchor<internal::ExpressionFunctions, internal::ExpressionPhaseData>;
   std::vector<std::unique_ptr<Phase>> phases;
   for (int i = 0; i < m; ++i) {
     const ExpressionPhaseSpec& p = view->phases[i];
@@ -260,7 +259,7 @@ HybridModel BuildExpressionModel(ExpressionModelSpec spec, std::shared_ptr<const
                                                                         p.integrals.num_outputs(), p.typical_state,
                                                                         block.get(), i));
     } else {
-      phases.push_back(std::make_unique<ExpressionPhase>(p.name, p.state_names, next_dim, p.typical_state, block.get(), i));
+      phases.push_back(internal::MakeExpressionPhase(n, p, next_dim, block.get(), i));
     }
   }
   internal::ValidatePhaseSizes(spec.name, phases);
@@ -268,7 +267,7 @@ HybridModel BuildExpressionModel(ExpressionModelSpec spec, std::shared_ptr<const
   if (static_cast<int>(view->phases[0].state_names.size()) > kMaxPhaseDim) {
     anchor_fn = std::make_unique<internal::LargeExpressionAnchor>(block.get(), m);
   } else {
-    anchor_fn = std::make_unique<ExpressionAnchor>(block.get(), m);
+    anchor_fn = internal::MakeExpressionAnchor(static_cast<int>(view->phases[0].state_names.size()), block.get(), m);
   }
   HybridModel model(spec.name, spec.description, std::move(block), std::move(phases), std::move(anchor_fn));
   for (ModelSymmetry& s : spec.symmetries) model.AddSymmetry(std::move(s));

@@ -70,6 +70,7 @@ decltype(auto) DispatchOnDimension(int n, Fn&& fn) {
 // A functor may declare its state dimension, static constexpr int kDimension: its derivatives are then
 // compiled for that dimension only (DispatchOnDimension compiles every one of 1..kMaxFixedJetDim and the
 // bounded-dynamic path, most of a model file's compile time). The same jets as the dispatch would choose.
+// kDimension = Eigen::Dynamic declares the bounded-dynamic path alone, for any dimension up to kMaxPhaseDim.
 template <class F>
 concept DeclaresDimension = requires {
   { F::kDimension } -> std::convertible_to<int>;
@@ -80,7 +81,7 @@ concept DeclaresDimension = requires {
 template <class F, class Fn>
 decltype(auto) DispatchFor(int n, Fn&& fn) {
   if constexpr (DeclaresDimension<F>) {
-    HYBRIDCONT_DEMAND(n == F::kDimension);
+    HYBRIDCONT_DEMAND(F::kDimension == Eigen::Dynamic || n == F::kDimension);
     constexpr int N = F::kDimension <= kMaxFixedJetDim ? F::kDimension : Eigen::Dynamic;
     return fn(std::integral_constant<int, N>{});
   } else {
@@ -303,7 +304,7 @@ class AutoDiffPhase final : public Phase {
         slot_(slot),
         differentiable_(binding_.template differentiable<F>()) {
     if constexpr (DeclaresDimension<F>) {
-      if (dim() != F::kDimension) {
+      if (F::kDimension != Eigen::Dynamic && dim() != F::kDimension) {
         throw std::invalid_argument("phase '" + this->name() + "': its functions declare kDimension = " +
                                     std::to_string(F::kDimension) + ", but " + std::to_string(dim()) +
                                     " state names are given");
