@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <iomanip>
 #include <random>
 #include <sstream>
@@ -11,7 +12,9 @@
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/conservation_check.h"
 #include "hybridcont/derivative_check.h"
+#include "hybridcont/model_file.h"
 #include "hybridcont/models.h"
+#include "install_paths.h"
 #include "hybridcont/shooting_layout.h"
 #include "option_parsing.h"
 
@@ -36,6 +39,26 @@ int ListCommand(const std::vector<std::string>& models, std::ostream& out, std::
       out << fmt::format("    {:<6} = {:<8g} in {:<12} {}\n", info.name, info.default_value, info.range.ToString(),
                          info.description);
     }
+  }
+  if (!models.empty()) return 0;
+  // The model files shipped with the tool, which `run NAME` finds by their name alone.
+  std::error_code ec;
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(ModelsDirectory(), ec)) {
+    if (entry.path().extension() == ".toml") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) return 0;
+  out << fmt::format("\nmodel files in {} (`hybridcont run NAME` or `list NAME` for their phases):\n",
+                     ModelsDirectory().string());
+  for (const std::filesystem::path& file : files) {
+    std::string description;
+    try {
+      description = ReadModelFile(file).description;
+    } catch (const std::exception& e) {
+      description = std::string("(unreadable: ") + e.what() + ")";
+    }
+    out << fmt::format("  {:<24} {}\n", file.stem().string(), description);
   }
   return 0;
 }

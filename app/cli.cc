@@ -66,7 +66,7 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
       "print the figure script and the model folder this executable uses, and exit");
 
   std::vector<std::string> list_models;
-  auto* list = app.add_subcommand("list", "list models (default: the built-in ones) with phases, dimensions and parameters");
+  auto* list = app.add_subcommand("list", "list models with phases, dimensions and parameters (default: the built-in ones, then the shipped model files by name)");
   list->add_option("models", list_models, "built-in model names or model files (.toml)");
 
   CheckArguments check_args;

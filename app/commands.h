@@ -38,6 +38,7 @@ struct RunArguments {
   std::optional<int> threads;          // unset: ExplorationOptions default (the machine's cores)
   std::string formulation = "time";
   bool quiet = false;
+  bool verbose = false;                // a line per point and the full report instead of the one-screen answer
   bool no_plots = false;
   bool no_symmetry = false;            // trace every half-branch instead of mapping images
   bool overwrite = false;              // replace another model's results in --out (refused otherwise)

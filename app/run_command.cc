@@ -8,8 +8,13 @@
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
+#include <chrono>
+#include <iostream>
 #include <thread>
 
+#include <unistd.h>
+
+#include "answer.h"
 #include "commands.h"
 #include "figure_script.h"
 #include "hybridcont/study.h"
@@ -35,7 +40,7 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
                            "NAME=VALUE, e.g. H=2 or speed=1 (repeatable)"));
   NonEmpty(run->add_option("--monitor", args->monitors,
                            "locate the points where an observable of the model reaches a value, NAME=VALUE, e.g. "
-                           "speed=0.5 (repeatable; special points UZ)"));
+                           "speed=0.5, or several values, speed=0.5,0.8 (repeatable; special points UZ)"));
   NonEmpty(run->add_option("--bound", args->bounds,
                            "replace the model's bound on an unknown, NAME=LOWER:UPPER (e.g. H=0:2.7; 'period' is the "
                            "sum of the durations; an empty end is unbounded) (repeatable)"));
@@ -79,7 +84,10 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
   run->add_flag("--resume", args->resume,
                 "continue the run interrupted in --out (killed, stopped, out of disk): the branches it traced are "
                 "taken as they are, the rest computed; the options must be those of that run");
-  run->add_flag("--quiet", args->quiet, "no progress lines");
+  run->add_flag("--quiet", args->quiet, "no progress");
+  run->add_flag("--verbose", args->verbose,
+                "a progress line per accepted point and the full report (every branch, special point and switch) "
+                "instead of the one-screen answer");
   run->add_flag("--no-plots", args->no_plots, "do not draw figures");
 }
 
@@ -111,8 +119,16 @@ StudyOptions StudyOptionsOf(const RunArguments& args) {
     o.bounds.push_back({b.name, b.lower, b.upper});
   }
   for (const std::string& a : args.monitors) {
-    const auto [name, value] = ParseAssignment("--monitor", a);
-    o.monitors.push_back({name, value});
+    // Several values of one observable: NAME=V1,V2,... (each checked as NAME=Vi).
+    const std::size_t eq = a.find('=');
+    if (eq == std::string::npos) ParseAssignment("--monitor", a);  // refused: expected NAME=VALUE
+    for (std::size_t begin = eq + 1;;) {
+      const std::size_t comma = std::min(a.find(',', begin), a.size());
+      const auto [name, value] = ParseAssignment("--monitor", a.substr(0, eq + 1) + a.substr(begin, comma - begin));
+      o.monitors.push_back({name, value});
+      if (comma == a.size()) break;
+      begin = comma + 1;
+    }
   }
   o.rtol = args.rtol;
   o.atol = args.atol;
@@ -155,12 +171,44 @@ StudyOptions StudyOptionsOf(const RunArguments& args) {
   return o;
 }
 
-// Progress on `out`: a line per branch and per accepted point, and what each stage begins with.
-StudyHooks PrintingHooks(const RunArguments& args, std::ostream& out, std::ostream& err) {
+// Progress on `out`. On a terminal one line, rewritten in place: the branch, its family, the point and the
+// continued coordinate, the points so far and the time (the number of branches is what the run discovers, so
+// no fraction of the whole is known in advance); each stage's first words on a line of their own. In a pipe,
+// or with --verbose, a line per branch and per accepted point.
+StudyHooks PrintingHooks(const RunArguments& args, bool terminal, std::ostream& out, std::ostream& err) {
   StudyHooks hooks;
   hooks.on_note = [&err](const std::string& line) { err << "note: " << CommandLineWords(line) << "\n"; };
   if (args.quiet) return hooks;
   auto current = std::make_shared<int>(-1);
+  if (terminal && !args.verbose) {
+    struct Status {
+      int points = 0;
+      bool open = false;  // a status line is on the screen
+      std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now(), shown;
+    };
+    auto status = std::make_shared<Status>();
+    hooks.on_point = [&out, status](const StudyPoint& p, const StudyBranch& b) {
+      ++status->points;
+      const auto now = std::chrono::steady_clock::now();
+      if (status->open && now - status->shown < std::chrono::milliseconds(50)) return;  // ~20 updates a second
+      status->shown = now;
+      const auto at = std::find(b.unknown_names.begin(), b.unknown_names.end(), b.continued);
+      const double x = at == b.unknown_names.end() ? std::nan("") : p.u(at - b.unknown_names.begin());
+      out << fmt::format("\r\033[K  branch {} {}· point {} · {} = {:.6g} · {} points · {:.1f} s", b.id,
+                         b.family.empty() ? "" : "(" + b.family + ") ", p.index, b.continued, x, status->points,
+                         std::chrono::duration<double>(now - status->start).count())
+          << std::flush;
+      status->open = true;
+    };
+    hooks.on_progress = [&out, status](const StudyProgress& progress) {
+      if (progress.message.empty()) return;
+      if (status->open) out << "\r\033[K";
+      status->open = false;
+      out << progress.message << (progress.message.back() == '\n' ? "" : "\n") << std::flush;
+    };
+    hooks.on_branch = [](const StudyBranch&) {};
+    return hooks;
+  }
   hooks.on_point = [&out, current](const StudyPoint& p, const StudyBranch& b) {
     if (b.id != *current && b.origin.empty()) out << fmt::format("branch {}\n", b.id);
     *current = b.id;
@@ -186,12 +234,14 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     options.out_dir = (fs::path("results") / MakeModelWithOverrides(args.model, {}, nullptr, false).name()).string();
   }
   StudyResult study;
+  const bool terminal = &out == &std::cout && isatty(STDOUT_FILENO) == 1;
   try {
-    study = RunStudy(options, PrintingHooks(args, out, err));
+    study = RunStudy(options, PrintingHooks(args, terminal, out, err));
   } catch (const StudyOptionError& e) {
     throw CommandLineError(e);
   }
-  out << study.report;
+  if (terminal && !args.quiet && !args.verbose) out << "\r\033[K";  // the status line
+  out << (args.verbose ? study.report : OneScreenAnswer(study, study.work.wall_seconds));
   const std::string& dir = options.out_dir;
   if (!study.write_error.empty()) {
     // A full disk (or a folder removed under us): what could be written stays, marked as not complete.

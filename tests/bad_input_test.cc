@@ -372,6 +372,7 @@ const std::vector<BadInputCase>& Cases() {
       {"CheckSetTwice", Cli({"check", "slip", "--set", "k=20", "--set", "k=20"}), 2, "'k' is given twice"},
       {"UntilTwice", Run("slip", {"--until", "H=1", "--until", "H=1.5"}), 2, "--until 'H=1.5': 'H' is given twice"},
       {"BoundTwice", Run("slip", {"--bound", "H=0:1", "--bound", "H=0:2"}), 2, "--bound 'H=0:2': 'H' is given twice"},
+      {"MonitorValueTwice", Run("slip.toml", {"--monitor", "apex=1.2,1.2"}), 2, "--monitor 'apex=1.2': is given twice"},
       {"UntilOutsideBound", Run("slip", {"--until", "H=2", "--bound", "H=0:1"}), 2, "--until 'H=2' lies outside --bound 'H=0:1'"},
       {"FormulationFoo", Run("slip", {"--formulation", "foo"}), 2, "--formulation 'foo': expected 'time' or 'state'"},
       {"FormulationUpperCase", Run("slip", {"--formulation", "TIME"}), 2, "--formulation 'TIME'"},

@@ -1,7 +1,10 @@
 // The command-line tool as a user meets it: exit codes, messages, files.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -31,6 +34,52 @@ TEST(Cli, ListShowsModelsPhasesAndParameters) {
   for (const char* s : {"bouncing-ball", "rocking-block", "bouncing-rod", "slip", "stance", "n = 5", "w2", "beta"}) {
     EXPECT_NE(r.out.find(s), std::string::npos) << s;
   }
+}
+
+// The built tool run as a user runs it (its models folder is found next to it): stdout and stderr together,
+// and the exit code.
+CliResult RunBuiltTool(const std::string& arguments) {
+  CliResult r{0, "", ""};
+  FILE* pipe = popen((std::string(HYBRIDCONT_CLI_PATH) + " " + arguments + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return {-1, "", "popen failed"};
+  char buffer[4096];
+  for (std::size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) r.out.append(buffer, n);
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// `list` names the shipped model files after the built-ins, and a shipped file is found by its name alone; a
+// name that is a path is not looked up in the models folder.
+TEST(Cli, ShippedModelFilesAreListedAndFoundByName) {
+  const CliResult all = RunBuiltTool("list");
+  ASSERT_EQ(all.code, 0) << all.out;
+  for (const char* s : {"model files in", "compass-gait ", "mass-chain ", "bipedal-slip "}) {
+    EXPECT_NE(all.out.find(s), std::string::npos) << s;
+  }
+  const CliResult one = RunBuiltTool("list compass-gait");
+  EXPECT_EQ(one.code, 0) << one.out;
+  EXPECT_NE(one.out.find("phases (m = "), std::string::npos) << one.out;
+  EXPECT_EQ(one.out.find("model files in"), std::string::npos);  // asked for one model: that one alone
+  const CliResult path = RunBuiltTool("list ../models/compass-gait");
+  EXPECT_EQ(path.code, 2);
+  EXPECT_NE(path.out.find("unknown model"), std::string::npos) << path.out;
+}
+
+// The end of a run is the one-screen answer: each physical family with its physical and stable ranges and its
+// located special points; --verbose gives the full report instead.
+TEST(Cli, RunEndsWithTheOneScreenAnswer) {
+  const fs::path dir = TempDir("answer");
+  const CliResult r = RunTool({"run", "slip", "--out", dir.string(), "--no-plots", "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* s : {"hopping in place (branch 2)", "  physical  H 1 .. 2", "  stable    H 1.282809324 .. 1.614433285   (PD4 .. BP6)",
+                        "PD4    H = 1.282809324", "forward hopping (branch 5): the mirror image of branch 4, backward hopping", "more branches hold no physical orbit"}) {
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+  }
+  EXPECT_EQ(r.out.find("turning-point in H (located)"), std::string::npos);  // the full report's lines
+  const CliResult verbose = RunTool({"run", "slip", "--out", dir.string(), "--no-plots", "--quiet", "--verbose"});
+  ASSERT_EQ(verbose.code, 0) << verbose.err;
+  EXPECT_NE(verbose.out.find("turning-point in H (located)"), std::string::npos);
 }
 
 TEST(Cli, CheckPassesForEveryModel) {

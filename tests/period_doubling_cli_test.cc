@@ -14,7 +14,7 @@ namespace {
 
 TEST(PeriodDoublingCli, SlipFamilyFromThePdPointOfHoppingInPlace) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "hybridcont_pd_cli_test";
-  const CliResult r = RunTool({"run", "slip", "--period-doubling", "--out", dir.string(), "--quiet", "--no-plots",
+  const CliResult r = RunTool({"run", "slip", "--period-doubling", "--verbose", "--out", dir.string(), "--quiet", "--no-plots",
                                "--threads", "1", "--overwrite"});
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream summary_file(dir / "summary.json");

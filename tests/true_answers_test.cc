@@ -470,7 +470,7 @@ TEST(Starts, TheXiAxisOfASingularStartIsExcludedByTheToolItself) {
                                "conditions = [{ terms = { t2 = 1, t1 = -1, t3 = -1 }, description = \"t2 = t1 + t3\" }]",
                                "", file));
   const fs::path out = file.parent_path() / "out";
-  const CliResult r = RunTool({"run", file.string(), "--out", out.string(), "--no-plots", "--quiet"});
+  const CliResult r = RunTool({"run", file.string(), "--out", out.string(), "--no-plots", "--quiet", "--verbose"});
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("the condition direction[xi] = 0 added"), std::string::npos) << r.out.substr(0, 2000);
   std::ifstream in(out / "summary.json");

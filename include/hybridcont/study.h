@@ -260,8 +260,10 @@ struct StudyHooks {
   std::function<bool()> stop_requested;
 };
 
-// The model a study of `model` runs on (StudyOptions::model, parameters, models_directory): a built-in model or
-// a model file, compiled unless `compile` is false (then interpreted); notes on compiling go to `log`.
+// The model a study of `model` runs on (StudyOptions::model, parameters, models_directory): a built-in model, a
+// model file, or a shipped model file by its name alone ("compass-gait" for <models_directory>/compass-gait.toml,
+// where no built-in model has that name), compiled unless `compile` is false (then interpreted); notes on
+// compiling go to `log`.
 // Throws as RunStudy does.
 HybridModel MakeStudyModel(const std::string& model, const std::vector<NamedValue>& parameters = {},
                            const std::string& models_directory = "", std::ostream* log = nullptr,

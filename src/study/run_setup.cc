@@ -227,7 +227,15 @@ void ApplyFreeParameter(const StudyOptions& args, const HybridModel& model, RunS
 // Observables named by --until, --bound and --monitor join the map's unknowns (shooting_layout.h,
 // "Observables"), in the order named; --monitor names observables only.
 void ApplyObservables(const StudyOptions& args, const HybridModel& model, RunSetup* setup) {
-  RefuseRepeats("monitors", args.monitors);
+  // Several values of one observable are several monitors; the same value twice is a mistake.
+  std::set<std::pair<std::string, double>> monitored;
+  for (std::size_t i = 0; i < args.monitors.size(); ++i) {
+    const NamedValue& m = args.monitors[i];
+    if (m.name.empty()) Refuse("monitors", static_cast<int>(i), Text(m) + ": the name is empty");
+    if (!monitored.insert({m.name, m.value}).second) {
+      Refuse("monitors", static_cast<int>(i), Text(m) + ": is given twice");
+    }
+  }
   const auto join = [&](const std::string& name) {
     if (model.FindObservable(name) < 0) return;
     std::vector<std::string>& joined = setup->free.observables;

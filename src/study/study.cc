@@ -15,6 +15,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -190,8 +191,10 @@ std::string RangesReport(const BifurcationDiagram& diagram, const Scenario& sc, 
 }
 
 // The Floquet crossings among the diagram's special points (located by the exploration as test functions,
-// floquet_test_functions.h), one line each, BP before PD.
-std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayout& layout) {
+// floquet_test_functions.h), one line each, BP before PD. A monitored value is located on any orbit: one on an
+// orbit that is no motion of the system (`physical` false) says so.
+std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayout& layout,
+                          const std::function<bool(const Vector& u)>& physical) {
   std::string report =
       "Floquet and observable special points (multiplier crossings on physical orbits; grazing events; constraint "
       "boundaries; monitored values):\n";
@@ -211,10 +214,12 @@ std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayou
         if (std::isfinite(sp.interval_width(i))) precision += sp.interval_width(i) * sp.interval_width(i), widths = true;
       }
       precision = widths ? std::sqrt(precision) : sp.precision();
-      report += fmt::format("  {} on branch {} after point {}: {} = {:.12f}, T = {:.12f} ({}, precision {:.1e}){}\n", code,
-                            sp.branch_id, sp.index, layout.continued_name(), sp.u(layout.continued_index()),
+      const bool non_physical = type == SpecialPointType::kObservableValue && !physical(sp.u);
+      report += fmt::format("  {} on branch {} after point {}: {} = {:.12f}, T = {:.12f} ({}, precision {:.1e}){}{}\n",
+                            code, sp.branch_id, sp.index, layout.continued_name(), sp.u(layout.continued_index()),
                             layout.Period(sp.u), ToString(sp.status), precision,
-                            sp.message.empty() ? "" : " " + sp.message);
+                            sp.message.empty() ? "" : " " + sp.message,
+                            non_physical ? " (on a non-physical orbit)" : "");
       ++count;
     }
   }
@@ -320,7 +325,11 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   writer.Annotate("exploration", {{"status", ToString(diagram.status)}, {"message", diagram.message}});
   if (writer.failed()) return;  // the failed write is the result's write_error
   nlohmann::json special_points = SpecialPointsJson(diagram, layout, &model, setup.integrator);
-  const std::string floquet_report = FloquetReport(diagram, layout);
+  const std::unique_ptr<HybridModel> at_point = setup.free.empty() ? nullptr : std::make_unique<HybridModel>(model.Clone());
+  const std::string floquet_report = FloquetReport(diagram, layout, [&](const Vector& u) {
+    if (at_point) SetFreeParameters(layout, u, at_point.get());
+    return IsPhysical(at_point ? *at_point : model, OrbitPart(layout, u), setup.integrator);
+  });
   std::string period_doubled;
   const bool from_pd = restart != nullptr && restart->kind == Kind::kPeriodDoubled;
   const bool from_curve = restart != nullptr && restart->kind == Kind::kCurve;

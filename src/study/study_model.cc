@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -18,7 +19,23 @@ HybridModel MakeStudyModel(const std::string& name, const std::vector<NamedValue
                            const std::string& models_directory_text, std::ostream* log, bool compile) {
   const std::filesystem::path models_directory = models_directory_text;
   HybridModel model = [&] {
-    if (!IsModelFilePath(name)) return MakeBuiltinModel(name);
+    if (!IsModelFilePath(name)) {
+      // A shipped model file by its name alone (`hybridcont run compass-gait`), where no built-in has it: a
+      // plain name (letters, digits, '-', '_'), never a path.
+      const std::vector<std::string> builtins = BuiltinModelNames();
+      const bool plain = !name.empty() && std::all_of(name.begin(), name.end(), [](char ch) {
+        return std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_';
+      });
+      std::error_code ec;
+      if (plain && std::find(builtins.begin(), builtins.end(), name) == builtins.end() && !models_directory.empty() &&
+          std::filesystem::is_regular_file(models_directory / (name + ".toml"), ec)) {
+        ModelFileOptions options;
+        options.log = log;
+        options.compile = compile;
+        return LoadModelFile(models_directory / (name + ".toml"), options);
+      }
+      return MakeBuiltinModel(name);
+    }
     ModelFileOptions options;
     options.log = log;
     options.compile = compile;

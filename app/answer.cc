@@ -1,0 +1,119 @@
+#include "answer.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace hybridcont::app {
+
+namespace {
+
+// The branch's continued coordinate at u (H, or the free parameter).
+double Coordinate(const StudyBranch& b, const Vector& u) {
+  const auto at = std::find(b.unknown_names.begin(), b.unknown_names.end(), b.continued);
+  if (at == b.unknown_names.end() || u.size() == 0) return std::nan("");
+  const auto k = static_cast<Eigen::Index>(at - b.unknown_names.begin());
+  return k < u.size() ? u(k) : std::nan("");
+}
+
+// "1.2828 .. 1.6144  (PD4 .. BP6)" for a range: the values and how each end is known.
+std::string RangeText(const Range& r, const std::vector<StudySpecialPoint>& special) {
+  const auto end = [&](const RangeEnd& e) {
+    if (e.special_point >= 0 && e.special_point < static_cast<int>(special.size())) {
+      return special[e.special_point].Label() + (e.located ? "" : ", not located");
+    }
+    return e.how;
+  };
+  const double lo = std::min(r.from.value, r.to.value), hi = std::max(r.from.value, r.to.value);
+  const bool forward = r.from.value <= r.to.value;
+  return fmt::format("{:.10g} .. {:.10g}   ({} .. {})", lo, hi, end(forward ? r.from : r.to), end(forward ? r.to : r.from));
+}
+
+bool InPhysicalRange(const StudyBranch& b, int index) {
+  for (const Range& r : b.ranges.physical) {
+    if (index >= std::min(r.first_point, r.last_point) - 1 && index <= std::max(r.first_point, r.last_point)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+std::string OneScreenAnswer(const StudyResult& study, double seconds) {
+  std::string out;
+  int points = 0, physical_branches = 0;
+  for (const StudyBranch& b : study.branches) {
+    points += static_cast<int>(b.points.size());
+    physical_branches += !b.ranges.physical.empty();
+  }
+  out += fmt::format("\n{}: {} branch{} with physical orbits of {} ({} points)\n", study.model, physical_branches,
+                     physical_branches == 1 ? "" : "es", study.branches.size(), points);
+  // Which branches leave each special point: the families a point connects.
+  std::map<int, std::vector<int>> children;
+  for (const StudyBranch& b : study.branches) {
+    if (b.parent_special_point >= 0) children[b.parent_special_point].push_back(b.id);
+  }
+  const auto name = [&](const StudyBranch& b) {
+    return b.family.empty() ? std::string("no physical orbit") : b.family;
+  };
+  for (const StudyBranch& b : study.branches) {
+    if (b.ranges.physical.empty()) continue;
+    const std::string& c = b.continued;
+    std::string head = fmt::format("\n{} (branch {}", b.family.empty() ? "unnamed family" : b.family, b.id);
+    if (!b.origin.empty()) head += ", " + b.origin;
+    // The image of a traced branch under a symmetry: where that branch is a physical family too, its special
+    // points and connections were listed with it.
+    const bool image_of_family = b.image_of >= 0 && !study.branch(b.image_of).ranges.physical.empty();
+    if (b.image_of >= 0) {
+      const StudyBranch& traced = study.branch(b.image_of);
+      out += head + fmt::format("): the {} image of branch {}, {}\n", b.symmetry, b.image_of,
+                                image_of_family ? traced.family : "which holds no physical orbit");
+    } else {
+      out += head + ")\n";
+    }
+    for (const Range& r : b.ranges.physical) {
+      out += fmt::format("  physical  {} {}\n", c, RangeText(r, study.special_points));
+    }
+    if (b.ranges.stable.empty()) out += "  stable    nowhere\n";
+    for (const Range& r : b.ranges.stable) out += fmt::format("  stable    {} {}\n", c, RangeText(r, study.special_points));
+    if (image_of_family) continue;
+    // Its located special points on physical stretches, and where other families leave them.
+    std::string located, leads;
+    for (const StudySpecialPoint& sp : study.special_points) {
+      if (sp.branch != b.id || sp.duplicate_of >= 0 || sp.code == "start" || !InPhysicalRange(b, sp.index)) continue;
+      located += fmt::format("    {:<6} {} = {:.10g}  T = {:.10g}  {}\n", sp.Label(), c, Coordinate(b, sp.u), sp.T,
+                             sp.status == "located" ? fmt::format("(to {:.1e})", sp.precision) : "(" + sp.status + ")");
+      const auto it = children.find(sp.id);
+      if (it == children.end()) continue;
+      std::vector<std::string> names;
+      for (const int child : it->second) {
+        const StudyBranch& k = study.branch(child);
+        names.push_back(fmt::format("{} (branch {})", name(k), k.id));
+      }
+      std::string joined;
+      for (std::size_t i = 0; i < names.size(); ++i) joined += (i ? ", " : "") + names[i];
+      leads += fmt::format("    at {}: {}\n", sp.Label(), joined);
+    }
+    if (!located.empty()) out += "  special points (label, " + c + ", period, precision)\n" + located;
+    if (!leads.empty()) out += "  families leaving it\n" + leads;
+  }
+  const int others = static_cast<int>(study.branches.size()) - physical_branches;
+  if (others > 0) {
+    out += fmt::format("\n{} more branch{} hold no physical orbit (time-reversed or otherwise no motion of the "
+                       "system).\n", others, others == 1 ? "" : "es");
+  }
+  if (study.status != ExplorationStatus::kCompleted) {
+    out += fmt::format("\nThe run did not complete ({}): {}\n", ToString(study.status), study.message);
+  }
+  out += "Every branch, special point and switch: --verbose, or \"report\" in summary.json; restart from a label "
+         "with --from DIR --at LABEL.\n";
+  out += fmt::format("wall time {:.3f} s\n", seconds);
+  return out;
+}
+
+}  // namespace hybridcont::app

@@ -1,0 +1,23 @@
+// The answer of a run on one screen: what a researcher asks first of a diagram. Per physical family (named as
+// the model names it, its mirror images folded into it): where its orbits are physical and where stable in
+// the continued coordinate, with how each range ends; its located special points (type, coordinate, period,
+// precision) with their restart labels; and the families it connects to. The rest of the diagram (branches
+// without a physical orbit, every special point, the branch switches, the work) is counted in one line and
+// kept in the full report (`--verbose`, summary.json's "report").
+//
+//   std::cout << OneScreenAnswer(study, seconds);
+#ifndef HYBRIDCONT_APP_ANSWER_H_
+#define HYBRIDCONT_APP_ANSWER_H_
+
+#include <string>
+
+#include "hybridcont/study.h"
+
+namespace hybridcont::app {
+
+// `seconds`: the wall time of the computation, its last line.
+std::string OneScreenAnswer(const StudyResult& study, double seconds);
+
+}  // namespace hybridcont::app
+
+#endif  // HYBRIDCONT_APP_ANSWER_H_
