@@ -19,6 +19,7 @@ namespace {
 struct DataLocation {
   fs::path plot_script;
   fs::path models;
+  ReportAssets report;
 };
 
 // The rule of install_paths.h; empty paths if the executable's path cannot be read.
@@ -30,10 +31,15 @@ DataLocation Locate() {
   // equivalent() is false (with ec set) once the build directory is gone: the executable is then not in it.
   if (fs::equivalent(exe_dir, fs::path(HYBRIDCONT_BUILD_BIN_DIR), ec)) {
     const fs::path source = HYBRIDCONT_SOURCE_TREE;
-    return {source / "python" / "hybridcont_plot.py", source / "models"};
+    const fs::path viewer = source / "report";
+    return {source / "python" / "hybridcont_plot.py", source / "models",
+            {viewer / "template.html", viewer / "viewer.js", viewer / "viewer.css",
+             exe_dir / "report" / "plotly-basic.min.js"}};
   }
   const fs::path data = (exe_dir / HYBRIDCONT_BIN_TO_DATA).lexically_normal();
-  return {data / "hybridcont_plot.py", data / "models"};
+  const fs::path report = data / "report";
+  return {data / "hybridcont_plot.py", data / "models",
+          {report / "template.html", report / "viewer.js", report / "viewer.css", report / "plotly-basic.min.js"}};
 }
 
 fs::path IfExists(const fs::path& path) {
@@ -44,6 +50,8 @@ fs::path IfExists(const fs::path& path) {
 }  // namespace
 
 fs::path PlotScriptPath() { return IfExists(Locate().plot_script); }
+
+ReportAssets ReportAssetsOfTool() { return Locate().report; }
 
 fs::path ModelsDirectory() {
   const fs::path models = IfExists(Locate().models);

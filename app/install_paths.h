@@ -19,6 +19,8 @@
 
 #include <filesystem>
 
+#include "hybridcont/study_report.h"
+
 namespace hybridcont::app {
 
 // The figure script (python/hybridcont_plot.py) the rule above selects; empty if that file does not exist
@@ -28,6 +30,11 @@ std::filesystem::path PlotScriptPath();
 // The folder of model files (models/) the rule above selects; empty if it does not exist or the
 // executable's own path cannot be read.
 std::filesystem::path ModelsDirectory();
+
+// The files report.html is assembled from (study_report.h), by the same rule: in the build tree the viewer
+// of the source tree (report/) and the plotting library the build installed from npm (<build>/report/);
+// installed, <exe dir>/<bin-to-data>/report/. ReportAssets::Missing() says what is not there.
+ReportAssets ReportAssetsOfTool();
 
 }  // namespace hybridcont::app
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <chrono>
@@ -18,6 +19,7 @@
 #include "commands.h"
 #include "figure_script.h"
 #include "hybridcont/study.h"
+#include "hybridcont/study_report.h"
 #include "install_paths.h"
 #include "option_parsing.h"
 
@@ -225,6 +227,33 @@ StudyHooks PrintingHooks(const RunArguments& args, bool terminal, std::ostream& 
   return hooks;
 }
 
+// report.html in `dir` (study_report.h), written whole (a temporary file renamed); false, with a note, when the
+// tool lacks its assets or the file cannot be written.
+bool WriteReport(const StudyResult& study, const std::string& dir, std::ostream& err) {
+  const ReportAssets assets = ReportAssetsOfTool();
+  if (const std::string missing = assets.Missing(); !missing.empty()) {
+    err << "note: no report.html: this installation lacks " << missing
+        << " (the plotting library is installed from npm when the tool is built)\n";
+    return false;
+  }
+  const fs::path target = fs::path(dir) / "report.html", temporary = fs::path(dir) / ".report.html.tmp";
+  try {
+    const std::string html = StudyReportHtml(study, assets);
+    {
+      std::ofstream out(temporary, std::ios::binary);
+      out << html;
+      if (!out.flush()) throw std::runtime_error("cannot write " + temporary.string());
+    }
+    fs::rename(temporary, target);
+  } catch (const std::exception& e) {
+    std::error_code ec;
+    fs::remove(temporary, ec);
+    err << "note: no report.html: " << e.what() << "\n";
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
@@ -249,7 +278,9 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
         << "/ are incomplete (summary.json, if present, says status 'running' or 'failed')\n";
     return 1;
   }
-  out << fmt::format("results written to {}/ (summary.json, branch-*.csv, orbit-*.csv)\n", dir);
+  const bool report = WriteReport(study, dir, err);
+  out << fmt::format("results written to {}/ (summary.json, branch-*.csv, orbit-*.csv{})\n", dir,
+                     report ? ", report.html: open it in a browser" : "");
   if (study.status == ExplorationStatus::kStartFailed) {
     err << "error: no family was traced: " << study.message << "\n";
     return 1;  // nothing to draw
@@ -267,6 +298,7 @@ int PlotCommand(const std::string& dir, std::ostream& out, std::ostream& err) {
   }
   const int rc = DrawFigures(dir, err, true);
   if (rc == 0) out << "figures written to " << dir << "/\n";
+  if (rc == 0 && WriteReport(LoadStudy(dir), dir, err)) out << "report written to " << dir << "/report.html\n";
   return rc == 0 ? 0 : rc == 2 ? 2 : 1;  // 2: the script found the results malformed (bad input)
 }
 

@@ -4,7 +4,7 @@
 // whatever its expectations; a row refused as bad input (exit 2) must leave its folder exactly as it was;
 // a summary.json left behind by a failed run must not say "complete". docs/bad-input.md lists the rows.
 //
-// The contract (README, "Bad input"): bad input → a message naming the field and the value (and for model
+// The contract (docs/design/README.md, "Bad input"): bad input → a message naming the field and the value (and for model
 // files the line), exit code 2, nothing written; a numerical failure → exit 1 with a status in the result.
 #include <gtest/gtest.h>
 

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "hybridcont/study.h"
+#include "hybridcont/study_report.h"
 #include "hybridcont/timebased_shooting.h"
 
 namespace hybridcont {
@@ -474,6 +475,56 @@ TEST(Study, LoadStudyNamesWhatIsWrongInAFolder) {
         << e.what();
   }
   fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace hybridcont
+
+namespace hybridcont {
+namespace {
+
+// report.html's data block is the study: every branch with a value of each column per point, the classes,
+// the multipliers of physical points, the special points with their labels; and assembling the page keeps a
+// "</script" inside a script from ending it.
+TEST(StudyReport, DataIsTheStudyAndScriptsStayClosed) {
+  const StudyResult study = RunStudy(Slip());
+  const nlohmann::json data = nlohmann::json::parse(StudyReportData(study));
+  ASSERT_EQ(data["branches"].size(), study.branches.size());
+  const nlohmann::json& hopping = data["branches"][2];
+  EXPECT_EQ(hopping["family"], "hopping in place");
+  EXPECT_EQ(hopping["columns"]["H"].size(), study.branch(2).points.size());
+  EXPECT_EQ(hopping["columns"]["T"].size(), study.branch(2).points.size());
+  EXPECT_EQ(hopping["ranges"]["stable"].size(), 1u);
+  int physical = 0;
+  for (std::size_t i = 0; i < hopping["physical"].size(); ++i) {
+    if (!hopping["physical"][i].get<bool>()) continue;
+    ++physical;
+    EXPECT_EQ(hopping["multipliers"][i].size(), 2u) << i;  // the SLIP's two nontrivial multipliers
+  }
+  EXPECT_GT(physical, 20);
+  bool pd4 = false;
+  for (const nlohmann::json& sp : data["special_points"]) pd4 = pd4 || sp["label"] == "PD4";
+  EXPECT_TRUE(pd4);
+
+  const fs::path dir = fs::temp_directory_path() / "hybridcont_report_assets";
+  fs::create_directories(dir);
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return dir / name;
+  };
+  ReportAssets assets{write("template.html", "<style>/*HYBRIDCONT_STYLE*/</style><script>/*HYBRIDCONT_PLOTLY*/</script>"
+                                             "<script>/*HYBRIDCONT_DATA*/</script><script>/*HYBRIDCONT_VIEWER*/</script>"),
+                      write("viewer.js", "const s = '</SCRIPT><b>';"), write("viewer.css", "a { color: red }"),
+                      write("plotly.js", "var p = 1 </ 2;")};
+  EXPECT_EQ(assets.Missing(), "");
+  const std::string page = StudyReportHtml(study, assets);
+  EXPECT_NE(page.find("const s = '<\\/SCRIPT><b>';"), std::string::npos);
+  EXPECT_NE(page.find("var p = 1 </ 2;"), std::string::npos);  // not a script end: left alone
+  EXPECT_EQ(page.find("/*HYBRIDCONT_"), std::string::npos);
+  EXPECT_EQ(page.find("</SCRIPT>"), std::string::npos);
+  assets.plotly_js = dir / "absent.js";
+  EXPECT_NE(assets.Missing().find("absent.js"), std::string::npos);
+  EXPECT_THROW(StudyReportHtml(study, assets), std::runtime_error);
 }
 
 }  // namespace

@@ -1,0 +1,201 @@
+// The interactive report of a hybridcont study (report.html): the bifurcation diagram in any two of the
+// study's columns, coloured by family and drawn by class (stable: thick, physical: solid, not physical:
+// dotted and hidden unless asked for), the special points with their labels, the point a click selects with
+// its class, stability, phase durations and Floquet multipliers on the unit circle, and the tables of
+// families and special points. Everything it shows is in the data block of the page (see study_report.h).
+(function () {
+  'use strict';
+  const study = JSON.parse(document.getElementById('study-data').textContent);
+  // Okabe–Ito: distinguishable with any colour vision deficiency.
+  const PALETTE = ['#0072B2', '#D55E00', '#009E73', '#CC79A7', '#E69F00', '#56B4E9', '#000000', '#F0E442'];
+  const NONPHYSICAL = '#b0b0b0';
+  const SYMBOLS = {SB: 'circle', TP: 'circle-open', BP: 'square', PD: 'diamond', NS: 'hexagon', KC: 'star-diamond',
+                   GR: 'triangle-down', CB: 'triangle-up', UZ: 'cross', start: 'star'};
+
+  // Branches by id; special points on a branch the study lists.
+  const branchById = new Map(study.branches.map((b) => [b.id, b]));
+  const specialPoints = study.special_points.filter((sp) => branchById.has(sp.branch));
+  const families = [];
+  for (const b of study.branches) if (b.family && !families.includes(b.family)) families.push(b.family);
+  const colourOf = (family) => family ? PALETTE[families.indexOf(family) % PALETTE.length] : NONPHYSICAL;
+  const fmt = (v, digits = 10) => (typeof v === 'number' && isFinite(v)) ? Number(v.toPrecision(digits)).toString() : '—';
+
+  // Axis choices: every column some branch has, the continued coordinate and the period first.
+  const columns = [];
+  const add = (name) => { if (!columns.includes(name)) columns.push(name); };
+  if (study.branches.length) add(study.branches[0].continued);
+  add('T');
+  for (const b of study.branches) for (const name of Object.keys(b.columns)) add(name);
+  const xSelect = document.getElementById('x-axis'), ySelect = document.getElementById('y-axis');
+  for (const select of [xSelect, ySelect]) {
+    for (const name of columns) select.add(new Option(name, name));
+  }
+  xSelect.value = 'T';
+  ySelect.value = columns[0];
+
+  document.getElementById('title').textContent = study.model + (study.description ? ': ' + study.description : '');
+  document.getElementById('subtitle').textContent =
+      study.parameters.map((p) => p.name + ' = ' + fmt(p.value, 6)).join(', ') +
+      ' · ' + study.branches.length + ' branches · ' + specialPoints.length + ' special points · ' +
+      study.status + ' · hybridcont ' + study.version;
+
+  // One trace per branch and class: the points of other classes are gaps (null), so each line is drawn
+  // where its points are of that class.
+  function branchTraces(b, x, y, showNonphysical) {
+    const traces = [];
+    const n = b.columns[x] ? b.columns[x].length : 0;
+    if (!n || !b.columns[y]) return traces;
+    const kinds = [
+      {name: 'stable', test: (i) => b.physical[i] && b.stable[i], width: 4, dash: 'solid'},
+      {name: 'physical', test: (i) => b.physical[i], width: 1.6, dash: 'solid'},
+      {name: 'not physical', test: (i) => !b.physical[i], width: 1.2, dash: 'dot'},
+    ];
+    for (const kind of kinds) {
+      if (kind.name === 'not physical' && !showNonphysical) continue;
+      const xs = [], ys = [], text = [], custom = [];
+      let any = false;
+      for (let i = 0; i < n; ++i) {
+        // A segment belongs to the class when both its ends do (a stable stretch is drawn over the physical one).
+        const on = kind.test(i) || (i + 1 < n && kind.test(i + 1) && kind.name === 'not physical');
+        xs.push(on ? b.columns[x][i] : null);
+        ys.push(on ? b.columns[y][i] : null);
+        text.push(describePoint(b, i));
+        custom.push([b.id, i]);
+        any = any || on;
+      }
+      if (!any) continue;
+      traces.push({
+        type: 'scatter', mode: 'lines+markers', x: xs, y: ys, text: text, customdata: custom,
+        hovertemplate: '%{text}<extra></extra>', connectgaps: false,
+        name: (b.family || 'branch ' + b.id) + ' · ' + kind.name,
+        legendgroup: b.family || 'none', showlegend: false,
+        line: {color: kind.name === 'not physical' ? NONPHYSICAL : colourOf(b.family), width: kind.width, dash: kind.dash},
+        marker: {size: 3, color: kind.name === 'not physical' ? NONPHYSICAL : colourOf(b.family)},
+      });
+    }
+    return traces;
+  }
+
+  function describePoint(b, i) {
+    const parts = ['branch ' + b.id + ', point ' + i + (b.family ? ' · ' + b.family : '')];
+    for (const name of [b.continued, 'T']) if (b.columns[name]) parts.push(name + ' = ' + fmt(b.columns[name][i]));
+    parts.push(b.classification[i] + (b.stability[i] ? ', ' + b.stability[i] : ''));
+    return parts.join('<br>');
+  }
+
+  function specialTrace(x, y, showNonphysical) {
+    const xs = [], ys = [], text = [], custom = [], symbols = [], colours = [];
+    for (const sp of specialPoints) {
+      const b = branchById.get(sp.branch);
+      if (!b || !(x in sp.columns) || !(y in sp.columns)) continue;
+      const physical = b.physical[Math.min(sp.index, b.physical.length - 1)] || b.physical[Math.min(sp.index + 1, b.physical.length - 1)];
+      if (!physical && !showNonphysical) continue;
+      xs.push(sp.columns[x]);
+      ys.push(sp.columns[y]);
+      text.push(sp.label + ' on branch ' + sp.branch + (b.family ? ' (' + b.family + ')' : '') + '<br>' +
+                b.continued + ' = ' + fmt(sp.coordinate) + ', T = ' + fmt(sp.T) + '<br>' + sp.status +
+                (sp.status === 'located' && typeof sp.precision === 'number' ? ' to ' + sp.precision.toExponential(1) : '') +
+                (sp.message ? '<br>' + sp.message.slice(0, 160) : ''));
+      custom.push([sp.branch, sp.index]);
+      symbols.push(SYMBOLS[sp.code] || 'x');
+      colours.push(physical ? '#222' : NONPHYSICAL);
+    }
+    return {type: 'scatter', mode: 'markers', x: xs, y: ys, hovertext: text, hovertemplate: '%{hovertext}<extra></extra>', customdata: custom, showlegend: false,
+            marker: {symbol: symbols, size: 9, color: colours, line: {width: 1, color: '#222'}}};
+  }
+
+  function draw() {
+    const x = xSelect.value, y = ySelect.value, showNonphysical = document.getElementById('show-nonphysical').checked;
+    const traces = [];
+    for (const b of study.branches) traces.push(...branchTraces(b, x, y, showNonphysical));
+    traces.push(specialTrace(x, y, showNonphysical));
+    const layout = {
+      margin: {l: 60, r: 10, t: 10, b: 50}, hovermode: 'closest', dragmode: 'zoom',
+      xaxis: {title: {text: x}, zeroline: false}, yaxis: {title: {text: y}, zeroline: false},
+    };
+    Plotly.react('diagram', traces, layout, {responsive: true, displaylogo: false, scrollZoom: true});
+  }
+
+  // The selected point: its values, class, stability and multipliers.
+  function select(branchId, index) {
+    const b = branchById.get(branchId);
+    if (!b) return;
+    document.getElementById('hint').hidden = true;
+    const rows = [['branch', b.id + (b.family ? ' · ' + b.family : '')], ['point', index],
+                  ['class', b.classification[index]], ['stability', b.stability[index] || '—']];
+    for (const name of Object.keys(b.columns)) rows.push([name, fmt(b.columns[name][index])]);
+    const table = document.createElement('table');
+    for (const [k, v] of rows) {
+      const tr = table.insertRow();
+      tr.insertCell().textContent = k;
+      const td = tr.insertCell();
+      td.textContent = v;
+      td.className = 'number';
+    }
+    const point = document.getElementById('point');
+    point.replaceChildren(table);
+    point.dataset.branch = b.id;
+    point.dataset.index = index;
+    const mu = b.multipliers[index];
+    const circle = {type: 'scatter', mode: 'lines', hoverinfo: 'skip', line: {color: '#999', width: 1},
+                    x: [...Array(101).keys()].map((k) => Math.cos(2 * Math.PI * k / 100)),
+                    y: [...Array(101).keys()].map((k) => Math.sin(2 * Math.PI * k / 100))};
+    const traces = [circle];
+    if (mu) {
+      traces.push({type: 'scatter', mode: 'markers', x: mu.map((m) => m[0]), y: mu.map((m) => m[1]),
+                   marker: {size: 9, color: colourOf(b.family)},
+                   hovertemplate: 'μ = %{x:.6f} %{y:+.6f}i<extra></extra>'});
+    }
+    const lim = Math.max(1.3, ...(mu || []).map((m) => Math.hypot(m[0], m[1]) * 1.1));
+    Plotly.react('multipliers', traces, {
+      title: {text: mu ? 'Floquet multipliers' : 'no multipliers (not physical)', font: {size: 12}},
+      showlegend: false, margin: {l: 30, r: 10, t: 30, b: 30},
+      xaxis: {range: [-lim, lim], zeroline: true}, yaxis: {range: [-lim, lim], scaleanchor: 'x', zeroline: true},
+    }, {displaylogo: false, responsive: true});
+  }
+
+  function fillTable(id, header, rows) {
+    const table = document.getElementById(id);
+    const head = table.tHead.insertRow();
+    for (const h of header) {
+      const th = document.createElement('th');
+      th.textContent = h;
+      head.appendChild(th);
+    }
+    for (const row of rows) {
+      const tr = table.tBodies[0].insertRow();
+      for (const cell of row.cells) tr.insertCell().textContent = cell;
+      tr.addEventListener('click', () => {
+        for (const other of table.querySelectorAll('tr.selected')) other.classList.remove('selected');
+        tr.classList.add('selected');
+        select(row.branch, row.index);
+      });
+    }
+  }
+
+  const rangeText = (r) => fmt(Math.min(r.from, r.to)) + ' .. ' + fmt(Math.max(r.from, r.to)) +
+                           ' (' + (r.from <= r.to ? r.how_from + ' .. ' + r.how_to : r.how_to + ' .. ' + r.how_from) + ')';
+  fillTable('families', ['family', 'branch', 'physical', 'stable', 'ends'],
+            study.branches.filter((b) => b.ranges.physical.length).map((b) => ({
+              branch: b.id, index: b.ranges.physical[0].first_point,
+              cells: [b.family || '—', b.id + (b.image_of >= 0 ? ' (image of ' + b.image_of + ')' : ''),
+                      b.ranges.physical.map(rangeText).join('; '),
+                      b.ranges.stable.length ? b.ranges.stable.map(rangeText).join('; ') : 'nowhere', b.termination],
+            })));
+  fillTable('special-points', ['label', 'branch', 'family', 'coordinate', 'T', 'status', 'precision'],
+            specialPoints.map((sp) => {
+              const b = branchById.get(sp.branch);
+              return {
+                branch: sp.branch, index: Math.min(sp.index, b.physical.length - 1),
+                cells: [sp.label, sp.branch, b.family || '—', b.continued + ' = ' + fmt(sp.coordinate), fmt(sp.T),
+                        sp.status, typeof sp.precision === 'number' ? sp.precision.toExponential(1) : '—'],
+              };
+            }));
+
+  for (const el of [xSelect, ySelect, document.getElementById('show-nonphysical')]) el.addEventListener('change', draw);
+  draw();
+  document.getElementById('diagram').on('plotly_click', (event) => {
+    const p = event.points && event.points[0];
+    if (p && p.customdata) select(p.customdata[0], p.customdata[1]);
+  });
+})();

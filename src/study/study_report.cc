@@ -1,0 +1,161 @@
+#include "hybridcont/study_report.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "hybridcont/classification.h"
+
+namespace hybridcont {
+
+namespace {
+
+using nlohmann::json;
+
+// A number as JSON: NaN and infinities (undefined values) as null.
+json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json RangesJson(const std::vector<Range>& ranges) {
+  json out = json::array();
+  for (const Range& r : ranges) {
+    out.push_back({{"from", Number(r.from.value)}, {"to", Number(r.to.value)}, {"how_from", r.from.how},
+                   {"how_to", r.to.how}, {"first_point", r.first_point}, {"last_point", r.last_point}});
+  }
+  return out;
+}
+
+json BranchJson(const StudyBranch& b) {
+  json columns = json::object();
+  const std::size_t n = b.points.size();
+  for (std::size_t k = 0; k < b.unknown_names.size(); ++k) {
+    json values = json::array();
+    for (const StudyPoint& p : b.points) values.push_back(Number(static_cast<Eigen::Index>(k) < p.u.size() ? p.u(k) : NAN));
+    columns[b.unknown_names[k]] = std::move(values);
+  }
+  json period = json::array(), physical = json::array(), stable = json::array(), classification = json::array(),
+       stability = json::array(), multipliers = json::array();
+  std::vector<std::string> observables;
+  for (const StudyPoint& p : b.points) {
+    for (const auto& [name, value] : p.analysis.observables) {
+      if (std::find(observables.begin(), observables.end(), name) == observables.end()) observables.push_back(name);
+    }
+  }
+  for (const std::string& name : observables) columns[name] = json::array();
+  for (const StudyPoint& p : b.points) {
+    const OrbitAnalysis& a = p.analysis;
+    period.push_back(Number(p.T));
+    physical.push_back(a.classification.physical);
+    stable.push_back(a.classification.physical && a.floquet && a.stable);
+    classification.push_back(a.classification.physical ? std::string("physical") : ToString(a.classification.reason));
+    stability.push_back(a.floquet ? a.stability : std::string());
+    if (a.floquet) {
+      json mu = json::array();
+      for (const std::complex<double>& m : a.multipliers) mu.push_back({Number(m.real()), Number(m.imag())});
+      multipliers.push_back(std::move(mu));
+    } else {
+      multipliers.push_back(nullptr);
+    }
+    for (const std::string& name : observables) {
+      const auto it = std::find_if(a.observables.begin(), a.observables.end(),
+                                   [&](const auto& o) { return o.first == name; });
+      columns[name].push_back(it == a.observables.end() ? json(nullptr) : Number(it->second));
+    }
+  }
+  columns["T"] = std::move(period);
+  (void)n;
+  return {{"id", b.id},
+          {"family", b.family},
+          {"origin", b.origin},
+          {"image_of", b.image_of},
+          {"symmetry", b.symmetry},
+          {"continued", b.continued},
+          {"termination", b.termination},
+          {"columns", std::move(columns)},
+          {"physical", std::move(physical)},
+          {"stable", std::move(stable)},
+          {"classification", std::move(classification)},
+          {"stability", std::move(stability)},
+          {"multipliers", std::move(multipliers)},
+          {"ranges", {{"physical", RangesJson(b.ranges.physical)}, {"stable", RangesJson(b.ranges.stable)}}}};
+}
+
+json SpecialPointJson(const StudySpecialPoint& sp, const StudyResult& study) {
+  json columns = json::object();
+  double coordinate = NAN;
+  if (sp.branch >= 0 && sp.branch < static_cast<int>(study.branches.size())) {
+    const StudyBranch& b = study.branches[sp.branch];
+    for (std::size_t k = 0; k < b.unknown_names.size() && static_cast<Eigen::Index>(k) < sp.u.size(); ++k) {
+      columns[b.unknown_names[k]] = Number(sp.u(k));
+      if (b.unknown_names[k] == b.continued) coordinate = sp.u(k);
+    }
+  }
+  columns["T"] = Number(sp.T);
+  return {{"label", sp.Label()}, {"code", sp.code},           {"branch", sp.branch},
+          {"index", sp.index},   {"coordinate", Number(coordinate)}, {"H", Number(sp.H)},
+          {"T", Number(sp.T)},   {"precision", Number(sp.precision)}, {"status", sp.status},
+          {"message", sp.message}, {"columns", std::move(columns)}};
+}
+
+std::string Read(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("report: cannot read " + path.string());
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// The template with `marker` replaced by `text` (once; the marker must be there).
+void Fill(std::string* page, const std::string& marker, const std::string& text) {
+  const std::size_t at = page->find(marker);
+  if (at == std::string::npos) throw std::runtime_error("report: the template lacks " + marker);
+  page->replace(at, marker.size(), text);
+}
+
+}  // namespace
+
+std::string ReportAssets::Missing() const {
+  std::string missing;
+  for (const std::filesystem::path& p : {template_html, viewer_js, viewer_css, plotly_js}) {
+    std::error_code ec;
+    if (p.empty() || !std::filesystem::is_regular_file(p, ec)) missing += (missing.empty() ? "" : ", ") + p.string();
+  }
+  return missing;
+}
+
+std::string StudyReportData(const StudyResult& study) {
+  json branches = json::array(), special = json::array(), parameters = json::array();
+  for (const StudyBranch& b : study.branches) branches.push_back(BranchJson(b));
+  for (const StudySpecialPoint& sp : study.special_points) {
+    if (sp.duplicate_of < 0) special.push_back(SpecialPointJson(sp, study));
+  }
+  for (const NamedValue& p : study.parameters) parameters.push_back({{"name", p.name}, {"value", Number(p.value)}});
+  const json data = {{"model", study.model},         {"version", study.version},
+                     {"description", ""},            {"parameters", std::move(parameters)},
+                     {"status", ToString(study.status)}, {"branches", std::move(branches)},
+                     {"special_points", std::move(special)}};
+  return data.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+std::string StudyReportHtml(const StudyResult& study, const ReportAssets& assets) {
+  std::string page = Read(assets.template_html);
+  // Inside <script> only "</script" (any case) ends the element early: "<\/script" means the same to
+  // JavaScript (in a string, a regular expression or a comment, the only places it can stand) and to JSON.
+  const auto inert = [](std::string text) {
+    for (std::size_t at = 0; (at = text.find("</", at)) != std::string::npos; at += 2) {
+      std::string next = text.substr(at + 2, 6);
+      std::transform(next.begin(), next.end(), next.begin(), [](unsigned char c) { return std::tolower(c); });
+      if (next == "script") text.replace(at, 2, "<\\/"), ++at;
+    }
+    return text;
+  };
+  Fill(&page, "/*HYBRIDCONT_STYLE*/", Read(assets.viewer_css));
+  Fill(&page, "/*HYBRIDCONT_PLOTLY*/", inert(Read(assets.plotly_js)));
+  Fill(&page, "/*HYBRIDCONT_DATA*/", inert(StudyReportData(study)));
+  Fill(&page, "/*HYBRIDCONT_VIEWER*/", inert(Read(assets.viewer_js)));
+  return page;
+}
+
+}  // namespace hybridcont
