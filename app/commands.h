@@ -39,7 +39,8 @@ struct RunArguments {
   std::string formulation = "time";
   bool quiet = false;
   bool verbose = false;                // a line per point and the full report instead of the one-screen answer
-  bool no_plots = false;
+  bool plots = false;                  // also draw the PNG figures (report.html is written either way)
+  bool no_plots = false;               // no PNG figures (the default; an explicit --no-plots wins over --plots)
   bool no_symmetry = false;            // trace every half-branch instead of mapping images
   bool overwrite = false;              // replace another model's results in --out (refused otherwise)
   bool one_word = false;               // an automaton: follow the start's word only (no phase-sequence changes)

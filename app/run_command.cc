@@ -90,7 +90,10 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
   run->add_flag("--verbose", args->verbose,
                 "a progress line per accepted point and the full report (every branch, special point and switch) "
                 "instead of the one-screen answer");
-  run->add_flag("--no-plots", args->no_plots, "do not draw figures");
+  run->add_flag("--plots", args->plots,
+                "also draw the PNG figures (matplotlib, a few seconds; `hybridcont plot DIR` draws them later); the "
+                "interactive report.html is written either way");
+  run->add_flag("--no-plots", args->no_plots, "draw no PNG figures (the default; kept for scripts that say so)");
 }
 
 namespace {
@@ -285,7 +288,10 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     err << "error: no family was traced: " << study.message << "\n";
     return 1;  // nothing to draw
   }
-  if (!args.no_plots && DrawFigures(dir, err, false) == 0) out << fmt::format("figures written to {}/\n", dir);
+  // The figures wait for matplotlib for seconds, the computation takes a fraction of that: drawn on request.
+  if (args.plots && !args.no_plots && DrawFigures(dir, err, false) == 0) {
+    out << fmt::format("figures written to {}/\n", dir);
+  }
   return 0;
 }
 

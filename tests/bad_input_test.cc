@@ -427,7 +427,7 @@ const std::vector<BadInputCase>& Cases() {
       {"OutSummaryIsAFolder", Cli({"run", "bouncing-ball", "--out", "res", "--quiet", "--no-plots"}), 2,
        "holds a summary.json that is not the results", [](Context& c) { fs::create_directories(c.work / "res/summary.json"); }},
       // a folder name that would break a shell command line: passed as it is, nothing else runs
-      {"OutNameWithQuotes", Cli({"run", "bouncing-ball", "--out", "it's; touch pwned; '", "--quiet"}), 0,
+      {"OutNameWithQuotes", Cli({"run", "bouncing-ball", "--out", "it's; touch pwned; '", "--quiet", "--plots"}), 0,
        "figures written to", nullptr, Tool::kCli,
        [](const Context& c) {
          EXPECT_FALSE(fs::exists(c.work / "pwned"));

@@ -133,7 +133,7 @@ TEST(CliParameters, SlipAtFixedFlightSpeedInStiffness) {
 TEST(CliParameters, SlipFirstSbCurveInSwingFrequencyMatchesTheClosedForm) {
   const fs::path dir = fs::temp_directory_path() / "hybridcont_cli_curves_w2";
   const CliResult r = RunTool({"run", "slip", "--curves", "w2", "--bound", "w2=2:10", "--out", dir.string(), "--quiet",
-                               "--threads", "1", "--overwrite"});
+                               "--threads", "1", "--overwrite", "--plots"});
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json summary = ReadSummary(dir);
   EXPECT_EQ(summary["options"]["curves"]["parameter"], "w2");
