@@ -232,7 +232,7 @@ StudyHooks PrintingHooks(const RunArguments& args, bool terminal, std::ostream& 
 
 // report.html in `dir` (study_report.h), written whole (a temporary file renamed); false, with a note, when the
 // tool lacks its assets or the file cannot be written.
-bool WriteReport(const StudyResult& study, const std::string& dir, std::ostream& err) {
+bool WriteReport(const StudyResult& study, const std::string& dir, const HybridModel* model, std::ostream& err) {
   const ReportAssets assets = ReportAssetsOfTool();
   if (const std::string missing = assets.Missing(); !missing.empty()) {
     err << "note: no report.html: this installation lacks " << missing
@@ -241,7 +241,7 @@ bool WriteReport(const StudyResult& study, const std::string& dir, std::ostream&
   }
   const fs::path target = fs::path(dir) / "report.html", temporary = fs::path(dir) / ".report.html.tmp";
   try {
-    const std::string html = StudyReportHtml(study, assets);
+    const std::string html = StudyReportHtml(study, assets, model);
     {
       std::ofstream out(temporary, std::ios::binary);
       out << html;
@@ -281,7 +281,14 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
         << "/ are incomplete (summary.json, if present, says status 'running' or 'failed')\n";
     return 1;
   }
-  const bool report = WriteReport(study, dir, err);
+  // The model again (compiled code cached) for the orbits' drawings; without it the report has no animations.
+  std::unique_ptr<HybridModel> model;
+  try {
+    model = std::make_unique<HybridModel>(MakeStudyModel(options.model, options.parameters, options.models_directory));
+  } catch (const std::exception&) {
+    model.reset();
+  }
+  const bool report = WriteReport(study, dir, model.get(), err);
   out << fmt::format("results written to {}/ (summary.json, branch-*.csv, orbit-*.csv{})\n", dir,
                      report ? ", report.html: open it in a browser" : "");
   if (study.status == ExplorationStatus::kStartFailed) {
@@ -304,7 +311,16 @@ int PlotCommand(const std::string& dir, std::ostream& out, std::ostream& err) {
   }
   const int rc = DrawFigures(dir, err, true);
   if (rc == 0) out << "figures written to " << dir << "/\n";
-  if (rc == 0 && WriteReport(LoadStudy(dir), dir, err)) out << "report written to " << dir << "/report.html\n";
+  if (rc == 0) {
+    const StudyResult study = LoadStudy(dir);
+    std::unique_ptr<HybridModel> model;
+    try {  // a built-in model or a shipped model file by its name: the orbits drawn; otherwise none
+      model = std::make_unique<HybridModel>(MakeStudyModel(study.model, study.parameters, ModelsDirectory().string()));
+    } catch (const std::exception&) {
+      model.reset();
+    }
+    if (WriteReport(study, dir, model.get(), err)) out << "report written to " << dir << "/report.html\n";
+  }
   return rc == 0 ? 0 : rc == 2 ? 2 : 1;  // 2: the script found the results malformed (bad input)
 }
 

@@ -116,6 +116,62 @@
     Plotly.react('diagram', traces, layout, {responsive: true, displaylogo: false, scrollZoom: true});
   }
 
+  // The selected point's orbit, animated as the model draws it: its points at evenly spaced instants of one
+  // period, joined by the drawing's lines, its masses as discs of the model's radius, to scale (one scale for
+  // both axes, over the whole period), the ground at y = 0.
+  let animation = null;
+  function animate(b, index) {
+    const canvas = document.getElementById('orbit');
+    if (animation) cancelAnimationFrame(animation.request);
+    animation = null;
+    const frames = b.animation && b.animation[index];
+    canvas.hidden = !frames || !study.drawing;
+    if (canvas.hidden) return;
+    const drawing = study.drawing, names = drawing.points;
+    const at = (name) => names.indexOf(name);
+    const lines = [], masses = [];
+    for (const phase of Object.values(drawing.phases || {})) {
+      for (const [a, c] of phase.lines || []) lines.push([at(a), at(c)]);
+      for (const m of phase.masses || []) masses.push(at(m));
+    }
+    const r = drawing.mass_radius || 0.05;
+    let xmin = Infinity, xmax = -Infinity, ymin = drawing.ground ? 0 : Infinity, ymax = -Infinity;
+    for (const f of frames) {
+      for (let k = 0; k + 1 < f.length; k += 2) {
+        if (f[k] === null || f[k + 1] === null) continue;
+        xmin = Math.min(xmin, f[k] - r); xmax = Math.max(xmax, f[k] + r);
+        ymin = Math.min(ymin, f[k + 1] - r); ymax = Math.max(ymax, f[k + 1] + r);
+      }
+    }
+    const ctx = canvas.getContext('2d'), W = canvas.width, H = canvas.height, pad = 10;
+    const scale = Math.min((W - 2 * pad) / Math.max(xmax - xmin, 1e-9), (H - 2 * pad) / Math.max(ymax - ymin, 1e-9));
+    const X = (x) => pad + (x - xmin) * scale + ((W - 2 * pad) - (xmax - xmin) * scale) / 2;
+    const Y = (y) => H - pad - (y - ymin) * scale;
+    const colour = colourOf(b.family);
+    const start = performance.now(), seconds = 2.0;
+    const frame = (now) => {
+      const f = frames[Math.floor(((now - start) / 1000 / seconds) * frames.length) % frames.length];
+      ctx.clearRect(0, 0, W, H);
+      if (drawing.ground) {
+        ctx.strokeStyle = '#888'; ctx.lineWidth = 1;
+        ctx.beginPath(); ctx.moveTo(0, Y(0)); ctx.lineTo(W, Y(0)); ctx.stroke();
+      }
+      ctx.strokeStyle = '#333'; ctx.lineWidth = 2;
+      for (const [a, c] of lines) {
+        if (a < 0 || c < 0 || f[2 * a] === null || f[2 * c] === null) continue;  // not placed in this phase
+        ctx.beginPath(); ctx.moveTo(X(f[2 * a]), Y(f[2 * a + 1])); ctx.lineTo(X(f[2 * c]), Y(f[2 * c + 1])); ctx.stroke();
+      }
+      ctx.fillStyle = colour;
+      for (const m of masses) {
+        if (m < 0 || f[2 * m] === null) continue;
+        ctx.beginPath(); ctx.arc(X(f[2 * m]), Y(f[2 * m + 1]), Math.max(r * scale, 2), 0, 2 * Math.PI); ctx.fill();
+      }
+      animation.request = requestAnimationFrame(frame);
+    };
+    animation = {request: requestAnimationFrame(frame)};
+    canvas.dataset.frames = frames.length;
+  }
+
   // The selected point: its values, class, stability and multipliers.
   function select(branchId, index) {
     const b = branchById.get(branchId);
@@ -136,6 +192,7 @@
     point.replaceChildren(table);
     point.dataset.branch = b.id;
     point.dataset.index = index;
+    animate(b, index);
     const mu = b.multipliers[index];
     const circle = {type: 'scatter', mode: 'lines', hoverinfo: 'skip', line: {color: '#999', width: 1},
                     x: [...Array(101).keys()].map((k) => Math.cos(2 * Math.PI * k / 100)),

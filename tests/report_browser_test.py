@@ -1,7 +1,7 @@
 """report.html in a real browser: headless Chromium opens the SLIP's report from file:// (no network), no script
 fails or logs an error, a click on a point of a physical family (a mouse event at that point's pixel, through
-the browser) shows the point's class and its Floquet multipliers on the unit circle, and a row of the special
-points' table selects its point. The browser is driven over the DevTools protocol on a pipe (Chromium's
+the browser) shows the point's class, its orbit animated as the model draws it and its Floquet multipliers on
+the unit circle, and a row of the special points' table selects its point. The browser is driven over the DevTools protocol on a pipe (Chromium's
 --remote-debugging-pipe: JSON messages separated by NUL bytes on file descriptors 3 and 4).
 
 Environment: HYBRIDCONT_BIN (the built tool), CHROMIUM (default: chromium on PATH). Screenshots of the page
@@ -161,10 +161,23 @@ def test_report_opens_offline_and_a_click_shows_the_orbit(slip_report):
             text: document.getElementById('point').innerText,
             multipliers: document.querySelectorAll('#multipliers .scatterlayer .trace:nth-child(2) .point').length,
             circle: !!document.querySelector('#multipliers .scatterlayer .trace path.js-line'),
+            orbit_shown: !document.getElementById('orbit').hidden,
+            frames: Number(document.getElementById('orbit').dataset.frames),
         })""")
         assert abs(shown["index"] - where["index"]) <= 1, shown
         assert "asymptotically stable" in shown["text"] or "neutrally stable" in shown["text"], shown["text"]
         assert shown["multipliers"] == 2 and shown["circle"], shown
+        # The orbit animated as the model draws it: frames of one period, drawn (pixels that are not blank).
+        assert shown["orbit_shown"] and shown["frames"] >= 40, shown
+        time.sleep(0.3)
+        painted = browser.evaluate("""(() => {
+            const c = document.getElementById('orbit');
+            const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+            let n = 0;
+            for (let k = 3; k < d.length; k += 4) n += d[k] > 0;
+            return n;
+        })()""")
+        assert painted > 200, painted
         # A row of the special points' table selects its point.
         browser.evaluate("[...document.querySelectorAll('#special-points tbody tr')]"
                          ".find(r => r.cells[0].textContent === 'PD4').click()")

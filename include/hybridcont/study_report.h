@@ -27,11 +27,15 @@ struct ReportAssets {
   std::string Missing() const;
 };
 
-// The study's data as the viewer reads it (JSON text).
-std::string StudyReportData(const StudyResult& study);
+// The study's data as the viewer reads it (JSON text). With the study's model (MakeStudyModel), every physical
+// point of the families continued in H̄ carries its orbit drawn as the model draws it (its presentation's
+// points at kAnimationFrames instants of one period: the viewer animates it), and the presentation's lines,
+// masses and ground; without, no animations.
+std::string StudyReportData(const StudyResult& study, const HybridModel* model = nullptr);
+inline constexpr int kAnimationFrames = 40;
 
 // report.html of the study. Throws std::runtime_error naming the asset that cannot be read.
-std::string StudyReportHtml(const StudyResult& study, const ReportAssets& assets);
+std::string StudyReportHtml(const StudyResult& study, const ReportAssets& assets, const HybridModel* model = nullptr);
 
 }  // namespace hybridcont
 

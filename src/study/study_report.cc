@@ -5,11 +5,14 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
 #include "hybridcont/classification.h"
+#include "hybridcont/orbit_trace.h"
+#include "hybridcont/setup_evaluation.h"
 
 namespace hybridcont {
 
@@ -27,6 +30,33 @@ json RangesJson(const std::vector<Range>& ranges) {
                    {"how_to", r.to.how}, {"first_point", r.first_point}, {"last_point", r.last_point}});
   }
   return out;
+}
+
+// Each point's orbit drawn at kAnimationFrames instants (null where not physical or not drawable): one flat
+// row [x0, y0, x1, y1, ...] over the presentation's points per instant.
+json AnimationJson(const StudyBranch& b, const HybridModel& model, const OrbitPresentation& presentation) {
+  json frames = json::array();
+  for (const StudyPoint& p : b.points) {
+    if (!p.analysis.classification.physical) {
+      frames.push_back(nullptr);
+      continue;
+    }
+    const OrbitTrace trace(model, p.u, IntegratorOptions{});
+    if (!trace.ok()) {
+      frames.push_back(nullptr);
+      continue;
+    }
+    const std::vector<OrbitSample> samples = trace.Sample(kAnimationFrames);
+    const std::vector<Matrix> drawn = presentation.DrawOrbit(samples);
+    json orbit = json::array();
+    for (const Matrix& points : drawn) {
+      json row = json::array();
+      for (Eigen::Index k = 0; k < points.cols(); ++k) row.push_back(Number(points(0, k))), row.push_back(Number(points(1, k)));
+      orbit.push_back(std::move(row));
+    }
+    frames.push_back(std::move(orbit));
+  }
+  return frames;
 }
 
 json BranchJson(const StudyBranch& b) {
@@ -125,21 +155,42 @@ std::string ReportAssets::Missing() const {
   return missing;
 }
 
-std::string StudyReportData(const StudyResult& study) {
+std::string StudyReportData(const StudyResult& study, const HybridModel* model) {
   json branches = json::array(), special = json::array(), parameters = json::array();
-  for (const StudyBranch& b : study.branches) branches.push_back(BranchJson(b));
+  std::unique_ptr<OrbitPresentation> presentation;
+  json drawing = nullptr;
+  if (model != nullptr) {
+    presentation = std::make_unique<OrbitPresentation>(*model);
+    if (!presentation->has_drawing()) presentation.reset();
+    const json summary = json::parse(study.summary_json, nullptr, false);
+    if (presentation && summary.is_object() && summary.contains("presentation") &&
+        summary["presentation"].contains("drawing")) {
+      drawing = summary["presentation"]["drawing"];
+      drawing["points"] = presentation->point_names();
+    }
+  }
+  for (const StudyBranch& b : study.branches) {
+    json branch = BranchJson(b);
+    // The study's own model, its families in H̄ (the orbit's unknowns alone): a period-doubled family or
+    // another word runs on another model, a family in a parameter on other parameter values.
+    if (presentation && !drawing.is_null() && b.origin.empty() && b.continued == "H" && b.model == study.model) {
+      branch["animation"] = AnimationJson(b, *model, *presentation);
+    }
+    branches.push_back(std::move(branch));
+  }
   for (const StudySpecialPoint& sp : study.special_points) {
     if (sp.duplicate_of < 0) special.push_back(SpecialPointJson(sp, study));
   }
   for (const NamedValue& p : study.parameters) parameters.push_back({{"name", p.name}, {"value", Number(p.value)}});
   const json data = {{"model", study.model},         {"version", study.version},
                      {"description", ""},            {"parameters", std::move(parameters)},
+                     {"drawing", std::move(drawing)},
                      {"status", ToString(study.status)}, {"branches", std::move(branches)},
                      {"special_points", std::move(special)}};
   return data.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
-std::string StudyReportHtml(const StudyResult& study, const ReportAssets& assets) {
+std::string StudyReportHtml(const StudyResult& study, const ReportAssets& assets, const HybridModel* model) {
   std::string page = Read(assets.template_html);
   // Inside <script> only "</script" (any case) ends the element early: "<\/script" means the same to
   // JavaScript (in a string, a regular expression or a comment, the only places it can stand) and to JSON.
@@ -153,7 +204,7 @@ std::string StudyReportHtml(const StudyResult& study, const ReportAssets& assets
   };
   Fill(&page, "/*HYBRIDCONT_STYLE*/", Read(assets.viewer_css));
   Fill(&page, "/*HYBRIDCONT_PLOTLY*/", inert(Read(assets.plotly_js)));
-  Fill(&page, "/*HYBRIDCONT_DATA*/", inert(StudyReportData(study)));
+  Fill(&page, "/*HYBRIDCONT_DATA*/", inert(StudyReportData(study, model)));
   Fill(&page, "/*HYBRIDCONT_VIEWER*/", inert(Read(assets.viewer_js)));
   return page;
 }
