@@ -5,10 +5,12 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -525,6 +527,35 @@ TEST(StudyReport, DataIsTheStudyAndScriptsStayClosed) {
   assets.plotly_js = dir / "absent.js";
   EXPECT_NE(assets.Missing().find("absent.js"), std::string::npos);
   EXPECT_THROW(StudyReportHtml(study, assets), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace hybridcont
+
+namespace hybridcont {
+namespace {
+
+// A note said in parts ("compiling model ..." when the compiler starts, the time when it ends) reaches the
+// hooks as one line.
+TEST(StudyNotes, ACompileNoteIsOneLine) {
+  const fs::path cache = fs::temp_directory_path() / "hybridcont_note_cache";
+  fs::remove_all(cache);
+  const char* before = std::getenv("HYBRIDCONT_CACHE");
+  const std::string saved = before ? before : "";
+  setenv("HYBRIDCONT_CACHE", cache.c_str(), 1);
+  StudyOptions options;
+  options.model = std::string(HYBRIDCONT_SOURCE_DIR) + "/models/bouncing-ball.toml";
+  std::vector<std::string> notes;
+  StudyHooks hooks;
+  hooks.on_note = [&](const std::string& line) { notes.push_back(line); };
+  RunStudy(options, hooks);
+  if (before) setenv("HYBRIDCONT_CACHE", saved.c_str(), 1);
+  else unsetenv("HYBRIDCONT_CACHE");
+  fs::remove_all(cache);
+  ASSERT_FALSE(notes.empty());
+  const std::string& line = notes.front();
+  EXPECT_EQ(line.rfind("compiling model 'bouncing-ball' (first use of this model; cached in ", 0), 0u) << line;
+  EXPECT_EQ(line.substr(line.size() - 2), " s") << line;
 }
 
 }  // namespace

@@ -483,21 +483,23 @@ nlohmann::json ResultOptionsJson(const StudyOptions& o, const HybridModel& model
 class NoteBuffer : public std::stringbuf {
  public:
   explicit NoteBuffer(const StudyHooks& hooks) : hooks_(hooks) {}
+  // A flush without a newline (a note said in parts, "compiling ..." then "done") waits for its line's end.
   int sync() override {
-    std::string text = str();
+    pending_ += str();
+    str("");
     std::size_t end;
-    while ((end = text.find('\n')) != std::string::npos) {
-      std::string line = text.substr(0, end);
+    while ((end = pending_.find('\n')) != std::string::npos) {
+      std::string line = pending_.substr(0, end);
       if (line.rfind("note: ", 0) == 0) line.erase(0, 6);
       if (hooks_.on_note) hooks_.on_note(line);
-      text.erase(0, end + 1);
+      pending_.erase(0, end + 1);
     }
-    str(text);
     return 0;
   }
 
  private:
   const StudyHooks& hooks_;
+  std::string pending_;  // the start of a line not yet ended
 };
 
 // A study checked against its model, ready to run: nothing computed or written yet.
