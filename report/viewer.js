@@ -150,7 +150,9 @@
     const colour = colourOf(b.family);
     const start = performance.now(), seconds = 2.0;
     const frame = (now) => {
-      const f = frames[Math.floor(((now - start) / 1000 / seconds) * frames.length) % frames.length];
+      // requestAnimationFrame's time is the frame's start, which may precede `start`.
+      const k = Math.floor((Math.max(0, now - start) / 1000 / seconds) * frames.length) % frames.length;
+      const f = frames[k];
       ctx.clearRect(0, 0, W, H);
       if (drawing.ground) {
         ctx.strokeStyle = '#888'; ctx.lineWidth = 1;
