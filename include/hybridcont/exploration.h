@@ -92,6 +92,9 @@ struct ExplorationOptions {
   // exploration of the same problem with the same options: the diagram is then that of an uninterrupted
   // exploration. Called on the exploring thread.
   std::function<std::optional<Branch>(int id)> recorded_branch;
+  // A recorded branch the exploration takes (recorded_branch), before its points are reported: what was
+  // learnt from its trace may be learnt again here. Called on the exploring thread. Empty: nothing.
+  std::function<void(const Branch& branch)> on_recorded_branch;
   // A regular start traces the direction of its given tangent only (a branch continued from its end, whose
   // other side is known): Explore(problem, u0, tangent, options).
   bool one_way_start = false;

@@ -301,6 +301,7 @@ Branch Explorer::Traced(HalfBranch* half, int id) {
     if (recorded && same(*recorded)) {
       recorded->id = id;
       Recall(half, /*wait=*/true);  // traced ahead for nothing
+      if (options_.on_recorded_branch) options_.on_recorded_branch(*recorded);
       half->progress.clear();
       if (options_.continuation.progress) images_.ReportImage(*recorded, &half->progress);
       return std::move(*recorded);

@@ -587,11 +587,13 @@ void SpecialPointDetector::RedetectTestFunctions(size_t from, Branch* branch) {
   for (const Symmetry& s : symmetries) {
     if (s.name == branch->symmetry) symmetry = &s;
   }
+  // A mapped branch is images from its start; a reflected loop from after its midpoint (`from`, traced).
+  const size_t first_image = branch->image_of >= 0 ? from : from + 1;
   for (size_t i = from; i < branch->points.size(); ++i) {
     ContinuationPoint& p = branch->points[i];
     const Vector mapped = p.test_values;
     p.evaluated_at.resize(0);
-    if (symmetry != nullptr && symmetry->signs.size() == p.u.size()) {
+    if (symmetry != nullptr && i >= first_image && symmetry->signs.size() == p.u.size()) {
       functions_->EvaluateAtImage(p.u, symmetry->Apply(p.u), &p.test_values);
     } else {
       Sample(&p);

@@ -391,11 +391,9 @@ ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point
   }
   if (store_ != nullptr) {
     const int offset = store_offset_ + branch_offset;
-    options.recorded_branch = [this, store = store_, offset](int id) {
-      std::optional<Branch> branch = store->Lookup(offset + id);
-      if (branch) RelearnRecordedPoints(*branch);
-      return branch;
-    };
+    options.recorded_branch = [store = store_, offset](int id) { return store->Lookup(offset + id); };
+    // Once taken, and once a worker tracing it ahead is recalled: nothing publishes over what is learnt.
+    options.on_recorded_branch = [this](const Branch& b) { RelearnRecordedPoints(b); };
     options.on_branch = [store = store_, offset](const Branch& b) { store->Save(offset + b.id, b); };
   }
   return options;
@@ -415,9 +413,10 @@ void ModelExploration::RelearnRecordedPoints(const Branch& branch) {
   for (const Symmetry& s : symmetries) {
     if (s.name == branch.symmetry) symmetry = &s;
   }
+  // (A reflected loop's images begin after its midpoint, reflected_from − 1, which was traced.)
   const std::size_t mapped = symmetry == nullptr          ? branch.points.size()
                              : branch.image_of >= 0       ? 0
-                             : branch.reflected_from >= 1 ? static_cast<std::size_t>(branch.reflected_from - 1)
+                             : branch.reflected_from >= 1 ? static_cast<std::size_t>(branch.reflected_from)
                                                           : branch.points.size();
   for (std::size_t i = 0; i < std::min(mapped, branch.points.size()); ++i) {
     const ContinuationPoint& p = branch.points[i];
