@@ -61,7 +61,6 @@ json AnimationJson(const StudyBranch& b, const HybridModel& model, const OrbitPr
 
 json BranchJson(const StudyBranch& b) {
   json columns = json::object();
-  const std::size_t n = b.points.size();
   for (std::size_t k = 0; k < b.unknown_names.size(); ++k) {
     json values = json::array();
     for (const StudyPoint& p : b.points) values.push_back(Number(static_cast<Eigen::Index>(k) < p.u.size() ? p.u(k) : NAN));
@@ -97,7 +96,6 @@ json BranchJson(const StudyBranch& b) {
     }
   }
   columns["T"] = std::move(period);
-  (void)n;
   return {{"id", b.id},
           {"family", b.family},
           {"origin", b.origin},
