@@ -35,6 +35,8 @@ def test_report_opens_offline_and_a_click_shows_the_orbit(slip_report):
     try:
         wait_for(browser, "document.readyState === 'complete' && !!document.querySelector('#diagram .scatterlayer')")
         assert browser.errors() == []
+        # Before a point is chosen, no empty orbit frame is on the screen.
+        assert browser.evaluate("getComputedStyle(document.getElementById('orbit')).display") == "none"
         # The page fetches nothing: every script is inline.
         assert browser.evaluate("[...document.scripts].every(s => !s.src)")
         # A point of hopping in place (branch 2) where it is stable, at its pixel on the screen.
