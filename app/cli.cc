@@ -81,8 +81,18 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
   AddRunOptions(run, &run_args);
 
   std::string plot_dir;
+  FigureOptions figures;
   auto* plot = app.add_subcommand("plot", "draw the figures of saved results");
   NonEmpty(plot->add_option("dir", plot_dir, "results folder written by `hybridcont run`")->required());
+  plot->add_flag("--svg", figures.svg, "also write every figure as SVG");
+  plot->add_flag("--pdf", figures.pdf, "also write every figure as PDF");
+  plot->add_flag("--all", figures.all,
+                 "label every branch's special points and show every branch whole (by default the view "
+                 "encloses the physical families)");
+  auto* x_option = NonEmpty(plot->add_option("--x", figures.x, "with --y: draw only column Y over column X"));
+  auto* y_option = NonEmpty(plot->add_option("--y", figures.y, "with --x: the column on the vertical axis"));
+  x_option->needs(y_option);
+  y_option->needs(x_option);
 
   // A misspelt command would otherwise be reported as "A subcommand is required".
   const auto is_command = [&app](const std::string& word) {
@@ -122,7 +132,7 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
     if (*list) return ListCommand(list_models, out, err);
     if (*check) return CheckCommand(check_args, out, err);
     if (*run) return RunCommand(run_args, out, err);
-    if (*plot) return PlotCommand(plot_dir, out, err);
+    if (*plot) return PlotCommand(plot_dir, figures, out, err);
   } catch (const std::invalid_argument& e) {
     err << "error: " << Printable(e.what()) << "\n";
     return 2;

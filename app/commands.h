@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "figure_script.h"
+
 namespace CLI {
 class App;
 class Option;
@@ -58,7 +60,8 @@ void AddRunOptions(CLI::App* run, RunArguments* args);
 CLI::Option* NonEmpty(CLI::Option* option);
 int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err);
 
-int PlotCommand(const std::string& dir, std::ostream& out, std::ostream& err);
+// `plot DIR`: the figures (FigureOptions: formats, --all, one diagram of two columns) and report.html.
+int PlotCommand(const std::string& dir, const FigureOptions& figures, std::ostream& out, std::ostream& err);
 
 }  // namespace hybridcont::app
 

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "install_paths.h"
 
@@ -86,14 +87,14 @@ void ReportOutput(const fs::path& dir, const std::string& output, int rc, std::o
       err << line << "\n";
     }
   }
-  if (rc != 0) {
+  if (rc != 0 && !(all_messages && rc == 2)) {  // exit 2 of `plot`: its error line says it all
     err << "warning: drawing the figures failed" << (logged ? " (see " + log.string() + ")" : std::string()) << "\n";
   }
 }
 
 }  // namespace
 
-int DrawFigures(const fs::path& dir, std::ostream& err, bool all_messages) {
+int DrawFigures(const fs::path& dir, std::ostream& err, bool all_messages, const FigureOptions& options) {
   const fs::path script = PlotScriptPath();  // install_paths.h: this executable's own script
   if (script.empty()) {
     err << "warning: figure script not found (see `hybridcont --paths`); results are saved, figures skipped\n";
@@ -102,12 +103,17 @@ int DrawFigures(const fs::path& dir, std::ostream& err, bool all_messages) {
   // Debian's python3 carries matplotlib (python3-matplotlib); prefer it over other pythons on PATH.
   std::error_code ec;
   const std::string python = fs::exists("/usr/bin/python3", ec) ? "/usr/bin/python3" : "python3";
-  const std::string script_text = script.string(), dir_text = dir.string();
-  char* const argv[] = {const_cast<char*>(python.c_str()), const_cast<char*>(script_text.c_str()),
-                        const_cast<char*>(dir_text.c_str()), nullptr};
+  std::vector<std::string> words = {python, script.string(), dir.string()};
+  if (options.svg) words.push_back("--svg");
+  if (options.pdf) words.push_back("--pdf");
+  if (options.all) words.push_back("--all");
+  if (!options.x.empty()) words.insert(words.end(), {"--x", options.x, "--y", options.y});
+  std::vector<char*> argv;
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
   std::string output;
   int rc = 1;
-  if (!RunCapturingOutput(argv, &output, &rc, err)) return 1;
+  if (!RunCapturingOutput(argv.data(), &output, &rc, err)) return 1;
   ReportOutput(dir, output, rc, err, all_messages);
   return rc;
 }

@@ -302,14 +302,18 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   return 0;
 }
 
-int PlotCommand(const std::string& dir, std::ostream& out, std::ostream& err) {
+int PlotCommand(const std::string& dir, const FigureOptions& figures, std::ostream& out, std::ostream& err) {
   std::error_code ec;
   if (!fs::exists(dir, ec)) throw std::invalid_argument("plot '" + dir + "': no such folder");
   if (!fs::is_directory(dir, ec)) throw std::invalid_argument("plot '" + dir + "': not a folder");
   if (!fs::exists(fs::path(dir) / "summary.json", ec)) {
     throw std::invalid_argument("plot '" + dir + "': no summary.json (run `hybridcont run MODEL --out " + dir + "` first)");
   }
-  const int rc = DrawFigures(dir, err, true);
+  const int rc = DrawFigures(dir, err, true, figures);
+  if (rc == 0 && !figures.x.empty()) {  // one diagram asked for: nothing else is redrawn
+    out << "figure written to " << (fs::path(dir) / (figures.y + "_" + figures.x + ".png")).string() << "\n";
+    return 0;
+  }
   if (rc == 0) out << "figures written to " << dir << "/\n";
   if (rc == 0) {
     const StudyResult study = LoadStudy(dir);

@@ -3,10 +3,12 @@
 
 Usage::
 
-    /usr/bin/python3 hybridcont_plot.py RESULTS_DIR [--svg] [--frames N]
+    /usr/bin/python3 hybridcont_plot.py RESULTS_DIR [--svg] [--pdf] [--all] [--x COLUMN --y COLUMN] [--frames N]
 
 Reads RESULTS_DIR/summary.json and the CSV files it names, writes the figures into RESULTS_DIR as PNG
-(150 dpi; with ``--svg`` also as SVG) and prints the paths of the files written, one per line.
+(200 dpi; with ``--svg`` and ``--pdf`` also as vector files, text kept as text, fonts embedded) and prints
+the paths of the files written, one per line.  ``--x C --y D`` draws only the diagram of column D over
+column C (D_C.png), in the same style as the main diagram.
 Exits with status 2 and a one-line message on stderr (naming the file and the field) when the folder or
 summary.json is missing or malformed, with status 1 when some figure could not be drawn (the others are
 still written).  Only the standard library and matplotlib (Agg backend) are used.
@@ -45,13 +47,19 @@ orbit-<k>.csv
 
 Figures
 -------
-H_T.png          H-bar over T for every branch (paper Fig. HoverT).  Physical points (physical == 1)
-                 solid, the rest dashed; a branch is split into runs of equal flag that share their
-                 boundary point, so the line stays continuous.  One colour per branch.  Special points:
-                 SB filled dot, TP open circle, BP square, PD diamond, start star; points only bracketed
-                 (not located) have a grey edge.  With a "stable" column, stable physical parts are thicker.
-                 A run across the words of an automaton ("words" in summary.json) names each branch's
-                 word (its modes) in the legend.
+H_T.png          the main diagram: H-bar over T for every branch (paper Fig. HoverT).  Families in a
+                 parameter p instead (summary "options.free") give <y>_<p>.png: the period over p, or,
+                 where the period says nothing (constant, or T p or T / p constant: a forced system),
+                 the section's first state that changes.
+                 Drawn by family (summary "branches[].family"), not by branch: one Okabe-Ito colour per
+                 family (colour-blind safe), one legend entry each; branches without physical orbits
+                 thin, light grey and unlabelled ("other branches").  Physical stretches solid, the
+                 family's others dashed and lighter, stable ones thick with a dark rim; a family lying on
+                 another in the projection (mirror images) in long dashes on top.  The view encloses the
+                 families' physical orbits (--all: everything).  Special points on physical stretches are
+                 marked and labelled (SB filled dot, TP open circle, BP square, PD diamond, start star;
+                 only bracketed ones with a grey edge); labels of coinciding points join ("BP2/PD3"),
+                 and each label takes a free place around its point.  Others get a small grey marker.
                  A branch whose projection collapses to one point is drawn as a marker.
 H_T_xi.png       (only when some xi != 0) the same in three dimensions T, xi, H-bar, showing the
                  branches that differ only in xi (e.g. an equilibrium family).
@@ -71,19 +79,22 @@ import math
 import os
 import sys
 
-plt = Line2D = Circle = None  # matplotlib, imported once the results have been read (import_matplotlib)
+plt = Line2D = Circle = patheffects = None  # matplotlib, imported once the results have been read (import_matplotlib)
 
 
 def import_matplotlib():
     """matplotlib takes half a second to import: a damaged folder or a bad argument is reported first."""
-    global plt, Line2D, Circle
+    global plt, Line2D, Circle, patheffects
     if plt is None:
         import matplotlib
         matplotlib.use("Agg")
+        matplotlib.rcParams["svg.fonttype"] = "none"  # SVG text stays text (editable, searchable)
+        matplotlib.rcParams["pdf.fonttype"] = 42      # PDF fonts embedded as TrueType (journals ask for it)
         import matplotlib.pyplot as pyplot
+        import matplotlib.patheffects as effects
         from matplotlib.lines import Line2D as line_2d
         from matplotlib.patches import Circle as circle
-        plt, Line2D, Circle = pyplot, line_2d, circle
+        plt, Line2D, Circle, patheffects = pyplot, line_2d, circle, effects
 
 
 
@@ -381,23 +392,73 @@ def load_branches(results_dir, summary):
 # styling helpers
 # ----------------------------------------------------------------------------------------------------
 
-def branch_colour(position):
-    cycle = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
-             "#bcbd22", "#17becf"]
-    return cycle[position % len(cycle)]
+# Okabe & Ito's eight colours, distinguishable with every common colour-vision deficiency (yellow last: it
+# is faint on white).  A family keeps its colour in every figure of a folder.
+OKABE_ITO = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#56B4E9", "#E69F00", "#000000", "#F0E442"]
+OTHER_COLOUR = "0.72"  # branches without physical orbits: light, behind the families
+OTHER_LABEL = "other branches (no physical orbit)"
+
+
+def family_colours(presentation_families, branches):
+    """{family name: colour}: the presentation's families first, in its order, then the others as met."""
+    order = [f for f in presentation_families or [] if isinstance(f, str)]
+    for b in branches:
+        f = b.get("family")
+        if f and f not in order:
+            order.append(f)
+    return {f: OKABE_ITO[k % len(OKABE_ITO)] for k, f in enumerate(order)}
 
 
 # The paper's models are written in units of a mass m_o, a length l_o and gravity g; other models (model
 # files of the user's own) carry the units of their parameters, which the figures do not guess.
 PAPER_MODELS = {"bouncing-ball", "rocking-block", "bouncing-rod", "slip", "ball-chain"}
 UNITS = {"on": True}
+# Options of the whole run: "all" draws every branch's special points as the families' are drawn; "formats"
+# the file types each figure is written in.
+FIGURE_OPTIONS = {"all": False, "formats": ["png"]}
 
 
 def time_unit():
     return r"\ \ [\sqrt{l_\mathrm{o}/g}]" if UNITS["on"] else ""
 
 
-def axis_label(name):
+GREEK = {"alpha", "beta", "gamma", "delta", "epsilon", "zeta", "eta", "theta", "iota", "kappa", "lambda", "mu",
+         "nu", "xi", "pi", "rho", "sigma", "tau", "phi", "chi", "psi", "omega"}
+
+
+def symbol(name):
+    """A state's name as mathematics: alpha -> α, dx -> ẋ (a leading d is a time derivative), th_st -> θ_st."""
+    base, _, sub = name.partition("_")
+    dot = base.startswith("d") and len(base) > 1 and (base[1:] in GREEK or len(base) == 2)
+    core = base[1:] if dot else base
+    if core in GREEK:
+        core = "\\" + core
+    elif core == "th":
+        core = "\\theta"
+    elif core == "ph":
+        core = "\\phi"
+    elif len(core) > 1:
+        core = r"\mathrm{%s}" % core
+    core = (r"\dot{%s}" % core) if dot else core
+    return "$%s%s$" % (core, "_{\\mathrm{%s}}" % sub.replace("_", r"\_") if sub else "")
+
+
+def state_column(name, res):
+    """(phase name, state name) of a column x<i>_<state> (the state at the start of phase i), else None."""
+    if res is None or not name.startswith("x") or "_" not in name:
+        return None
+    head, _, state = name.partition("_")
+    if not head[1:].isdigit():
+        return None
+    i = int(head[1:]) - 1
+    if 0 <= i < len(res.phases) and state in res.phases[i]["states"]:
+        return res.phases[i]["name"], state
+    return None
+
+
+def axis_label(name, res=None):
+    """The name of a column on an axis, in words with its symbol and unit: "energy H̄ [m g l]", "period T",
+    "ẋ at the start of flight (x2_dx)", "parameter k"; a column the figures do not know keeps its name."""
     energy_unit = r"\ \ [m_\mathrm{o} g\, l_\mathrm{o}]" if UNITS["on"] else ""
     labels = {
         "H": r"energy $\bar{H}%s$" % energy_unit,
@@ -407,7 +468,16 @@ def axis_label(name):
     if name in labels:
         return labels[name]
     if name.startswith("t") and name[1:].isdigit():
-        return r"$t_{%s}%s$" % (name[1:], time_unit())
+        phase = ""
+        i = int(name[1:]) - 1
+        if res is not None and res.phases:
+            phase = " (%s)" % res.phases[i % len(res.phases)]["name"] if i < len(res.phases) + 1 else ""
+        return r"duration $t_{%s}$%s%s" % (name[1:], phase, ("$%s$" % time_unit()) if UNITS["on"] else "")
+    state = state_column(name, res)
+    if state is not None:
+        return "%s at the start of %s  (%s)" % (symbol(state[1]), state[0], name)
+    if res is not None and name in res.parameters:
+        return "parameter %s" % name
     return name
 
 
@@ -421,10 +491,10 @@ def column_symbol(name):
     return name
 
 
-def axis_label_of(names):
+def axis_label_of(names, res=None):
     """Label of an axis showing several columns: durations share their unit, other names are listed."""
     if len(names) == 1:
-        return axis_label(names[0])
+        return axis_label(names[0], res)
     if all(n.startswith("t") and n[1:].isdigit() for n in names):
         return "durations " + ", ".join(column_symbol(n) for n in names) + ("$%s$" % time_unit() if UNITS["on"] else "")
     return ", ".join(names)
@@ -489,10 +559,12 @@ def branch_label(branch, special_points):
     return label
 
 
-def plot_runs(ax, xs, ys, phys, stable, colour, zs=None):
+def plot_runs(ax, xs, ys, phys, stable, colour, zs=None, over=False):
     """Draw one branch: runs of equal (physical, stable) flag, solid/dashed, sharing boundary points.
 
-    Points with a non-finite coordinate break the line.  Returns True when something was drawn."""
+    Points with a non-finite coordinate break the line.  With `over` the branch lies on one drawn before
+    (a mirror image in this projection): its physical runs are drawn in long dashes on top, so that both
+    colours show.  Returns True when something was drawn."""
     n = len(xs)
     pts = []
     for i in range(n):
@@ -508,10 +580,18 @@ def plot_runs(ax, xs, ys, phys, stable, colour, zs=None):
         return (p, s)
 
     def draw(run, k):
-        lw = 2.9 if k[1] else (1.8 if k[0] else 1.4)
-        ls = "-" if k[0] else (0, (4.0, 2.5))
         cols = list(zip(*run))
-        ax.plot(*cols, color=colour, lw=lw, ls=ls, solid_capstyle="round", zorder=2 + k[0])
+        dashes = dict(ls=(0, (5.0, 5.0)), zorder=5) if over and k[0] else {}
+        if colour == OTHER_COLOUR:  # a branch with no physical orbit: thin and behind everything
+            ax.plot(*cols, color=colour, lw=0.9, ls=(0, (3.0, 2.0)), zorder=1)
+        elif k[1]:  # stable: thick, with a dark rim, above the rest
+            rim = [] if over else [patheffects.Stroke(linewidth=6.2, foreground="0.15"), patheffects.Normal()]
+            ax.plot(*cols, **dict(dict(color=colour, lw=4.6, solid_capstyle="round", zorder=4,
+                                       path_effects=rim), **dashes))
+        elif k[0]:
+            ax.plot(*cols, **dict(dict(color=colour, lw=1.9, solid_capstyle="round", zorder=3), **dashes))
+        else:  # a family's non-physical stretch: its colour, dashed and lighter
+            ax.plot(*cols, color=colour, lw=1.2, ls=(0, (4.0, 2.5)), alpha=0.6, zorder=2)
 
     span = max(max(abs(c[d] - good[0][d]) for c in good) for d in range(len(good[0])))
     scale = max(1.0, max(abs(v) for c in good for v in c))
@@ -571,9 +651,20 @@ class Results:
             path = os.path.join(results_dir, o["file"]) if isinstance(o.get("file"), str) else None
             if path is not None and not os.path.isfile(path):
                 raise PlotError("%s names %s, which is missing" % (self.summary_path, path))
-        for pos, b in enumerate(self.branches):
-            b["colour"] = branch_colour(pos)
-            b["label"] = branch_label(b, self.special_points)
+        # A branch is drawn as its family (summary "family": named by the model's family rules where its
+        # orbits are physical); branches without physical orbits are "other branches", light and unlabelled.
+        for b in self.branches:
+            f = b["entry"].get("family")
+            b["family"] = f if isinstance(f, str) and f else None
+            declared = (self.presentation or {}).get("families") or []
+            if (b["family"] and b.get("word") and b["family"] not in declared and b["word"] not in b["family"]
+                    and " > " not in b["family"]):
+                b["family"] += " [%s]" % b["word"]
+        colours = family_colours((self.presentation or {}).get("families"), self.branches)
+        for b in self.branches:
+            b["colour"] = colours[b["family"]] if b["family"] else OTHER_COLOUR
+            b["label"] = b["family"] or OTHER_LABEL
+            b["detail"] = branch_label(b, self.special_points)
         self.by_id = {b["id"]: b for b in self.branches}
 
     def has_stable(self):
@@ -649,9 +740,27 @@ class Results:
 # bifurcation diagrams
 # ----------------------------------------------------------------------------------------------------
 
+def on_physical_stretch(res, sp):
+    """Whether a special point lies where its branch's orbits are physical (either neighbouring point)."""
+    branch = res.by_id.get(sp.get("branch"))
+    if branch is None or branch["table"] is None or not branch["family"]:
+        return sp.get("type") == "start"
+    phys = branch["table"].num("physical")
+    index = to_float(sp.get("index"))
+    if phys is None or not finite(index):
+        return False
+    row = int(index)
+    return any(0 <= r < len(phys) and phys[r] == 1 for r in (row, row + 1))
+
+
 def draw_special_points(ax, res, xname, yname, zname=None, annotate=True, only=None):
-    """Markers of the special points; returns {legend name: style} of those drawn."""
+    """Markers of the special points; returns {legend name: style} of those drawn.
+
+    Points where the orbits are physical get their marker and a label (placed later by place_labels, so
+    that labels of coincident points merge and none overlaps another); the others a small light marker,
+    unlabelled, unless the figure shows every branch's points (--all)."""
     used = {}
+    labels = getattr(ax, "_hc_labels", [])
     for sp in res.special_points:
         kind = str(sp.get("type", "?"))
         if only is not None and not only(sp):
@@ -662,26 +771,102 @@ def draw_special_points(ax, res, xname, yname, zname=None, annotate=True, only=N
             continue
         style = special_point_style(kind, str(sp.get("status", "located")) != "located",
                                     res.summary.get("special_point_codes"))
+        main = on_physical_stretch(res, sp) or FIGURE_OPTIONS["all"]
         kw = dict(marker=style["marker"], s=style["s"], facecolors=style["facecolor"],
                   edgecolors=style["edgecolor"], linewidths=style["linewidth"], zorder=6)
+        if not main:
+            kw.update(s=style["s"] * 0.35, facecolors="0.85" if style["facecolor"] != "white" else "white",
+                      edgecolors="0.6", linewidths=0.7, zorder=2)
         if zname:
             ax.scatter([x], [y], [z], depthshade=False, **kw)
         else:
             ax.scatter([x], [y], **kw)
-            if annotate and kind != "start":
-                ax.annotate("%s%s" % (kind, sp.get("id", "")), (x, y), xytext=(5, 4),
-                            textcoords="offset points", fontsize=7, color="0.2", zorder=7,
-                            bbox=dict(boxstyle="round,pad=0.1", fc="white", ec="none", alpha=0.75))
-        used[style["name"]] = style
+            if annotate and kind != "start" and main:
+                labels.append((x, y, "%s%s" % (kind, sp.get("id", ""))))
+        if main:
+            used[style["name"]] = style
+    ax._hc_labels = labels
     return used
 
 
+def place_labels(ax, fontsize=7):
+    """Writes the special points' labels gathered on ax without collisions.
+
+    Labels of points that coincide on the figure (within 3 pixels: a PD and a BP at one orbit) are joined
+    ("BP2/PD3").  Each label takes the first of 12 positions around its point (near ones first) whose box
+    overlaps no label placed before, no marker and no axis edge; when none is free, the least crowded one."""
+    labels = getattr(ax, "_hc_labels", [])
+    if not labels:
+        return
+    ax.get_xlim(), ax.get_ylim()  # settles the autoscaled limits, so that transData is final
+    fig = ax.figure
+    px = fig.dpi / 72.0
+    groups = []
+    for x, y, text in labels:
+        X, Y = ax.transData.transform((x, y))
+        for g in groups:
+            if abs(g["X"] - X) <= 3 and abs(g["Y"] - Y) <= 3:
+                if text not in g["texts"]:
+                    g["texts"].append(text)
+                break
+        else:
+            groups.append({"x": x, "y": y, "X": X, "Y": Y, "texts": [text]})
+    box = ax.get_window_extent()
+    markers = [(g["X"] - 5 * px, g["Y"] - 5 * px, g["X"] + 5 * px, g["Y"] + 5 * px) for g in groups]
+    placed = []
+
+    def overlap(a, b):
+        w = min(a[2], b[2]) - max(a[0], b[0])
+        h = min(a[3], b[3]) - max(a[1], b[1])
+        return w * h if w > 0 and h > 0 else 0.0
+
+    for g in sorted(groups, key=lambda g: (g["X"], g["Y"])):
+        text = "/".join(sorted(g["texts"], key=lambda t: (t.rstrip("0123456789"), int("0" + t.lstrip("ABCDEFGHIJKLMNOPQRSTUVWXYZ")))))
+        w, h = 0.62 * fontsize * len(text) * px + 2 * px, 1.25 * fontsize * px
+        best = None
+        for r in (6, 14):
+            for dx, dy in ((1, 0.4), (1, -1.4), (-1, 0.4), (-1, -1.4), (0, 1), (0, -2.2)):
+                ox = r * px if dx > 0 else (-r * px - w if dx < 0 else -w / 2)
+                oy = dy * (r * 0.6) * px if dx != 0 else (r * px if dy > 0 else -r * px - h)
+                cand = (g["X"] + ox, g["Y"] + oy, g["X"] + ox + w, g["Y"] + oy + h)
+                cost = sum(overlap(cand, q) for q in placed) + sum(overlap(cand, m) for m in markers)
+                if cand[0] < box.x0 or cand[2] > box.x1 or cand[1] < box.y0 or cand[3] > box.y1:
+                    cost += w * h
+                if best is None or cost < best[0] - 1e-9:
+                    best = (cost, cand, dx, ox, oy)
+                if cost == 0:
+                    break
+            if best[0] == 0:
+                break
+        _, cand, dx, ox, oy = best
+        placed.append(cand)
+        # the text's near edge at the box's near edge: the estimated width only reserves room
+        ha, tx = {1: ("left", ox), -1: ("right", ox + w), 0: ("center", ox + w / 2)}[dx]
+        ax.annotate(text, (g["x"], g["y"]), xytext=(tx / px, oy / px), textcoords="offset points",
+                    fontsize=fontsize, color="0.15", ha=ha, va="bottom", zorder=7,
+                    bbox=dict(boxstyle="square,pad=0.05", fc="white", ec="none", alpha=0.8))
+    ax._hc_labels = []
+
+
 def legend_handles(res, branches_drawn, sp_styles, stable=False, extra=()):
-    handles = [Line2D([], [], color=b["colour"], lw=2, label=b["label"]) for b in branches_drawn]
-    handles.append(Line2D([], [], color="0.2", lw=1.8, label="physical (solid)"))
-    handles.append(Line2D([], [], color="0.2", lw=1.4, ls=(0, (4.0, 2.5)), label="non-physical (dashed)"))
+    """One entry per family drawn (in the colour order), the light "other branches", the line styles and
+    the kinds of special point drawn."""
+    handles, seen = [], set()
+    for b in sorted(branches_drawn, key=lambda b: (b["family"] is None, OKABE_ITO.index(b["colour"])
+                                                   if b["colour"] in OKABE_ITO else 99)):
+        if b["label"] in seen:
+            continue
+        seen.add(b["label"])
+        if b["family"] is None:
+            handles.append(Line2D([], [], color=OTHER_COLOUR, lw=0.9, ls=(0, (3.0, 2.0)), label=b["label"]))
+        else:
+            handles.append(Line2D([], [], color=b["colour"], lw=2.4, label=b["label"]))
+    handles.append(Line2D([], [], color="0.2", lw=1.9, label="physical"))
+    handles.append(Line2D([], [], color="0.2", lw=1.2, ls=(0, (4.0, 2.5)), alpha=0.6, label="not physical"))
     if stable:
-        handles.append(Line2D([], [], color="0.2", lw=2.9, label="stable (thick)"))
+        handles.append(Line2D([], [], color="0.5", lw=4.6, label="stable",
+                              path_effects=[patheffects.Stroke(linewidth=6.2, foreground="0.15"),
+                                            patheffects.Normal()]))
     handles.extend(extra)
     for name in sorted(sp_styles):
         st = sp_styles[name]
@@ -691,27 +876,62 @@ def legend_handles(res, branches_drawn, sp_styles, stable=False, extra=()):
 
 
 def place_legend(fig, ax, handles):
+    place_labels(ax)
     ncol = 1 if len(handles) <= 16 else 2
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False,
               ncol=ncol, borderaxespad=0.0, handlelength=2.6)
 
 
+def same_curve(a, b):
+    """Whether two drawn curves (lists of (x, y)) are the same points, to 1e-9 of their size."""
+    if len(a) != len(b) or not a:
+        return False
+    scale = max(1.0, max(abs(v) for p in a for v in p))
+    return all(abs(p[0] - q[0]) <= 1e-9 * scale and abs(p[1] - q[1]) <= 1e-9 * scale for p, q in zip(a, b))
+
+
+def focus_on_families(ax, res, xname, yname, margin=0.06):
+    """Limits enclosing the families' physical orbits (the other branches, and the families' non-physical
+    stretches, reach far off where nothing is physical); unchanged when no family is drawn or with --all."""
+    if FIGURE_OPTIONS["all"]:
+        return
+    pts = []
+    for b in res.branches:
+        xs, ys, phys = res.column(b, xname), res.column(b, yname), b["table"].num("physical")
+        if b["family"] is None or xs is None or ys is None or phys is None:
+            continue
+        pts += [(x, y) for x, y, p in zip(xs, ys, phys) if p == 1 and finite(x, y)]
+    if not pts:
+        return
+    for axis, values in ((ax.set_xlim, [p[0] for p in pts]), (ax.set_ylim, [p[1] for p in pts])):
+        lo, hi = min(values), max(values)
+        pad = (hi - lo) * margin if hi > lo else max(abs(hi), 1.0) * 0.05
+        axis(lo - pad, hi + pad)
+
+
 def projection(ax, res, xname, yname, sp=True, annotate=True, sp_filter=None):
-    """Draw all branches in the (xname, yname) projection; returns (branches drawn, special point styles)."""
+    """Draw all branches in the (xname, yname) projection; returns (branches drawn, special point styles).
+
+    Families are drawn in their colours; a family lying on another one in this projection (a mirror image:
+    forward and backward hopping have the same H and T) in long dashes on top of it."""
     stable = res.has_stable()
-    drawn = []
+    drawn, curves = [], []
     for b in res.branches:
         xs, ys = res.column(b, xname), res.column(b, yname)
         if xs is None or ys is None:
             continue
         t = b["table"]
         st = t.num("stable") if stable else None
-        how = plot_runs(ax, xs, ys, t.num("physical"), st, b["colour"])
+        curve = [(x, y) for x, y in zip(xs, ys) if finite(x, y)]
+        over = b["family"] is not None and any(f != b["family"] and same_curve(curve, c) for f, c in curves)
+        how = plot_runs(ax, xs, ys, t.num("physical"), st, b["colour"], over=over)
+        if b["family"] is not None:
+            curves.append((b["family"], curve))
         if how:
-            drawn.append(dict(b, label=b["label"] + ("; a point here" if how == "point" else "")))
+            drawn.append(b)
     sp_styles = draw_special_points(ax, res, xname, yname, annotate=annotate, only=sp_filter) if sp else {}
-    ax.set_xlabel(axis_label(xname))
-    ax.set_ylabel(axis_label(yname))
+    ax.set_xlabel(axis_label(xname, res))
+    ax.set_ylabel(axis_label(yname, res))
     ax.grid(True, color="0.9", lw=0.6)
     return drawn, sp_styles
 
@@ -724,24 +944,80 @@ def model_title(res):
 
 
 def save(fig, res, name, svg, written):
-    path = os.path.join(res.dir, name + ".png")
-    fig.savefig(path, dpi=150, bbox_inches="tight")
-    written.append(path)
-    if svg:
-        path = os.path.join(res.dir, name + ".svg")
-        fig.savefig(path, bbox_inches="tight")
+    """Writes the figure in every format asked for (PNG at 200 dpi; SVG and PDF as vectors)."""
+    formats = list(FIGURE_OPTIONS["formats"])
+    if svg and "svg" not in formats:
+        formats.append("svg")
+    for ext in formats:
+        path = os.path.join(res.dir, name + "." + ext)
+        fig.savefig(path, dpi=200 if ext == "png" else None, bbox_inches="tight")
         written.append(path)
     plt.close(fig)
 
 
+def physical_values(res, name, of=None):
+    """The column's values over the physical points of every branch (of(value, row) applied when given)."""
+    vals = []
+    for b in res.branches:
+        col, phys = res.column(b, name), b["table"].num("physical")
+        if col is not None and phys is not None:
+            vals += [v if of is None else of(v, b, r) for r, (v, p) in enumerate(zip(col, phys))
+                     if p == 1 and finite(v)]
+    return [v for v in vals if finite(v)]
+
+
+def constant(vals):
+    return bool(vals) and max(vals) - min(vals) <= 1e-9 * max(1e-300, max(abs(v) for v in vals))
+
+
+def period_is_forced(res):
+    """Whether the period says nothing: constant, or in fixed ratio to the parameter (T = 2πn/w of a system
+    forced at frequency w, T = n p of one forced with period p)."""
+    if constant(physical_values(res, "T")):
+        return True
+    if res.family == "H":
+        return False
+    col = lambda v, b, r: v * res.column(b, res.family)[r]  # noqa: E731
+    ratio = lambda v, b, r: v / res.column(b, res.family)[r]  # noqa: E731
+    return constant(physical_values(res, "T", col)) or constant(physical_values(res, "T", ratio))
+
+
+def main_diagram_axes(res):
+    """(x, y, file name) of the main diagram.
+
+    Families in H̄: H̄ over T (paper Fig. HoverT), H_T.png.  Families in a parameter p (a walker's slope, a
+    forced system's frequency): over p, the period, unless the period says nothing (period_is_forced: a
+    forced system's is the forcing's), then the first state at the section that changes; named <y>_<p>.png."""
+    if res.family == "H":
+        return "T", "H", "H_T"
+    y = "T"
+    if period_is_forced(res):
+        # the first state at the section (the start of the first phase: a position before its velocity,
+        # the amplitude of a forced oscillator) that changes along the families
+        first = [n for n in res.unknowns if state_column(n, res) and n.startswith("x1_")]
+        for name in first + [n for n in res.unknowns if state_column(n, res) and n not in first]:
+            if not constant(physical_values(res, name)):
+                y = name
+                break
+    return res.family, y, "%s_%s" % (y, res.family)
+
+
 def figure_h_t(res, svg, written):
-    fig, ax = plt.subplots(figsize=(7.0, 4.8))
-    drawn, sp_styles = projection(ax, res, "T", res.family)
+    xname, yname, name = main_diagram_axes(res)
+    figure_of_columns(res, xname, yname, name, svg, written)
+
+
+def figure_of_columns(res, xname, yname, name, svg, written, title=None):
+    """One column over another for every branch: the main diagram, and any pair asked for (--x, --y)."""
+    fig, ax = plt.subplots(figsize=(7.0, 4.6))
+    drawn, sp_styles = projection(ax, res, xname, yname)
     if not drawn:
         ax.text(0.5, 0.5, "no branch points", transform=ax.transAxes, ha="center", va="center", color="0.4")
-    ax.set_title(column_symbol(res.family) + r" over $T$: " + model_title(res), fontsize=10)
+    focus_on_families(ax, res, xname, yname)
+    ax.set_title((title or "%s over %s" % (column_symbol(yname), column_symbol(xname))) + ": " + model_title(res),
+                 fontsize=10)
     place_legend(fig, ax, legend_handles(res, drawn, sp_styles, res.has_stable()))
-    save(fig, res, "H_T", svg, written)
+    save(fig, res, name, svg, written)
 
 
 def figure_words(res, svg, written):
@@ -771,7 +1047,7 @@ def figure_words(res, svg, written):
                 continue
             pts = [(x, y) for x, y, p in zip(xs, ys, phys) if p == 1 and finite(x, y)]
             if pts:
-                ax.plot([x for x, _ in pts], [y for _, y in pts], ".", ms=3.5, color=branch_colour(k),
+                ax.plot([x for x, _ in pts], [y for _, y in pts], ".", ms=3.5, color=OKABE_ITO[k % len(OKABE_ITO)],
                         label=names[k] if k not in drawn else None)
                 drawn.add(k)
     by_id = {b["id"]: b for b in res.branches}
@@ -914,13 +1190,16 @@ def figure_declared(res, spec, svg, written):
     if extra:
         extra.insert(0, Line2D([], [], color="0.2", lw=1.8,
                                label="%s (line)" % column_symbol(ynames[0])))
-    ax.set_xlabel(axis_label(xname))
-    ax.set_ylabel(axis_label_of(ynames))
+    ax.set_xlabel(axis_label(xname, res))
+    ax.set_ylabel(axis_label_of(ynames, res))
+    if len(ynames) == 1 and " over " in spec["title"]:  # the model's own words for its quantity
+        ax.set_ylabel(spec["title"].split(" over ")[0] + "  (%s)" % ynames[0])
     if spec["zoom"]:
         (x0, x1), (y0, y1) = zoom_limits(res, interesting, xname, ynames)
         ax.set_xlim(x0, x1)
         ax.set_ylim(y0, y1)
     else:
+        focus_on_families(ax, res, xname, ynames[0])
         # a column through zero (a duration, a velocity) changes its meaning there: mark the zero
         lo, hi = data_range(res, xname)
         if lo < 0 < hi:
@@ -1173,7 +1452,7 @@ def figure_curves(res, svg, written):
         boundary = c.get("type") == "boundary"
         style = boundary_styles[boundaries % len(boundary_styles)] if boundary else "-"
         boundaries += 1 if boundary else 0
-        ax.plot(xs, ys, color="0.25" if boundary else branch_colour(pos), lw=1.6, ls=style,
+        ax.plot(xs, ys, color="0.25" if boundary else OKABE_ITO[pos % len(OKABE_ITO)], lw=1.6, ls=style,
                 label="boundary %s" % c.get("name") if boundary
                 else "%s from special point %s" % (c.get("type"), c.get("special_point")))
         for q in c.get("codim_two") or []:
@@ -1314,12 +1593,33 @@ def parse_args(argv):
                                      description="Figures from the results folder of 'hybridcont run'.")
     parser.add_argument("results_dir", help="folder with summary.json and the branch/orbit CSV files")
     parser.add_argument("--svg", action="store_true", help="also write every figure as SVG")
+    parser.add_argument("--pdf", action="store_true", help="also write every figure as PDF")
+    parser.add_argument("--all", action="store_true",
+                        help="label the special points of every branch and show every branch whole "
+                             "(by default the view encloses the physical families)")
+    parser.add_argument("--x", metavar="COLUMN", help="with --y: draw only this column over --x's")
+    parser.add_argument("--y", metavar="COLUMN", help="with --x: the column on the vertical axis")
     parser.add_argument("--frames", type=int, default=9,
                         help="key frames per orbit, equally spaced from t = 0 to T (2..16, default 9)")
     args = parser.parse_args(argv)
     if not 2 <= args.frames <= 16:
         parser.error("--frames must be between 2 and 16")
+    if (args.x is None) != (args.y is None):
+        parser.error("--x and --y go together (the two columns of one diagram)")
     return args
+
+
+def check_columns(res, names):
+    """Exit-2 error naming the column and the ones there are, when no branch has it."""
+    known = set()
+    for b in res.branches:
+        if b["table"] is not None:
+            known.update(b["table"].columns)
+    for name in names:
+        if name not in known:
+            shown = sorted(c for c in known if c not in ("index", "classification", "stability"))
+            raise PlotError("no branch file in %s has a column '%s'; the columns are: %s"
+                            % (res.dir, name, ", ".join(shown)))
 
 
 def main(argv):
@@ -1333,8 +1633,23 @@ def main(argv):
         print("hybridcont_plot: error: %s is malformed: %s: %s" % (
             os.path.join(args.results_dir, "summary.json"), type(e).__name__, e), file=sys.stderr)
         return 2
+    FIGURE_OPTIONS["all"] = args.all
+    FIGURE_OPTIONS["formats"] = ["png"] + (["svg"] if args.svg else []) + (["pdf"] if args.pdf else [])
+    if args.x is not None:
+        try:
+            check_columns(res, [args.x, args.y])
+        except PlotError as e:
+            print("hybridcont_plot: error: %s" % e, file=sys.stderr)
+            return 2
     import_matplotlib()
-    jobs = [("H_T", lambda w: figure_h_t(res, args.svg, w))]
+    if args.x is not None:
+        written = []
+        figure_of_columns(res, args.x, args.y, "%s_%s" % (args.y, args.x), False, written)
+        for path in written:
+            print(path)
+        return 0
+    main_name = main_diagram_axes(res)[2]
+    jobs = [(main_name, lambda w: figure_h_t(res, False, w))]
     if has_nonzero_xi(res):
         jobs.append(("H_T_xi", lambda w: figure_h_t_xi(res, args.svg, w)))
     jobs.append(("curves", lambda w: figure_curves(res, args.svg, w)))
@@ -1343,7 +1658,7 @@ def main(argv):
         warn("%s has no 'presentation' (written by an older hybridcont): only the generic figures are drawn"
              % res.summary_path)
     else:
-        names = set(("H_T", "H_T_xi", "keyframes", "curves", "words"))
+        names = set((main_name, "H_T_xi", "keyframes", "curves", "words"))
         for spec in res.presentation["figures"]:
             if spec["name"] in names:
                 warn("%s is declared twice or would overwrite a generic figure; skipped" % spec["file"])

@@ -288,3 +288,67 @@ TEST(Cli, RunOnTwoThreadsWritesWhatTheSerialRunWrites) {
 
 }  // namespace
 }  // namespace hybridcont::app
+
+namespace hybridcont::app {
+namespace {
+
+Matrix MonodromyOf(const nlohmann::json& orbit) {
+  const auto& rows = orbit.at("monodromy");
+  Matrix m(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(rows.size()));
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    for (Eigen::Index j = 0; j < m.cols(); ++j) m(i, j) = rows[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
+  }
+  return m;
+}
+
+// dT/dH̄ from the branch tangent against the ball's closed form T = sqrt(8 H̄), dT/dH̄ = 4 / T; the key-frame
+// orbit's monodromy: the ball's (a shear, both multipliers 1), and the SLIP's, whose eigenvalues hold the
+// nontrivial multipliers its branch file lists at that point.
+TEST(Cli, PeriodSlopeAndMonodromyAgreeWithTheClosedFormAndTheMultipliers) {
+  {
+    const fs::path dir = TempDir("ball_slope");
+    const CliResult r = RunTool({"run", "bouncing-ball", "--out", dir.string(), "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err << r.out;
+    std::ifstream summary_file(dir / "summary.json");
+    const nlohmann::json summary = nlohmann::json::parse(summary_file);
+    int checked = 0;
+    for (const auto& b : summary["branches"]) {
+      for (const auto& row : ReadCsv(dir / b["file"].get<std::string>())) {
+        if (row.at("physical") != "1" || std::stod(row.at("H")) < 0.05) continue;
+        const double T = std::stod(row.at("T"));
+        EXPECT_NEAR(std::stod(row.at("dT_dH")), 4.0 / T, 1e-8 * 4.0 / T) << "H = " << row.at("H");
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 5);
+    ASSERT_FALSE(summary["orbits"].empty());
+    const Matrix m = MonodromyOf(summary["orbits"][0]);
+    ASSERT_EQ(m.rows(), 2);
+    EXPECT_NEAR(m.determinant(), 1.0, 1e-9);
+    EXPECT_NEAR(m.trace(), 2.0, 1e-9);
+  }
+  const fs::path dir = TempDir("slip_monodromy");
+  const CliResult r = RunTool({"run", "slip", "--out", dir.string(), "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  std::ifstream summary_file(dir / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  int orbits = 0;
+  for (const auto& orbit : summary["orbits"]) {
+    const Matrix m = MonodromyOf(orbit);
+    const Eigen::VectorXcd eigenvalues = m.eigenvalues();
+    const auto rows = ReadCsv(dir / summary["branches"][orbit["branch"].get<std::size_t>()]["file"].get<std::string>());
+    const auto& row = rows.at(orbit["index"].get<std::size_t>());
+    for (int k = 1; row.count("mu" + std::to_string(k) + "_re") && !row.at("mu" + std::to_string(k) + "_re").empty(); ++k) {
+      const std::complex<double> mu(std::stod(row.at("mu" + std::to_string(k) + "_re")),
+                                    std::stod(row.at("mu" + std::to_string(k) + "_im")));
+      double nearest = HUGE_VAL;
+      for (const auto& e : eigenvalues) nearest = std::min(nearest, std::abs(e - mu));
+      EXPECT_LT(nearest, 1e-6 * (1 + std::abs(mu))) << orbit["label"] << " mu" << k << " = " << mu;
+    }
+    ++orbits;
+  }
+  EXPECT_EQ(orbits, 3);  // hopping in place, forward and backward hopping
+}
+
+}  // namespace
+}  // namespace hybridcont::app

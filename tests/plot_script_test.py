@@ -256,3 +256,94 @@ def test_damaged_folder_exits_2_before_drawing(plot, results, capsys, damage, me
     assert out == ""
     assert message in err and "Traceback" not in err, err
     assert not list(results.glob("*.png")), "figures drawn from a damaged folder"
+
+
+# --------------------------------------------------------------------------------------------------------
+# figures for papers: families, labels, formats, any two columns
+# --------------------------------------------------------------------------------------------------------
+
+def with_families(folder):
+    """The folder's summary with the writer's family names: branch 0 is forward hopping, branch 1 has no
+    physical orbit (no name)."""
+    with open(folder / "summary.json") as f:
+        s = json.load(f)
+    s["branches"][0]["family"] = "forward hopping"
+    with open(folder / "summary.json", "w") as f:
+        json.dump(s, f)
+    return folder
+
+
+def test_legend_names_families_not_branches(plot, results):
+    res = plot.Results(str(with_families(results)))
+    fig, ax = plot.plt.subplots()
+    drawn, styles = plot.projection(ax, res, "T", "H")
+    labels = [h.get_label() for h in plot.legend_handles(res, drawn, styles, stable=True)]
+    assert labels[:2] == ["forward hopping", plot.OTHER_LABEL]
+    assert not any(label.startswith("branch") for label in labels)
+    # the family takes the first of Okabe and Ito's colours; the unnamed branch is light grey
+    assert res.by_id[0]["colour"] == plot.OKABE_ITO[0] and res.by_id[1]["colour"] == plot.OTHER_COLOUR
+    # only the special point on the physical stretch is labelled (SB1 at index 4; the TP lies where no
+    # orbit is physical)
+    assert [text for _, _, text in ax._hc_labels] == ["SB1"]
+    plot.plt.close(fig)
+
+
+def test_labels_of_coincident_points_merge_and_no_two_labels_overlap(plot):
+    fig, ax = plot.plt.subplots(figsize=(4, 3))
+    ax.set_xlim(0, 10)
+    ax.set_ylim(0, 10)
+    points = [(5, 5, "SB1"), (5, 5, "PD3"), (5.05, 5.05, "BP2"), (5.3, 5.0, "TP4"), (5.0, 5.3, "TP5"),
+              (5.3, 5.3, "GR6")]
+    ax._hc_labels = list(points)
+    plot.place_labels(ax)
+    texts = [t for t in ax.texts]
+    assert sorted(t.get_text() for t in texts) == ["BP2/PD3/SB1", "GR6", "TP4", "TP5"]
+    fig.canvas.draw()
+    boxes = [t.get_window_extent() for t in texts]
+    for i in range(len(boxes)):
+        for j in range(i + 1, len(boxes)):
+            assert not boxes[i].overlaps(boxes[j]), (texts[i].get_text(), texts[j].get_text())
+    plot.plt.close(fig)
+
+
+def test_any_two_columns_and_vector_formats(results):
+    rc, out, err = run(results, "--x", "t2", "--y", "asym", "--svg", "--pdf")
+    assert rc == 0, err
+    assert out.split() == [str(results / ("asym_t2.%s" % ext)) for ext in ("png", "svg", "pdf")]
+    with open(results / "asym_t2.pdf", "rb") as f:
+        assert f.read(5) == b"%PDF-"
+    with open(results / "asym_t2.svg") as f:
+        assert "<svg" in f.read(2000)
+    assert not (results / "H_T.png").exists()  # one diagram asked for, nothing else drawn
+    rc, out, err = run(results, "--x", "t2", "--y", "speed")
+    assert rc == 2 and out == ""
+    assert "no branch file in %s has a column 'speed'" % results in err and "asym" in err
+    rc, _, err = run(results, "--x", "t2")
+    assert rc == 2 and "--x and --y go together" in err
+
+
+def test_forced_system_diagram_shows_a_state_over_the_parameter(plot, results):
+    """Families in a forcing frequency w have T = 2π/w: the main diagram draws the section's first state
+    over w (x1_l here), named after its axes, not T."""
+    with open(results / "summary.json") as f:
+        s = json.load(f)
+    s["options"] = {"free": ["w"]}
+    s["unknowns"] = ["t1", "t2", "t3", "x1_l", "w"]
+    for sp in s["special_points"]:
+        sp.pop("u", None)
+    with open(results / "summary.json", "w") as f:
+        json.dump(s, f)
+    for k in (0, 1):
+        path = results / ("branch-%d.csv" % k)
+        with open(path) as f:
+            rows = list(csv.reader(f))
+        header = rows[0] + ["w"]
+        body = []
+        for r in rows[1:]:
+            w = 0.8 + 0.01 * int(r[0])
+            r[2] = repr(2 * math.pi / w)
+            body.append(r + [repr(w)])
+        write_csv(path, header, body)
+    res = plot.Results(str(results))
+    assert plot.main_diagram_axes(res) == ("w", "x1_l", "x1_l_w")
+    assert plot.axis_label("x1_l", res) == r"$l$ at the start of stance  (x1_l)"

@@ -123,6 +123,9 @@ struct ProgressInfo {
   // The point is the branch's start at a singular point of r (a branch switched at an SB point, a singular
   // start): multipliers collide at +1 there (floquet.h, FloquetOptions::at_branch_point).
   bool at_singular_point = false;
+  // The branch's unit tangent at the point, in the problem's unknowns (ContinuationPoint::tangent); empty
+  // where none is known.
+  Vector tangent;
 };
 
 struct ContinuationOptions {

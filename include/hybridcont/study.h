@@ -193,6 +193,9 @@ struct StudyOrbit {
   std::vector<double> t;               // sample times
   std::vector<int> segment;            // 0-based segment of each sample
   std::vector<Vector> x;               // the state at each sample
+  // Φ_T, the monodromy matrix of the orbit at the start of its first phase (floquet.h); empty where it
+  // could not be computed.
+  Matrix monodromy;
 };
 
 struct StudyWork {

@@ -32,6 +32,7 @@ inline ProgressInfo PointProgress(const ContinuationPoint& point, int branch_id,
   info.next_step = next_step;
   info.newton_iterations = point.newton_iterations;
   info.rejected_steps = rejected_steps;
+  info.tangent = point.tangent;
   return info;
 }
 

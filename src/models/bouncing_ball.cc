@@ -23,11 +23,12 @@ HybridModel MakeBouncingBall() {
   setup.run.bounds = {{"xi", "-1", "1"}, {"H", "-1", "1"}};
   setup.run.keyframe_component = "H";
   setup.run.keyframe_value = "0.5";
-  // y is the height of the ball's lowest point (the impact is at y = 0): a disc of radius 0.5 resting on it.
-  setup.drawing.mass_radius = 0.5;
+  // y is the height of the ball's lowest point (the impact is at y = 0): drawn as a disc of radius 0.1 resting
+  // on it (the model is a point mass; the disc is small against the bounces it shows).
+  setup.drawing.mass_radius = 0.1;
   DrawingSpec::PhaseDrawing flight;
   flight.phase = "flight";
-  flight.points = {{"ball", "X", "y + 0.5"}};
+  flight.points = {{"ball", "X", "y + 0.1"}};
   flight.masses = {"ball"};
   setup.drawing.phases = {flight};
   b.Setup(std::move(setup));

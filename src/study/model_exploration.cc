@@ -386,6 +386,13 @@ ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point
       const Vector v = Eigen::Map<const Vector>(info.values.data(), static_cast<Eigen::Index>(info.values.size()));
       ProgressInfo numbered = info;
       numbered.branch_id += branch_offset;
+      // The tangent in model units (the scaling is affine: the difference of two images), in the
+      // time-based layout; the state-based formulation's tangent is in other unknowns: dropped.
+      if (state_ || info.tangent.size() != v.size()) {
+        numbered.tangent.resize(0);
+      } else {
+        numbered.tangent = scaled_->FromScaled(v + info.tangent) - scaled_->FromScaled(v);
+      }
       on_point(numbered, scaled_->FromScaled(v));
     };
   }

@@ -59,7 +59,8 @@ class ModelExploration {
 
   using PointCallback = std::function<void(const ProgressInfo& info, const Vector& u)>;
   // Explores from the start point; on_point sees every accepted point in model units and in the layout of
-  // the formulation's unknowns (ToTimeBased converts state-based points). A start the model declares as a
+  // the formulation's unknowns (ToTimeBased converts state-based points), its info.tangent in model units in
+  // the time-based formulation (empty in the state-based one). A start the model declares as a
   // guess (StartSpec::Kind::kGuess) is first corrected by Newton at its H; if that fails the diagram's
   // status is kStartFailed with the corrector's message.
   BifurcationDiagram Run(const PointCallback& on_point = PointCallback());

@@ -225,6 +225,7 @@ void ResultsWriter::WritePoint(int branch_id, const PointRecord& p, const Shooti
       for (int c = 0; c < layout.dim(i); ++c) f << "," << names[layout.state_offset(i) + c];
     }
     f << ",physical,classification,stability,residual,newton_iterations,step";
+    f << ",dT_d" << layout.continued_name();
     for (const auto& [name, value] : p.extra) f << "," << name;
     for (const std::string& name : presentation.quantity_names()) f << "," << name;
     for (const auto& [name, value] : p.observables) f << "," << name;
@@ -242,6 +243,8 @@ void ResultsWriter::WritePoint(int branch_id, const PointRecord& p, const Shooti
   }
   f << fmt::format(",{},{},{},{:.3e},{},{:.6g}", p.classification.physical ? 1 : 0, ToString(p.classification.reason),
                    p.stability, p.residual, p.newton_iterations, p.step);
+  if (std::isfinite(p.period_slope)) f << fmt::format(",{:.10g}", p.period_slope);
+  else f << ",";
   for (const auto& [name, value] : p.extra) {
     if (std::isfinite(value)) f << fmt::format(",{:.10g}", value);
     else f << ",";  // not defined for this point (e.g. Floquet data of a non-physical orbit)
@@ -347,15 +350,24 @@ void ResultsWriter::SetSpecialPoints(nlohmann::json special_points) {
 }
 
 std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int index, double H, double T,
-                                    const std::string& label) {
+                                    const std::string& label, const Matrix& monodromy) {
   const std::string name = "orbit-" + std::to_string(summary_["orbits"].size()) + ".csv";
   const std::vector<OrbitSample> samples = trace.Sample(400);
-  StudyOrbit orbit{branch_id, index, label, H, T, {}, {}, {}};
+  StudyOrbit orbit{branch_id, index, label, H, T, {}, {}, {}, monodromy};
+  nlohmann::json entry = {{"file", name}, {"branch", branch_id}, {"index", index}, {"H", H}, {"T", T}, {"label", label}};
+  if (monodromy.size() > 0) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (Eigen::Index i = 0; i < monodromy.rows(); ++i) {
+      nlohmann::json row = nlohmann::json::array();
+      for (Eigen::Index j = 0; j < monodromy.cols(); ++j) row.push_back(monodromy(i, j));
+      rows.push_back(std::move(row));
+    }
+    entry["monodromy"] = std::move(rows);
+  }
   for (const OrbitSample& s : samples) orbit.t.push_back(s.t), orbit.segment.push_back(s.segment), orbit.x.push_back(s.x);
   orbits_.push_back(std::move(orbit));
   if (!writes_files()) {
-    summary_["orbits"].push_back(
-        {{"file", name}, {"branch", branch_id}, {"index", index}, {"H", H}, {"T", T}, {"label", label}});
+    summary_["orbits"].push_back(std::move(entry));
     return name;
   }
   if (!write_error_.empty()) return name;
@@ -394,8 +406,7 @@ std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int 
     fs::remove(dir_ / name, ec);  // no torn orbit: it is listed nowhere
     return name;
   }
-  summary_["orbits"].push_back(
-      {{"file", name}, {"branch", branch_id}, {"index", index}, {"H", H}, {"T", T}, {"label", label}});
+  summary_["orbits"].push_back(std::move(entry));
   return name;
 }
 

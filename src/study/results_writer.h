@@ -74,6 +74,10 @@ struct PointRecord {
   std::vector<std::pair<std::string, double>> observables;
   // The typed analysis the fields above are taken from (orbit_analysis.h).
   OrbitAnalysis analysis;
+  // dT/dc along the branch, c the coordinate it is continued in (H̄ or a parameter): from the branch's
+  // tangent τ at the point, Σ τ_{t_i} / τ_c (the period's slope; infinite at a turning point in c). Written as
+  // the column dT_d<c>. NaN where the tangent is unknown.
+  double period_slope = std::numeric_limits<double>::quiet_NaN();
 };
 
 // The record of an accepted point u before its analysis: index, Newton iterations and step from `info`.
@@ -127,9 +131,10 @@ class ResultsWriter {
   // Records the finished branch's metadata and rewrites summary.json.
   void EndBranch(const Branch& branch);
   void SetSpecialPoints(nlohmann::json special_points);
-  // Writes orbit-<k>.csv and records it in the summary; returns the file name.
+  // Writes orbit-<k>.csv and records it in the summary (with its monodromy matrix Φ_T, when not empty, as
+  // "monodromy": rows); returns the file name.
   std::string AddOrbit(const OrbitTrace& trace, int branch_id, int index, double H, double T,
-                       const std::string& label);
+                       const std::string& label, const Matrix& monodromy = Matrix());
   void SetReport(const std::string& report);
   // Rewrites summary.json atomically; false (and write_error() set) when it could not be written.
   bool WriteSummary();

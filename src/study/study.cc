@@ -27,6 +27,7 @@
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/conservation_check.h"
 #include "hybridcont/exploration.h"
+#include "hybridcont/floquet.h"
 #include "hybridcont/model_file.h"
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/setup_evaluation.h"
@@ -58,6 +59,16 @@ struct PointLog {
 
 // The exploration's point callback: converts each accepted point to the time-based layout (which every
 // output uses, whatever the formulation), analyses it (orbit_analysis.h) and hands it to the record.
+// dT/dc from a tangent τ in the layout's unknowns (c: the continued coordinate): Σ τ_{t_i} / τ_c; NaN
+// without a tangent, ±infinity at a turning point in c.
+double PeriodSlope(const ShootingLayout& layout, const Vector& tangent) {
+  if (tangent.size() != layout.num_unknowns()) return std::nan("");
+  double dT = 0;
+  for (int i = 0; i < layout.num_segments(); ++i) dT += tangent(layout.time_index(i));
+  const double dc = tangent(layout.continued_index());
+  return dc == 0 ? std::copysign(HUGE_VAL, dT) : dT / dc;
+}
+
 class PointStream {
  public:
   PointStream(const HybridModel& model, const RunSetup& setup, ModelExploration& exploration, ResultsWriter& writer)
@@ -73,6 +84,7 @@ class PointStream {
       return;
     }
     PointRecord record = RecordOf(info, u);
+    record.period_slope = PeriodSlope(floquet_map_.layout(), info.tangent);
     if (point_model_) SetFreeParameters(floquet_map_.layout(), u, point_model_.get());
     const auto known = exploration_.KnownBranchPointAnalysis(u);
     AnalyzePoint(point_model_ ? *point_model_ : model_, setup_.integrator, floquet_map_, replay_options_, &record,
@@ -174,8 +186,10 @@ void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log,
     HybridModel at_point = model.Clone();
     SetFreeParameters(layout, u, &at_point);
     const OrbitTrace trace(at_point, OrbitPart(layout, u), setup.integrator);
+    TimeBasedShooting map(model, setup.integrator, setup.free);
+    const FloquetResult floquet = ComputeFloquet(map, u);
     writer.AddOrbit(trace, c.branch, c.point, layout.has_level() ? u(layout.H_index()) : std::nan(""),
-                    layout.Period(u), c.family);
+                    layout.Period(u), c.family, floquet.ok() ? floquet.monodromy : Matrix());
   }
 }
 

@@ -173,6 +173,21 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
       o.family = JsonText((*orbits)[i], "label", at, "");
       o.H = JsonNumber((*orbits)[i], "H", at, kNaN);
       o.T = JsonNumber((*orbits)[i], "T", at, kNaN);
+      if (const nlohmann::json* m = FindField((*orbits)[i], "monodromy"); m != nullptr && m->is_array()) {
+        const auto n = static_cast<Eigen::Index>(m->size());
+        o.monodromy = Matrix::Constant(n, n, kNaN);
+        for (Eigen::Index row = 0; row < n; ++row) {
+          const nlohmann::json& entries = (*m)[static_cast<std::size_t>(row)];
+          if (!entries.is_array() || static_cast<Eigen::Index>(entries.size()) != n) {
+            throw std::invalid_argument("summary.json: " + at + ".monodromy is not a square matrix");
+          }
+          for (Eigen::Index col = 0; col < n; ++col) {
+            const nlohmann::json& v = entries[static_cast<std::size_t>(col)];
+            if (!v.is_number()) throw std::invalid_argument("summary.json: " + at + ".monodromy holds a non-number");
+            o.monodromy(row, col) = v.get<double>();
+          }
+        }
+      }
       r.orbits.push_back(std::move(o));
     }
   }
