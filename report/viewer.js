@@ -181,6 +181,7 @@
     document.getElementById('hint').hidden = true;
     const rows = [['branch', b.id + (b.family ? ' · ' + b.family : '')], ['point', index],
                   ['class', b.classification[index]], ['stability', b.stability[index] || '—']];
+    if (b.word && b.word.length) rows.splice(1, 0, ['word', b.word.join(' > ')]);
     for (const name of Object.keys(b.columns)) rows.push([name, fmt(b.columns[name][index])]);
     const table = document.createElement('table');
     for (const [k, v] of rows) {
@@ -234,10 +235,14 @@
 
   const rangeText = (r) => fmt(Math.min(r.from, r.to)) + ' .. ' + fmt(Math.max(r.from, r.to)) +
                            ' (' + (r.from <= r.to ? r.how_from + ' .. ' + r.how_to : r.how_to + ' .. ' + r.how_from) + ')';
-  fillTable('families', ['family', 'branch', 'physical', 'stable', 'ends'],
+  // An automaton's run crosses several words (phase sequences): each family's word is a column of its own.
+  const wordOf = (b) => (b.word || []).join(' > ');
+  const severalWords = new Set(study.branches.map(wordOf)).size > 1;
+  fillTable('families', ['family', ...(severalWords ? ['word'] : []), 'branch', 'physical', 'stable', 'ends'],
             study.branches.filter((b) => b.ranges.physical.length).map((b) => ({
               branch: b.id, index: b.ranges.physical[0].first_point,
-              cells: [b.family || '—', b.id + (b.image_of >= 0 ? ' (image of ' + b.image_of + ')' : ''),
+              cells: [b.family || '—', ...(severalWords ? [wordOf(b)] : []),
+                      b.id + (b.image_of >= 0 ? ' (image of ' + b.image_of + ')' : ''),
                       b.ranges.physical.map(rangeText).join('; '),
                       b.ranges.stable.length ? b.ranges.stable.map(rangeText).join('; ') : 'nowhere', b.termination],
             })));
@@ -250,6 +255,48 @@
                         sp.status, typeof sp.precision === 'number' ? sp.precision.toExponential(1) : '—'],
               };
             }));
+
+  // The parameter plane (a study with curves): where each family continued in H̄ is physical (light) and
+  // stable (darker), between the curves of the special points that end its ranges or the bound of H̄ it
+  // reached, and every curve, dashed by kind. Regions of mirror images that coincide are drawn once.
+  function drawPlane() {
+    const plane = study.plane;
+    if (!plane) return;
+    document.getElementById('plane-panel').hidden = false;
+    document.getElementById('plane-title').textContent = 'Parameter plane (' + plane.parameter + ', H)';
+    document.getElementById('plane-note').textContent =
+        'Shaded: where a family exists with physical orbits (light) and where they are stable (dark), between ' +
+        'the curves of the special points that end its ranges; the dotted line is this run\'s ' + plane.parameter +
+        ' = ' + fmt(plane.value, 6) + '.';
+    const DASH = {'fold': 'dot', 'branch-point': 'solid', 'period-doubling': 'dash', 'neimark-sacker': 'dashdot',
+                  'boundary': 'longdash'};
+    const traces = [], drawn = new Map();
+    for (const r of plane.regions) {
+      const key = r.kind + JSON.stringify(r.polygon);
+      if (drawn.has(key)) {  // a mirror image's region: the same set of (p, H)
+        const t = drawn.get(key);
+        if (!t.name.includes(r.family)) t.name = t.name.replace(' · ', ' = ' + r.family + ' · ');
+        continue;
+      }
+      const t = {type: 'scatter', mode: 'lines', fill: 'toself', x: r.polygon.map((q) => q[0]),
+                 y: r.polygon.map((q) => q[1]), name: r.family + ' · ' + r.kind, hoverinfo: 'name',
+                 line: {width: 0}, fillcolor: colourOf(r.family), opacity: r.kind === 'stable' ? 0.45 : 0.15};
+      drawn.set(key, t);
+      traces.push(t);
+    }
+    for (const c of plane.curves) {
+      traces.push({type: 'scatter', mode: 'lines', x: c.points.map((q) => q[0]), y: c.points.map((q) => q[1]),
+                   name: c.label + ' · ' + c.type + (c.family ? ' (' + c.family + ')' : ''), hoverinfo: 'name',
+                   line: {color: c.family ? colourOf(c.family) : '#444', width: 2, dash: DASH[c.type] || 'solid'}});
+    }
+    Plotly.react('plane', traces, {
+      margin: {l: 60, r: 10, t: 10, b: 50}, hovermode: 'closest', legend: {font: {size: 11}},
+      xaxis: {title: {text: plane.parameter}, zeroline: false}, yaxis: {title: {text: 'H'}, zeroline: false},
+      shapes: [{type: 'line', xref: 'x', yref: 'paper', x0: plane.value, x1: plane.value, y0: 0, y1: 1,
+                line: {color: '#888', width: 1, dash: 'dot'}}],
+    }, {responsive: true, displaylogo: false, scrollZoom: true});
+  }
+  drawPlane();
 
   for (const el of [xSelect, ySelect, document.getElementById('show-nonphysical')]) el.addEventListener('change', draw);
   draw();

@@ -28,12 +28,14 @@ def main(tool, folder):
                 # of families and then by the point itself.
                 browser.evaluate("""(() => {
                     const study = JSON.parse(document.getElementById('study-data').textContent);
+                    const branchColumn = [...document.querySelectorAll('#families thead th')]
+                        .findIndex(th => th.textContent === 'branch');
                     for (const b of study.branches) {
                         let i = b.stable.indexOf(true);
                         if (i < 0) i = b.physical.indexOf(true);
                         if (i < 0) continue;
                         const row = [...document.querySelectorAll('#families tbody tr')]
-                            .find(r => r.cells[1].textContent.startsWith(String(b.id)));
+                            .find(r => r.cells[branchColumn].textContent.startsWith(String(b.id)));
                         if (row) row.click();
                         return;
                     }

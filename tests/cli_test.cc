@@ -12,9 +12,11 @@
 #include <sstream>
 #include <utility>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
+#include "hybridcont/study.h"
 
 namespace hybridcont::app {
 namespace {
@@ -348,6 +350,48 @@ TEST(Cli, PeriodSlopeAndMonodromyAgreeWithTheClosedFormAndTheMultipliers) {
     ++orbits;
   }
   EXPECT_EQ(orbits, 3);  // hopping in place, forward and backward hopping
+}
+
+}  // namespace
+}  // namespace hybridcont::app
+
+namespace hybridcont::app {
+namespace {
+
+// `--curves k` continues the SLIP's PD point (where hopping in place turns stable) in (H, k): at a point of
+// that curve far from the run's k, a run at that k locates its PD at the curve's H. LoadStudy reads the curves
+// back as the run wrote them.
+TEST(Cli, PeriodDoublingCurvePassesThroughThePeriodDoublingOfARunAtItsParameter) {
+  const fs::path dir = TempDir("slip_pd_curve");
+  const CliResult r = RunTool({"run", "slip", "--curves", "k", "--out", dir.string(), "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  const StudyResult loaded = LoadStudy(dir.string());
+  EXPECT_EQ(loaded.curve_parameter, "k");
+  const StudyCurve* pd = nullptr;
+  for (const StudyCurve& c : loaded.curves) {
+    if (c.type == "period-doubling") pd = &c;
+  }
+  ASSERT_NE(pd, nullptr);
+  EXPECT_EQ(loaded.special_points.at(pd->special_point).Label(), "PD4");
+  ASSERT_GT(pd->points.size(), 100u);  // sampled finely enough to draw (a quarter of the families' step)
+  ASSERT_EQ(pd->columns[0], "H");
+  ASSERT_EQ(pd->columns[1], "k");
+  for (const double k_target : {15.0, 120.0}) {
+    const Vector* at = nullptr;
+    for (const Vector& u : pd->points) {
+      if (!at || std::abs(u(1) - k_target) < std::abs((*at)(1) - k_target)) at = &u;
+    }
+    const std::string k = fmt::format("{:.17g}", (*at)(1));
+    const fs::path there = TempDir("slip_pd_at_k");
+    const CliResult run = RunTool({"run", "slip", "--set", "k=" + k, "--out", there.string(), "--quiet"});
+    ASSERT_EQ(run.code, 0) << run.err;
+    const StudyResult study = LoadStudy(there.string());
+    double nearest = HUGE_VAL;
+    for (const StudySpecialPoint& sp : study.special_points) {
+      if (sp.code == "PD") nearest = std::min(nearest, std::abs(sp.H - (*at)(0)));
+    }
+    EXPECT_LT(nearest, 1e-8) << "k = " << k << ", curve H = " << (*at)(0);
+  }
 }
 
 }  // namespace

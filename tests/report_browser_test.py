@@ -83,3 +83,38 @@ def test_report_opens_offline_and_a_click_shows_the_orbit(slip_report):
             browser.screenshot(os.path.join(screenshots, "report-slip.png"))
     finally:
         browser.close()
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="no chromium (sh scripts/install-deps.sh installs it)")
+def test_parameter_plane_shades_where_families_are_physical_and_stable(tmp_path):
+    """`--curves k`: the plane (k, H) with the curves of the special points and the regions between them; hopping
+    in place is stable between its PD4 curve (below) and its SB5 curve (above) at every k of both."""
+    out = tmp_path / "slip-k"
+    subprocess.run([TOOL, "run", "slip", "--curves", "k", "--out", str(out), "--quiet", "--threads", "1"], check=True,
+                   stdout=subprocess.DEVNULL)
+    browser = Browser((out / "report.html").as_uri())
+    try:
+        wait_for(browser, "document.readyState === 'complete' && !!document.querySelector('#plane .scatterlayer')")
+        assert browser.errors() == []
+        assert browser.evaluate("document.getElementById('plane-panel').hidden") is False
+        names = browser.evaluate("[...document.querySelectorAll('#plane .legendtext')].map(t => t.textContent)")
+        assert "hopping in place · stable" in names, names
+        assert "PD4 · period-doubling (hopping in place)" in names, names
+        assert any(n.startswith("SB5 · branch-point") for n in names), names
+        # The stable region of hopping in place, read back from the data the page drew: its lower edge is the
+        # PD4 curve, its upper edge the SB5 curve, over the same k.
+        check = browser.evaluate("""(() => {
+            const plane = JSON.parse(document.getElementById('study-data').textContent).plane;
+            const region = plane.regions.find(r => r.family === 'hopping in place' && r.kind === 'stable');
+            const curve = (label) => plane.curves.find(c => c.label === label).points;
+            const onCurve = (q, pts) => pts.some(p => p[0] === q[0] && p[1] === q[1]);
+            const pd = curve('PD4'), sb = curve('SB5');
+            const n = region.polygon.length;
+            const lower = region.polygon.slice(0, n / 2), upper = region.polygon.slice(n / 2);
+            return {n, lower: lower.every(q => onCurve(q, pd)), upper: upper.every(q => onCurve(q, sb)),
+                    fills: document.querySelectorAll('#plane .fills path').length};
+        })()""")
+        assert check["n"] > 100 and check["lower"] and check["upper"], check
+        assert check["fills"] >= 3, check
+    finally:
+        browser.close()

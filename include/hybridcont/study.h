@@ -198,6 +198,19 @@ struct StudyOrbit {
   Matrix monodromy;
 };
 
+// A two-parameter curve of the study (options.curves = p): a special point of a physical family continued in
+// (H̄, p) — a fold, a branch point, a period doubling or Neimark–Sacker point (the zero of its Floquet test
+// function) — or a boundary of the physical families (a duration or a constraint at 0).
+struct StudyCurve {
+  int id = 0;
+  std::string type;         // "fold", "branch-point", "period-doubling", "neimark-sacker", "boundary"
+  std::string name;         // a boundary's quantity at 0 ("t2 = 0"); empty otherwise
+  int special_point = -1;   // the special point it is continued from (-1 for a boundary)
+  std::string status;       // "traced", "start-failed"
+  std::vector<std::string> columns;  // "H", p, then the curve's other unknowns
+  std::vector<Vector> points;        // in curve order, each in `columns` order
+};
+
 struct StudyWork {
   long rhs_evaluations = 0;          // the continuation's
   long map_evaluations = 0;
@@ -223,6 +236,8 @@ struct StudyResult {
   // marked as not complete; the result holds the whole study.
   std::string write_error;
   std::vector<StudyOrbit> orbits;    // key frames
+  std::string curve_parameter;       // p of the curves (options.curves); empty without
+  std::vector<StudyCurve> curves;    // id == index
   StudyWork work;
   // The whole saved document (summary.json, docs/results-format.md): the effective options, word changes
   // ("word_changes", "words"), curves ("curves"), starts, presentation. The typed fields above are read from

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <map>
 
+#include "hybridcont/floquet.h"
 #include "hybridcont/orbit_observables.h"
 #include "hybridcont/special_point_curve.h"
 #include "hybridcont/timebased_shooting.h"
@@ -16,9 +17,8 @@ namespace hybridcont::study {
 
 namespace {
 
-// The curve's points as CSV: H, p, then the other unknowns. False when the file could not be written.
-bool WriteCurve(const SpecialPointCurve& curve, const std::string& p, const std::filesystem::path& file) {
-  std::ofstream f(file);
+// The order of the curve's columns in its file: H, p, then the other unknowns.
+std::vector<int> CurveColumns(const SpecialPointCurve& curve, const std::string& p) {
   std::vector<int> order = {static_cast<int>(std::find(curve.unknown_names.begin(), curve.unknown_names.end(), "H") -
                                              curve.unknown_names.begin()),
                             static_cast<int>(std::find(curve.unknown_names.begin(), curve.unknown_names.end(), p) -
@@ -26,6 +26,31 @@ bool WriteCurve(const SpecialPointCurve& curve, const std::string& p, const std:
   for (int j = 0; j < static_cast<int>(curve.unknown_names.size()); ++j) {
     if (j != order[0] && j != order[1]) order.push_back(j);
   }
+  return order;
+}
+
+// The curve typed for the study's result, its points in CurveColumns' order.
+StudyCurve Typed(const SpecialPointCurve& curve, const std::string& p, const nlohmann::json& entry) {
+  StudyCurve c;
+  c.id = entry["id"];
+  c.type = entry["type"];
+  c.name = entry.value("name", std::string());
+  c.special_point = entry["special_point"].is_number() ? entry["special_point"].get<int>() : -1;
+  c.status = entry["status"];
+  const std::vector<int> order = CurveColumns(curve, p);
+  for (const int j : order) c.columns.push_back(curve.unknown_names[j]);
+  for (const Vector& u : curve.points) {
+    Vector v(static_cast<Eigen::Index>(order.size()));
+    for (std::size_t j = 0; j < order.size(); ++j) v(static_cast<Eigen::Index>(j)) = u(order[j]);
+    c.points.push_back(std::move(v));
+  }
+  return c;
+}
+
+// The curve's points as CSV: H, p, then the other unknowns. False when the file could not be written.
+bool WriteCurve(const SpecialPointCurve& curve, const std::string& p, const std::filesystem::path& file) {
+  std::ofstream f(file);
+  const std::vector<int> order = CurveColumns(curve, p);
   for (std::size_t j = 0; j < order.size(); ++j) f << (j ? "," : "") << curve.unknown_names[order[j]];
   f << "\n";
   for (const Vector& u : curve.points) {
@@ -50,6 +75,24 @@ SpecialPoint OnBaseMap(const SpecialPoint& sp, double p0) {
   point.tangent_after = extend(sp.tangent_after, 0.0);
   point.interval_width = extend(sp.interval_width, 0.0);
   return point;
+}
+
+// The Floquet test function whose zero a PD or NS point is (floquet.h: pd_test = 2^k prod (mu + 1), ns_test =
+// prod (mu_i mu_j - 1)), at a point of the base map's unknowns (the orbit, then p), evaluated on a map of its
+// own; NaN where the multipliers cannot be computed. Its gradient: central differences
+// (SpecialPointCurveOptions::second_derivative_step), exact enough to steer Newton, which solves g = 0 itself.
+ScalarTest FloquetZero(const HybridModel& model, const RunSetup& setup, double p0, SpecialPointType type) {
+  // The base map's own definition (p free, held at p0 by a fixing row): its layout is the base unknowns'; the
+  // fixing row's residual is not used.
+  const std::string& p = setup.curve_parameter;
+  auto map = std::make_shared<TimeBasedShooting>(model, setup.integrator, FreeParameters{{p}, {{p, p0}}, {}});
+  const bool pd = type == SpecialPointType::kPeriodDoubling;
+  return ScalarTest{pd ? "pd_test" : "ns_test", [map, pd](const Vector& u) {
+                      const FloquetResult f = ComputeFloquet(*map, u);
+                      if (!f.ok()) return std::nan("");
+                      return pd ? f.pd_test : f.ns_test;
+                    },
+                    nullptr};
 }
 
 // A boundary of the physical families: where a phase duration or a constraint's interior minimum is 0.
@@ -110,7 +153,8 @@ bool OnCurve(const std::vector<std::vector<Eigen::Vector2d>>& curves, const Eige
 }  // namespace
 
 nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
-                                    const std::filesystem::path& dir, std::string* report) {
+                                    const std::filesystem::path& dir, std::string* report,
+                                    std::vector<StudyCurve>* typed) {
   const std::string& p = setup.curve_parameter;
   const double p0 = model.parameter(p);
   TimeBasedShooting base(model, setup.integrator, FreeParameters{{p}, {{p, p0}}, {}});
@@ -121,23 +165,54 @@ nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& se
   for (const ComponentBound& b : setup.exploration.continuation.bounds) {
     if (b.component == "H") c.bounds.push_back(b);
   }
-  // Steps relative to the parameter's size: the curves are traced unscaled.
+  // Steps relative to the parameter's size: the curves are traced unscaled. At most a quarter of the
+  // families' largest step: a curve is drawn through its points (a region's edge in the report, a line of a
+  // figure), and the families' step would leave a visible polygon (~40 points over the SLIP's k in [10, 160]).
   const double scale = std::max(1.0, std::abs(p0));
   c.initial_step = setup.scenario.initial_step * scale;
-  c.max_step = setup.scenario.max_step * scale;
+  c.max_step = setup.scenario.max_step * scale / 4;
   c.max_points = setup.scenario.max_points;
   nlohmann::json curves = nlohmann::json::array();
   *report += fmt::format("Special-point curves in (H, {}) over {} in [{:g}, {:g}]:\n", p, p, setup.curve_bound.lower,
                          setup.curve_bound.upper);
   for (const SpecialPoint& sp : diagram.special_points) {
     const bool fold = sp.type == SpecialPointType::kTurningPoint && sp.component == "H";
-    if (!(fold || sp.type == SpecialPointType::kSimpleBifurcation) || sp.duplicate_of >= 0 || sp.u.size() == 0) continue;
+    // A PD or NS point: the zero of its Floquet test function, continued in (H, p) (the stability boundary a
+    // multiplier crossing -1 or a complex pair crossing the circle draws in the plane).
+    const bool floquet = sp.type == SpecialPointType::kPeriodDoubling || sp.type == SpecialPointType::kNeimarkSacker;
+    if (!(fold || floquet || sp.type == SpecialPointType::kSimpleBifurcation) || sp.duplicate_of >= 0 ||
+        sp.u.size() == 0 || (floquet && sp.status != LocationStatus::kLocated)) {
+      continue;
+    }
     if (!IsPhysical(model, sp.u, setup.integrator)) continue;
+    // A PD or NS point at a branch point of its family (the SLIP's PD where forward hopping leaves hopping in
+    // place) is no regular zero of its test function there: its curve is the branch point's.
+    const auto at_branch_point = [&] {
+      return std::any_of(diagram.special_points.begin(), diagram.special_points.end(), [&](const SpecialPoint& q) {
+        return q.branch_id == sp.branch_id && q.id != sp.id && q.u.size() == sp.u.size() &&
+               (q.type == SpecialPointType::kSimpleBifurcation || q.type == SpecialPointType::kFloquetBranchPoint) &&
+               (q.u - sp.u).lpNorm<Eigen::Infinity>() <= 1e-6 * (1 + sp.u.lpNorm<Eigen::Infinity>());
+      });
+    };
+    if (floquet && at_branch_point()) {
+      *report += fmt::format("  from special point {} ({}): not traced (at a branch point of its family, where its "
+                             "test function has no regular zero)\n", sp.id, Code(sp.type));
+      continue;
+    }
     SpecialPointCurve curve;
     try {
-      curve = TraceSpecialPointCurve(&base, OnBaseMap(sp, p0), fix_row, "H", options);
+      if (floquet) {
+        const CurveDefinition definition{CurveKind::kTestFunction, fix_row, "H", FloquetZero(model, setup, p0, sp.type)};
+        curve = TraceSpecialPointCurve(&base, definition, OnBaseMap(sp, p0).u, options);
+      } else {
+        curve = TraceSpecialPointCurve(&base, OnBaseMap(sp, p0), fix_row, "H", options);
+      }
     } catch (const std::invalid_argument& e) {  // a point the defining system does not accept
       *report += fmt::format("  from special point {}: not traced ({})\n", sp.id, e.what());
+      continue;
+    }
+    if (floquet && curve.status != CurveStatus::kTraced) {
+      *report += fmt::format("  from special point {} ({}): not traced ({})\n", sp.id, Code(sp.type), curve.message);
       continue;
     }
     const int id = static_cast<int>(curves.size());
@@ -153,7 +228,7 @@ nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& se
                            {"H", q.u(column("H"))}, {p, q.u(column(p))}});
     }
     curves.push_back({{"id", id},
-                      {"type", ToString(curve.kind)},
+                      {"type", floquet ? ToString(sp.type) : ToString(curve.kind)},
                       {"file", file},
                       {"special_point", sp.id},
                       {"status", ToString(curve.status)},
@@ -161,9 +236,11 @@ nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& se
                       {"points", curve.points.size()},
                       {"termination", {ToString(curve.backward_termination), ToString(curve.forward_termination)}},
                       {"codim_two", codim_two}});
+    if (typed) typed->push_back(Typed(curve, p, curves.back()));
     *report += fmt::format("  curve {} ({}) from special point {} at H = {:.10f}: {} points, {}; {} codimension-two "
                            "points\n",
-                           id, ToString(curve.kind), sp.id, sp.u(base.layout().H_index()), curve.points.size(),
+                           id, floquet ? ToString(sp.type) : ToString(curve.kind), sp.id,
+                           sp.u(base.layout().H_index()), curve.points.size(),
                            ToString(curve.status), curve.codim_two_points.size());
   }
   // Boundaries of the physical families: a duration through 0 between two points of a branch with a
@@ -202,6 +279,7 @@ nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& se
                       {"message", ""},
                       {"points", points.size()},
                       {"codim_two", nlohmann::json::array()}});
+    if (typed) typed->push_back(Typed(curve, p, curves.back()));
     *report += fmt::format("  curve {} (boundary {} = 0) from {}: {} points, H in [{:.6f}, {:.6f}]\n", id,
                            boundary.name, from, points.size(),
                            std::min_element(polyline.begin(), polyline.end(),

@@ -29,6 +29,7 @@
 #include <nlohmann/json.hpp>
 
 #include "hybridcont/exploration.h"
+#include "hybridcont/study.h"
 #include "run_setup.h"
 
 namespace hybridcont::study {
@@ -36,8 +37,10 @@ namespace hybridcont::study {
 // Traces the curves of diagram's special points (model units, the model's layout) in
 // setup.curve_parameter within setup.curve_bound and the scenario's H bound, writes their files into
 // dir and returns the "curves" list; report gets one line per curve.
+// Each curve also typed into `typed` (may be null).
 nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
-                                    const std::filesystem::path& dir, std::string* report);
+                                    const std::filesystem::path& dir, std::string* report,
+                                    std::vector<StudyCurve>* typed = nullptr);
 
 }  // namespace hybridcont::study
 

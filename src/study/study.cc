@@ -365,7 +365,8 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
     say("curves", "");
     nlohmann::json curves = nlohmann::json::array();
     try {
-      curves = TraceParameterCurves(model, setup, from_curve ? restart_points : diagram, writer.dir(), &curves_report);
+      curves = TraceParameterCurves(model, setup, from_curve ? restart_points : diagram, writer.dir(), &curves_report,
+                                    &result->curves);
     } catch (const std::runtime_error& e) {  // a curve file that could not be written (a full disk)
       writer.RecordWriteError(e.what());
     }
@@ -734,6 +735,8 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
   typed.report = result.report;
   typed.work = result.work;
   typed.orbits = writer.orbits();
+  typed.curves = std::move(result.curves);
+  typed.curve_parameter = p.setup.curve_parameter;
   typed.diagram = std::move(result.diagram);
   typed.write_error = writer.write_error();
   return typed;

@@ -5,7 +5,10 @@
 // (multipliers, replay errors, test functions) with 10 and the residual with 4 (docs/results-format.md), so
 // a loaded analysis equals the computed one to that many digits. Key-frame orbits are listed (branch, point,
 // family, H, T) without their samples, which stay in orbit-<k>.csv.
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -41,14 +44,15 @@ std::vector<std::string> SplitRow(const std::string& line) {
 // A number of a CSV field: empty is NaN (undefined for this point), "nan" too.
 double Field(const std::string& text, const std::string& where) {
   if (text.empty() || text == "nan" || text == "-nan") return kNaN;
-  std::size_t used = 0;
-  double value = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
+  // strtod, not stod: a subnormal number (an angle of 1e-311 the integrator left) is a number; stod calls its
+  // underflow out of range. Overflow (beyond the largest double) is refused.
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(text.c_str(), &end);
+  const bool overflow = errno == ERANGE && std::isinf(value);
+  if (end != text.c_str() + text.size() || text.empty() || std::isspace(static_cast<unsigned char>(text[0])) || overflow) {
+    throw std::invalid_argument(where + ": '" + text + "' is not a number");
   }
-  if (used != text.size() || used == 0) throw std::invalid_argument(where + ": '" + text + "' is not a number");
   return value;
 }
 
@@ -133,6 +137,53 @@ std::vector<StudyPoint> ReadBranchFile(const fs::path& file, const std::vector<s
   return points;
 }
 
+// The two-parameter curves summary.json lists ("curves", with options.curves.parameter), each read from its
+// file (docs/results-format.md). A listed file that is missing is skipped (an interrupted study).
+void ReadCurves(const nlohmann::json& summary, const fs::path& dir, StudyResult* r) {
+  const auto* options = summary.contains("options") ? &summary["options"] : nullptr;
+  if (options && options->is_object() && options->contains("curves") && (*options)["curves"].is_object()) {
+    const nlohmann::json& c = (*options)["curves"];
+    if (c.contains("parameter") && c["parameter"].is_string()) r->curve_parameter = c["parameter"];
+  }
+  if (!summary.contains("curves")) return;
+  if (!summary["curves"].is_array()) throw std::invalid_argument("curves: expected a list");
+  for (std::size_t i = 0; i < summary["curves"].size(); ++i) {
+    const nlohmann::json& e = summary["curves"][i];
+    const std::string at = "curves[" + std::to_string(i) + "]";
+    if (!e.is_object() || !e.contains("file") || !e["file"].is_string()) {
+      throw std::invalid_argument(at + ": expected an object with a file name");
+    }
+    const std::string file = e["file"];
+    if (fs::path(file).filename().string() != file) throw std::invalid_argument(at + ".file: '" + file + "' is not a file name");
+    std::error_code ec;
+    if (!fs::exists(dir / file, ec)) continue;
+    StudyCurve curve;
+    curve.id = static_cast<int>(r->curves.size());
+    curve.type = e.value("type", std::string());
+    curve.name = e.contains("name") && e["name"].is_string() ? e["name"].get<std::string>() : std::string();
+    curve.special_point = e.contains("special_point") && e["special_point"].is_number_integer() ? e["special_point"].get<int>() : -1;
+    curve.status = e.value("status", std::string());
+    std::ifstream f(dir / file);
+    std::string line;
+    if (!std::getline(f, line)) throw std::invalid_argument((dir / file).string() + ": empty (no header)");
+    curve.columns = SplitRow(line);
+    for (int row = 2; std::getline(f, line); ++row) {
+      const std::vector<std::string> fields = SplitRow(line);
+      const std::string where = (dir / file).string() + ":" + std::to_string(row);
+      if (fields.size() != curve.columns.size()) {
+        throw std::invalid_argument(where + ": " + std::to_string(fields.size()) + " fields, the header has " +
+                                    std::to_string(curve.columns.size()));
+      }
+      Vector v(static_cast<Eigen::Index>(fields.size()));
+      for (std::size_t j = 0; j < fields.size(); ++j) {
+        v(static_cast<Eigen::Index>(j)) = Field(fields[j], where + ", column '" + curve.columns[j] + "'");
+      }
+      curve.points.push_back(std::move(v));
+    }
+    r->curves.push_back(std::move(curve));
+  }
+}
+
 }  // namespace
 
 StudyResult LoadStudy(const std::string& dir_text) {
@@ -185,6 +236,7 @@ StudyResult LoadStudy(const std::string& dir_text) {
       points[b.id] = ReadBranchFile(dir / file, b.unknown_names, observables);
     }
     StudyResult r = study::ResultFromSummary(summary, std::move(points));
+    ReadCurves(summary, dir, &r);
     return r;
   } catch (const std::invalid_argument& e) {
     const std::string what = e.what();
