@@ -42,6 +42,33 @@ bool InPhysicalRange(const StudyBranch& b, int index) {
   return false;
 }
 
+// Whether two lists of ranges are the same stretches of the coordinate (ends within 1e-8 relative).
+bool SameRanges(const std::vector<Range>& a, const std::vector<Range>& b) {
+  if (a.size() != b.size()) return false;
+  const auto near = [](double x, double y) { return std::abs(x - y) <= 1e-8 * (1 + std::abs(x)); };
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double a_lo = std::min(a[i].from.value, a[i].to.value), a_hi = std::max(a[i].from.value, a[i].to.value);
+    const double b_lo = std::min(b[i].from.value, b[i].to.value), b_hi = std::max(b[i].from.value, b[i].to.value);
+    if (!near(a_lo, b_lo) || !near(a_hi, b_hi)) return false;
+  }
+  return true;
+}
+
+// The branch listed before `b` that is its twin: the same family, leaving the same special point, physical and
+// stable over the same ranges (the two directions from a branch point of a symmetric model, whose symmetry the
+// model does not declare); -1 for none.
+int TwinOf(const StudyResult& study, const StudyBranch& b) {
+  if (b.parent_special_point < 0 || b.image_of >= 0 || b.family.empty()) return -1;
+  for (const StudyBranch& a : study.branches) {
+    if (a.id >= b.id) break;
+    if (a.family == b.family && a.parent_special_point == b.parent_special_point && a.image_of < 0 &&
+        SameRanges(a.ranges.physical, b.ranges.physical) && SameRanges(a.ranges.stable, b.ranges.stable)) {
+      return a.id;
+    }
+  }
+  return -1;
+}
+
 }  // namespace
 
 std::string OneScreenAnswer(const StudyResult& study, double seconds) {
@@ -64,6 +91,14 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
   for (const StudyBranch& b : study.branches) {
     if (b.ranges.physical.empty()) continue;
     const std::string& c = b.continued;
+    if (const int twin = TwinOf(study, b); twin >= 0) {
+      const int parent = b.parent_special_point;
+      out += fmt::format("\n{} (branch {}): as branch {}, the other direction from {}: the same physical and stable "
+                         "ranges\n", b.family, b.id, twin,
+                         parent < static_cast<int>(study.special_points.size()) ? study.special_points[parent].Label()
+                                                                               : std::to_string(parent));
+      continue;
+    }
     std::string head = fmt::format("\n{} (branch {}", b.family.empty() ? "unnamed family" : b.family, b.id);
     if (!b.origin.empty()) head += ", " + b.origin;
     // The image of a traced branch under a symmetry: where that branch is a physical family too, its special

@@ -309,13 +309,15 @@ int PlotCommand(const std::string& dir, const FigureOptions& figures, std::ostre
   if (!fs::exists(fs::path(dir) / "summary.json", ec)) {
     throw std::invalid_argument("plot '" + dir + "': no summary.json (run `hybridcont run MODEL --out " + dir + "` first)");
   }
+  // The figures first: the script checks the folder and names what is damaged (exit 2, nothing written). The
+  // figure of the curves shades the regions of the report the run wrote (report.html, rewritten below).
   const int rc = DrawFigures(dir, err, true, figures);
   if (rc == 0 && !figures.x.empty()) {  // one diagram asked for: nothing else is redrawn
     out << "figure written to " << (fs::path(dir) / (figures.y + "_" + figures.x + ".png")).string() << "\n";
     return 0;
   }
-  if (rc == 0) out << "figures written to " << dir << "/\n";
   if (rc == 0) {
+    out << "figures written to " << dir << "/\n";
     const StudyResult study = LoadStudy(dir);
     std::unique_ptr<HybridModel> model;
     try {  // a built-in model or a shipped model file by its name: the orbits drawn; otherwise none

@@ -1436,32 +1436,91 @@ def nice_length(s):
     return unit
 
 
+def report_plane(res):
+    """The (p, H) plane of report.html's data (curves and the regions where families are physical and stable,
+    computed by the library: study_report.h), or {} without a report or a plane."""
+    path = os.path.join(res.dir, "report.html")
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except OSError:
+        return {}
+    start = text.find('<script id="study-data" type="application/json">')
+    end = text.find("</script>", start)
+    if start < 0 or end < 0:
+        return {}
+    try:
+        data = json.loads(text[start + len('<script id="study-data" type="application/json">'):end])  # <\/ is JSON's /
+    except ValueError:
+        return {}
+    plane = data.get("plane") if isinstance(data, dict) else None
+    return plane if isinstance(plane, dict) else {}
+
+
+CURVE_DASHES = {"fold": (0, (1.5, 1.5)), "branch-point": "-", "period-doubling": (0, (6, 2.5)),
+                "neimark-sacker": (0, (6, 2, 1.5, 2)), "boundary": (0, (3, 1.5, 1, 1.5))}
+
+
 def figure_curves(res, svg, written):
-    """Two-parameter curves of special points (summary "curves") in the (parameter, H) plane."""
+    """Two-parameter curves (summary "curves") in the (parameter, H) plane: each in the colour of the family
+    whose special point it continues (boundaries dark grey), dashed by kind (fold dotted, branch point solid,
+    period doubling dashed, Neimark-Sacker dash-dotted), labelled by that special point; codimension-two
+    points as stars; the run's own parameter value as a dotted vertical line; shaded in the family's colour,
+    the regions where it is physical (light) and stable (darker) that report.html's data holds."""
     entries = [c for c in (res.summary.get("curves") or []) if isinstance(c, dict) and isinstance(c.get("file"), str)]
     p = ((res.summary.get("options") or {}).get("curves") or {}).get("parameter")
     if not entries or not isinstance(p, str):
         return
-    fig, ax = plt.subplots(figsize=(7.0, 4.8))
-    boundary_styles = ["--", ":", "-.", (0, (5, 1, 1, 1))]
-    boundaries = 0
-    for pos, c in enumerate(entries):
+    fig, ax = plt.subplots(figsize=(7.0, 4.6))
+    by_id = {sp.get("id"): sp for sp in res.special_points}
+    for c in entries:
         with open(os.path.join(res.dir, c["file"]), newline="") as f:
             rows = list(csv.DictReader(f))
         xs, ys = [to_float(r.get(p)) for r in rows], [to_float(r.get("H")) for r in rows]
-        boundary = c.get("type") == "boundary"
-        style = boundary_styles[boundaries % len(boundary_styles)] if boundary else "-"
-        boundaries += 1 if boundary else 0
-        ax.plot(xs, ys, color="0.25" if boundary else OKABE_ITO[pos % len(OKABE_ITO)], lw=1.6, ls=style,
-                label="boundary %s" % c.get("name") if boundary
-                else "%s from special point %s" % (c.get("type"), c.get("special_point")))
+        kind = str(c.get("type"))
+        sp = by_id.get(c.get("special_point"))
+        branch = res.by_id.get(sp.get("branch")) if sp else None
+        colour = branch["colour"] if branch and branch["family"] else "0.25"
+        if kind == "boundary":
+            label = "boundary %s" % c.get("name")
+        else:
+            label = "%s%s · %s%s" % (sp.get("type", "?") if sp else "?", c.get("special_point"), kind,
+                                     " (%s)" % branch["family"] if branch and branch["family"] else "")
+        ax.plot(xs, ys, color=colour, lw=1.8, ls=CURVE_DASHES.get(kind, "-"), label=label)
         for q in c.get("codim_two") or []:
-            ax.plot([to_float(q.get(p))], [to_float(q.get("H"))], "k*", ms=8)
-    ax.set_xlabel(axis_label(p), fontsize=9)
-    ax.set_ylabel(axis_label("H"), fontsize=9)
-    ax.grid(True, alpha=0.3)
-    ax.set_title(r"special points in $(%s, \bar{H})$: " % p + model_title(res), fontsize=10)
-    ax.legend(fontsize=8)
+            ax.plot([to_float(q.get(p))], [to_float(q.get("H"))], "*", color="black", ms=8)
+    # Regions, physical ones first: one fill per set of points (mirror images that coincide are one region,
+    # named after both families, in the first one's colour).
+    fills = {}
+    for region in sorted(report_plane(res).get("regions") or [], key=lambda r: r.get("kind") == "stable"):
+        poly = [q for q in region.get("polygon") or [] if isinstance(q, list) and len(q) == 2 and finite(*q)]
+        family = region.get("family")
+        colour = next((b["colour"] for b in res.branches if b["family"] == family), None)
+        if len(poly) < 3 or not colour:
+            continue
+        key = (region.get("kind"), tuple(tuple(q) for q in poly))
+        if key in fills:
+            if family not in fills[key]["families"]:
+                fills[key]["families"].append(family)
+            continue
+        fills[key] = {"families": [family], "colour": colour, "kind": region.get("kind"), "poly": poly}
+    legend_regions = {}
+    for f in fills.values():
+        alpha = 0.35 if f["kind"] == "stable" else 0.12
+        ax.fill([q[0] for q in f["poly"]], [q[1] for q in f["poly"]], color=f["colour"], lw=0, zorder=0, alpha=alpha)
+        legend_regions.setdefault("%s: %s" % (" = ".join(f["families"]), f["kind"]), (f["colour"], alpha))
+    value = res.parameters.get(p)
+    if finite(value):
+        ax.axvline(value, color="0.55", lw=0.8, ls=":", zorder=0)
+    ax.set_xlabel(axis_label(p, res), fontsize=9)
+    ax.set_ylabel(axis_label("H", res), fontsize=9)
+    ax.grid(True, color="0.9", lw=0.6)
+    ax.set_title(r"special points continued in $(%s, \bar{H})$: " % p + model_title(res), fontsize=10)
+    handles = ax.get_legend_handles_labels()[0]
+    from matplotlib.patches import Patch
+    handles += [Patch(color=c, alpha=a, lw=0, label=name) for name, (c, a) in legend_regions.items()]
+    ax.legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False,
+              borderaxespad=0.0)
     save(fig, res, "curves", svg, written)
 
 
