@@ -560,3 +560,34 @@ TEST(StudyNotes, ACompileNoteIsOneLine) {
 
 }  // namespace
 }  // namespace hybridcont
+
+namespace hybridcont {
+namespace {
+
+// A family continued in a parameter (the compass gait in its slope) is animated too: each physical point's
+// orbit drawn on the model at that point's slope, at least kAnimationFrames rows of finite coordinates.
+TEST(StudyReport, FamiliesInAParameterAreAnimatedAtEachPointsValue) {
+  StudyOptions options;
+  options.model = std::string(HYBRIDCONT_SOURCE_DIR) + "/models/compass-gait.toml";
+  const StudyResult study = RunStudy(options);
+  const HybridModel model = MakeStudyModel(options.model);
+  const nlohmann::json data = nlohmann::json::parse(StudyReportData(study, &model));
+  int animated = 0;
+  for (const nlohmann::json& b : data["branches"]) {
+    ASSERT_EQ(b["continued"], "gamma");
+    ASSERT_TRUE(b.contains("animation")) << b["id"];
+    for (std::size_t i = 0; i < b["physical"].size(); ++i) {
+      if (!b["physical"][i].get<bool>()) continue;
+      const nlohmann::json& frames = b["animation"][i];
+      ASSERT_GE(frames.size(), static_cast<std::size_t>(kAnimationFrames)) << b["id"] << " " << i;  // + event instants
+      for (const nlohmann::json& row : frames) {
+        for (const nlohmann::json& v : row) ASSERT_TRUE(v.is_number()) << b["id"] << " " << i;
+      }
+      ++animated;
+    }
+  }
+  EXPECT_GT(animated, 100);
+}
+
+}  // namespace
+}  // namespace hybridcont

@@ -33,15 +33,29 @@ json RangesJson(const std::vector<Range>& ranges) {
 }
 
 // Each point's orbit drawn at kAnimationFrames instants (null where not physical or not drawable): one flat
-// row [x0, y0, x1, y1, ...] over the presentation's points per instant.
+// row [x0, y0, x1, y1, ...] over the presentation's points per instant. A family continued in a parameter
+// (its last unknown) is drawn on the model at each point's value of it.
 json AnimationJson(const StudyBranch& b, const HybridModel& model, const OrbitPresentation& presentation) {
+  const bool in_parameter = b.continued != "H";
   json frames = json::array();
   for (const StudyPoint& p : b.points) {
     if (!p.analysis.classification.physical) {
       frames.push_back(nullptr);
       continue;
     }
-    const OrbitTrace trace(model, p.u, IntegratorOptions{});
+    std::unique_ptr<HybridModel> at_point;
+    Vector state = p.u;
+    if (in_parameter) {
+      try {
+        at_point = std::make_unique<HybridModel>(model.Clone());
+        at_point->SetParameter(b.continued, p.u(p.u.size() - 1));
+      } catch (const std::invalid_argument&) {  // a value outside the parameter's range: not drawn
+        frames.push_back(nullptr);
+        continue;
+      }
+      state = p.u.head(p.u.size() - 1);
+    }
+    const OrbitTrace trace(at_point ? *at_point : model, state, IntegratorOptions{});
     if (!trace.ok()) {
       frames.push_back(nullptr);
       continue;
@@ -260,9 +274,11 @@ std::string StudyReportData(const StudyResult& study, const HybridModel* model) 
   }
   for (const StudyBranch& b : study.branches) {
     json branch = BranchJson(b);
-    // The study's own model, its families in H̄ (the orbit's unknowns alone): a period-doubled family or
-    // another word runs on another model, a family in a parameter on other parameter values.
-    if (presentation && !drawing.is_null() && b.origin.empty() && b.continued == "H" && b.model == study.model) {
+    // The study's own model, its families in H̄ (the orbit's unknowns alone) or in a parameter (its last
+    // unknown): a period-doubled family or another word runs on another model.
+    const bool continued_last = !b.unknown_names.empty() && b.unknown_names.back() == b.continued;
+    if (presentation && !drawing.is_null() && b.origin.empty() && b.model == study.model &&
+        (b.continued == "H" || continued_last)) {
       branch["animation"] = AnimationJson(b, *model, *presentation);
     }
     branches.push_back(std::move(branch));
