@@ -15,7 +15,7 @@
 
 #include <unistd.h>
 
-#include "answer.h"
+#include "hybridcont/study_answer.h"
 #include "commands.h"
 #include "figure_script.h"
 #include "hybridcont/study.h"

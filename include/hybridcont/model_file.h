@@ -49,6 +49,9 @@ ExpressionModelSpec ParseModelText(const std::string& text, const std::string& f
 
 // ReadModelFile, then build (compiled if possible). Throws ModelInputError.
 HybridModel LoadModelFile(const std::filesystem::path& path, const ModelFileOptions& options = {});
+// The same from model text (a model written by a program: the Python package's models from SymPy);
+// `file_name` appears in messages. Throws ModelInputError.
+HybridModel LoadModelText(const std::string& text, const std::string& file_name, const ModelFileOptions& options = {});
 
 // True when `name_or_path` names a model file rather than a built-in model (it ends in ".toml").
 bool IsModelFilePath(const std::string& name_or_path);

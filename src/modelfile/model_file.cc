@@ -102,8 +102,10 @@ ExpressionModelSpec ReadModelFile(const std::filesystem::path& path) {
   return ParseModelText(text.str(), path.string());
 }
 
-HybridModel LoadModelFile(const std::filesystem::path& path, const ModelFileOptions& options) {
-  ExpressionModelSpec spec = ReadModelFile(path);
+namespace {
+
+// The spec built (compiled if asked and possible); errors name `source`.
+HybridModel BuildSpec(ExpressionModelSpec spec, const std::string& source, const ModelFileOptions& options) {
   std::shared_ptr<const CompiledPrograms> compiled;
   if (options.compile) compiled = internal::CompileModel(spec.automaton ? ExpressionCatalogueSpec(spec) : spec, options);
   try {
@@ -111,8 +113,18 @@ HybridModel LoadModelFile(const std::filesystem::path& path, const ModelFileOpti
   } catch (const ModelInputError&) {
     throw;
   } catch (const std::invalid_argument& e) {
-    throw ModelInputError(SourceLocation{path.string(), 0, ""}, e.what());
+    throw ModelInputError(SourceLocation{source, 0, ""}, e.what());
   }
+}
+
+}  // namespace
+
+HybridModel LoadModelText(const std::string& text, const std::string& file_name, const ModelFileOptions& options) {
+  return BuildSpec(ParseModelText(text, file_name), file_name, options);
+}
+
+HybridModel LoadModelFile(const std::filesystem::path& path, const ModelFileOptions& options) {
+  return BuildSpec(ReadModelFile(path), path.string(), options);
 }
 
 bool IsModelFilePath(const std::string& name_or_path) {

@@ -435,8 +435,8 @@ bool ResultsWriter::WriteSummary() {
   return true;
 }
 
-bool ResultsWriter::Finish() {
-  summary_["status"] = "complete";
+bool ResultsWriter::Finish(bool cancelled) {
+  summary_["status"] = cancelled ? "cancelled" : "complete";
   return WriteSummary();
 }
 

@@ -16,8 +16,8 @@
 // Every CSV row is flushed when written and summary.json is rewritten atomically (temp + rename) after
 // each branch, so an interrupted run leaves consistent files with everything computed so far.
 //
-// Completeness: summary.json carries "status": "running" from the first write on, "complete" only from
-// Finish(), "failed" (with "status_message") from Fail(). A write that fails (a full disk) is never
+// Completeness: summary.json carries "status": "running" from the first write on, "complete" (or, for a study
+// stopped on request, "cancelled") only from Finish(), "failed" (with "status_message") from Fail(). A write that fails (a full disk) is never
 // renamed over the last good summary.json and stops all further writing; the folder then keeps the last
 // summary that could be written, which says "running" (or there is none): it never claims to be complete.
 //
@@ -138,8 +138,9 @@ class ResultsWriter {
   void SetReport(const std::string& report);
   // Rewrites summary.json atomically; false (and write_error() set) when it could not be written.
   bool WriteSummary();
-  // The final summary: "status": "complete". False when it could not be written.
-  bool Finish();
+  // The final summary: "status": "complete", or "cancelled" for a study stopped on request. False when it
+  // could not be written.
+  bool Finish(bool cancelled = false);
   // Records why the run did not complete ("status": "failed") and tries to write the summary.
   void Fail(const std::string& message);
 

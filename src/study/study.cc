@@ -723,7 +723,8 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
     writer.Fail(e.what());
     throw;
   }
-  if (!writer.Finish()) writer.Fail(writer.write_error());  // a full disk: the folder is marked incomplete
+  // A stopped study ends its folder as "cancelled": whole, but not the whole study (--resume completes it).
+  if (!writer.Finish(result.status == ExplorationStatus::kCancelled)) writer.Fail(writer.write_error());  // a full disk: the folder is marked incomplete
   const bool complete = writer.write_error().empty() && result.status != ExplorationStatus::kCancelled;
   if (store) {
     result.work.resumed_branches = store->used();

@@ -1,4 +1,4 @@
-#include "answer.h"
+#include "hybridcont/study_answer.h"
 
 #include <fmt/format.h>
 
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace hybridcont::app {
+namespace hybridcont {
 
 namespace {
 
@@ -151,4 +151,4 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
   return out;
 }
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont

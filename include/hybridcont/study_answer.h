@@ -3,21 +3,22 @@
 // the continued coordinate, with how each range ends; its located special points (type, coordinate, period,
 // precision) with their restart labels; and the families it connects to. The rest of the diagram (branches
 // without a physical orbit, every special point, the branch switches, the work) is counted in one line and
-// kept in the full report (`--verbose`, summary.json's "report").
+// kept in the full report (`--verbose`, summary.json's "report"). The command line ends a run with it; the
+// Python package's Study prints it.
 //
 //   std::cout << OneScreenAnswer(study, seconds);
-#ifndef HYBRIDCONT_APP_ANSWER_H_
-#define HYBRIDCONT_APP_ANSWER_H_
+#ifndef HYBRIDCONT_STUDY_ANSWER_H_
+#define HYBRIDCONT_STUDY_ANSWER_H_
 
 #include <string>
 
 #include "hybridcont/study.h"
 
-namespace hybridcont::app {
+namespace hybridcont {
 
 // `seconds`: the wall time of the computation, its last line.
 std::string OneScreenAnswer(const StudyResult& study, double seconds);
 
-}  // namespace hybridcont::app
+}  // namespace hybridcont
 
-#endif  // HYBRIDCONT_APP_ANSWER_H_
+#endif  // HYBRIDCONT_STUDY_ANSWER_H_

@@ -1,0 +1,530 @@
+// _hybridcont: the Python package's bridge to the library (pybind11). It exposes the study API (study.h) and
+// the model's maps, nothing of its own: the package's Python modules (python/hybridcont/) turn keyword
+// arguments into StudyOptions, results folders into DataFrames and SymPy into model text.
+//
+// Conventions:
+//  - Bad input (StudyOptionError, ModelInputError, any std::invalid_argument) arrives as ValueError with the
+//    library's message; a numerical failure is a status in what a call returns, never an exception.
+//  - The GIL is released while the library computes; the hooks take it back to call Python.
+//  - Ctrl-C during a study sets its stop request (a SIGINT handler of its own for the call's duration, the
+//    interpreter's restored after): the study ends after its current step with status "cancelled" and keeps
+//    the work so far.
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "hybridcont/continuation.h"
+#include "hybridcont/floquet.h"
+#include "hybridcont/model_file.h"
+#include "hybridcont/models.h"
+#include "hybridcont/orbit_trace.h"
+#include "hybridcont/study.h"
+#include "hybridcont/study_answer.h"
+#include "hybridcont/study_report.h"
+#include "hybridcont/timebased_shooting.h"
+
+namespace py = pybind11;
+
+namespace hybridcont::python {
+
+namespace {
+
+// ---- Ctrl-C: a flag the study's stop request reads, set by a SIGINT handler installed for one call.
+std::atomic<bool> interrupted{false};
+extern "C" void OnInterrupt(int) { interrupted = true; }
+
+class InterruptGuard {
+ public:
+  InterruptGuard() {
+    interrupted = false;
+    struct sigaction action {};
+    action.sa_handler = OnInterrupt;
+    sigemptyset(&action.sa_mask);
+    installed_ = sigaction(SIGINT, &action, &previous_) == 0;
+  }
+  ~InterruptGuard() {
+    if (installed_) sigaction(SIGINT, &previous_, nullptr);
+  }
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+ private:
+  struct sigaction previous_ {};
+  bool installed_ = false;
+};
+
+// ---- options: a dict of plain values (the package's keyword arguments, already named as StudyOptions')
+template <class T>
+T Get(const py::dict& d, const char* key, T fallback) {
+  return d.contains(key) && !d[key].is_none() ? d[key].cast<T>() : fallback;
+}
+
+std::vector<NamedValue> NamedValues(const py::dict& d, const char* key) {
+  std::vector<NamedValue> out;
+  if (!d.contains(key) || d[key].is_none()) return out;
+  for (const py::handle item : d[key]) {
+    const auto pair = item.cast<std::pair<std::string, double>>();
+    out.push_back({pair.first, pair.second});
+  }
+  return out;
+}
+
+StudyOptions OptionsOf(const py::dict& d) {
+  StudyOptions o;
+  o.model = Get<std::string>(d, "model", "");
+  o.models_directory = Get<std::string>(d, "models_directory", "");
+  o.parameters = NamedValues(d, "parameters");
+  o.until = NamedValues(d, "until");
+  o.monitors = NamedValues(d, "monitors");
+  if (d.contains("bounds") && !d["bounds"].is_none()) {
+    for (const py::handle item : d["bounds"]) {
+      const auto b = item.cast<std::tuple<std::string, double, double>>();
+      o.bounds.push_back({std::get<0>(b), std::get<1>(b), std::get<2>(b)});
+    }
+  }
+  if (d.contains("rtol") && !d["rtol"].is_none()) o.rtol = d["rtol"].cast<double>();
+  if (d.contains("atol") && !d["atol"].is_none()) o.atol = d["atol"].cast<double>();
+  if (d.contains("max_branches") && !d["max_branches"].is_none()) o.max_branches = d["max_branches"].cast<int>();
+  o.threads = Get<int>(d, "threads", 1);
+  const std::string formulation = Get<std::string>(d, "formulation", "time");
+  if (!FromString(formulation, &o.formulation)) {
+    throw std::invalid_argument("formulation '" + formulation + "': expected 'time' or 'state'");
+  }
+  o.use_symmetries = Get<bool>(d, "use_symmetries", true);
+  o.follow_word_changes = Get<bool>(d, "follow_word_changes", true);
+  o.period_doubling = Get<bool>(d, "period_doubling", false);
+  o.free = Get<std::string>(d, "free", "");
+  if (d.contains("fix") && !d["fix"].is_none()) {
+    const auto fix = d["fix"].cast<std::pair<std::string, double>>();
+    o.fix = NamedValue{fix.first, fix.second};
+  }
+  o.curves = Get<std::string>(d, "curves", "");
+  if (d.contains("restart") && !d["restart"].is_none()) {
+    const auto r = d["restart"].cast<std::tuple<std::string, std::string, std::string>>();
+    RestartSpec spec{std::get<0>(r), std::get<1>(r), RestartSpec::Kind::kAuto};
+    bool known = false;
+    for (const RestartSpec::Kind k : {RestartSpec::Kind::kAuto, RestartSpec::Kind::kContinue, RestartSpec::Kind::kSwitch,
+                                      RestartSpec::Kind::kPeriodDoubled, RestartSpec::Kind::kCurve,
+                                      RestartSpec::Kind::kFree}) {
+      if (ToString(k) == std::get<2>(r)) spec.kind = k, known = true;
+    }
+    if (!known) {
+      throw std::invalid_argument("as_ '" + std::get<2>(r) +
+                                  "': expected auto, continue, switch, period-doubled, curve or free");
+    }
+    o.restart = spec;
+  }
+  o.out_dir = Get<std::string>(d, "out_dir", "");
+  o.overwrite = Get<bool>(d, "overwrite", false);
+  o.resume = Get<bool>(d, "resume", false);
+  return o;
+}
+
+// ---- models
+using ModelHandle = std::shared_ptr<HybridModel>;
+
+ModelHandle Share(HybridModel model) { return std::make_shared<HybridModel>(std::move(model)); }
+
+// The map of the model's time-based layout, with `free` parameter(s) held by `fix` (free[i] at fix[i]); a
+// model without first integral continued in its parameter has that parameter free and nothing fixed.
+struct MapSpec {
+  std::vector<std::string> free;
+  std::vector<std::pair<std::string, double>> fix;
+};
+
+FreeParameters FreeOf(const MapSpec& spec) {
+  FreeParameters free;
+  free.parameters = spec.free;
+  for (const auto& [name, value] : spec.fix) free.fixed.push_back({name, value});
+  return free;
+}
+
+Vector ToVector(const std::vector<double>& v) { return Eigen::Map<const Vector>(v.data(), static_cast<Eigen::Index>(v.size())); }
+
+py::array_t<double> ToArray(const Vector& v) {
+  py::array_t<double> a(v.size());
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.mutable_at(i) = v(i);
+  return a;
+}
+
+py::array_t<double> ToArray(const Matrix& m) {
+  py::array_t<double> a({m.rows(), m.cols()});
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    for (Eigen::Index j = 0; j < m.cols(); ++j) a.mutable_at(i, j) = m(i, j);
+  }
+  return a;
+}
+
+IntegratorOptions IntegratorOf(std::optional<double> rtol, std::optional<double> atol) {
+  IntegratorOptions options;
+  if (rtol) options.rtol = *rtol;
+  if (atol) options.atol = *atol;
+  return options;
+}
+
+// u must hold one value per unknown of the map.
+void CheckSize(const std::vector<double>& u, const TimeBasedShooting& map) {
+  if (static_cast<int>(u.size()) != map.num_unknowns()) {
+    throw std::invalid_argument("u has " + std::to_string(u.size()) + " entries; the map's unknowns are " +
+                                std::to_string(map.num_unknowns()) + " (" + std::to_string(map.num_equations()) +
+                                " equations)");
+  }
+}
+
+py::dict Evaluate(const ModelHandle& model, const std::vector<double>& u, const MapSpec& spec, bool jacobian,
+                  std::optional<double> rtol, std::optional<double> atol) {
+  TimeBasedShooting map(*model, IntegratorOf(rtol, atol), FreeOf(spec));
+  CheckSize(u, map);
+  Vector r;
+  Matrix dr;
+  EvaluationStatus status;
+  {
+    py::gil_scoped_release release;
+    status = map.Evaluate(ToVector(u), &r, jacobian ? &dr : nullptr);
+  }
+  py::dict out;
+  out["ok"] = status.ok;
+  out["message"] = status.message;
+  out["r"] = status.ok ? py::object(ToArray(r)) : py::none();
+  out["dr"] = status.ok && jacobian ? py::object(ToArray(dr)) : py::none();
+  out["unknowns"] = map.unknown_names();
+  return out;
+}
+
+py::dict Floquet(const ModelHandle& model, const std::vector<double>& u, const MapSpec& spec,
+                 std::optional<double> rtol, std::optional<double> atol) {
+  TimeBasedShooting map(*model, IntegratorOf(rtol, atol), FreeOf(spec));
+  CheckSize(u, map);
+  FloquetResult f;
+  {
+    py::gil_scoped_release release;
+    f = ComputeFloquet(map, ToVector(u));
+  }
+  py::dict out;
+  out["ok"] = f.ok();
+  out["message"] = f.message;
+  out["monodromy"] = f.ok() ? py::object(ToArray(f.monodromy)) : py::none();
+  out["multipliers"] = f.multipliers;
+  out["nontrivial"] = f.nontrivial;
+  out["stable"] = f.stable;
+  out["stability"] = f.stability.ToString();
+  out["bp_test"] = f.bp_test;
+  out["pd_test"] = f.pd_test;
+  return out;
+}
+
+// One period of the orbit u (model layout, parameters as set on the model): samples t, segment, state.
+py::dict Trace(const ModelHandle& model, const std::vector<double>& u, int samples, std::optional<double> rtol,
+               std::optional<double> atol) {
+  std::unique_ptr<OrbitTrace> trace;
+  {
+    py::gil_scoped_release release;
+    trace = std::make_unique<OrbitTrace>(*model, ToVector(u), IntegratorOf(rtol, atol));
+  }
+  py::dict out;
+  out["ok"] = trace->ok();
+  out["message"] = trace->message();
+  std::vector<double> t;
+  std::vector<int> segment;
+  std::vector<std::string> phase;
+  std::vector<std::vector<double>> x;
+  if (trace->ok()) {
+    for (const OrbitSample& s : trace->Sample(samples)) {
+      t.push_back(s.t);
+      segment.push_back(s.segment);
+      phase.push_back(model->phase(s.segment % model->num_phases()).name());
+      x.emplace_back(s.x.data(), s.x.data() + s.x.size());
+    }
+  }
+  out["t"] = t;
+  out["segment"] = segment;
+  out["phase"] = phase;
+  out["x"] = x;
+  return out;
+}
+
+// ---- studies
+ReportAssets AssetsOf(const py::dict& assets) {
+  return ReportAssets{assets["template_html"].cast<std::string>(), assets["viewer_js"].cast<std::string>(),
+                      assets["viewer_css"].cast<std::string>(), assets["plotly_js"].cast<std::string>()};
+}
+
+// The model of a study the library can make by its name (a built-in model, a shipped model file), whose
+// orbits the report draws; null for another (a model of the caller's, then passed in).
+std::unique_ptr<HybridModel> StudyModelIfKnown(const StudyResult& study, const std::string& models_directory) {
+  try {
+    return std::make_unique<HybridModel>(MakeStudyModel(study.model, study.parameters, models_directory));
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+// Writes report.html into the study's folder (as the command line does, atomically); the reason it could not,
+// empty when written.
+std::string WriteReport(const StudyResult& study, const std::string& dir, const ReportAssets& assets,
+                        const HybridModel* model, const std::string& models_directory) {
+  if (const std::string missing = assets.Missing(); !missing.empty()) return "the report's files are missing: " + missing;
+  const std::unique_ptr<HybridModel> built = model ? nullptr : StudyModelIfKnown(study, models_directory);
+  try {
+    const std::filesystem::path path = std::filesystem::path(dir) / "report.html";
+    {
+      std::ofstream f(path.string() + ".tmp", std::ios::binary);
+      f << StudyReportHtml(study, assets, model ? model : built.get());
+      if (!f.flush()) return "cannot write " + path.string() + ".tmp";
+    }
+    std::filesystem::rename(path.string() + ".tmp", path);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& model, const py::object& on_progress,
+                            const py::object& on_point, const py::object& on_note, const py::object& report_assets) {
+  const StudyOptions options = OptionsOf(options_dict);
+  const std::optional<ReportAssets> assets =
+      report_assets.is_none() ? std::nullopt : std::optional<ReportAssets>(AssetsOf(report_assets.cast<py::dict>()));
+  StudyHooks hooks;
+  // Hooks run on this (the calling) thread while the GIL is released: each takes it to call Python. An
+  // exception in a callback ends the study like Ctrl-C and is raised again afterwards.
+  std::string callback_error;
+  const auto call = [&](const py::object& f, auto&&... args) {
+    if (f.is_none() || interrupted) return;
+    py::gil_scoped_acquire acquire;
+    try {
+      f(std::forward<decltype(args)>(args)...);
+    } catch (py::error_already_set& e) {
+      if (e.matches(PyExc_KeyboardInterrupt)) {
+        interrupted = true;
+      } else {
+        callback_error = e.what();
+        interrupted = true;
+      }
+    }
+  };
+  if (!on_progress.is_none()) {
+    hooks.on_progress = [&](const StudyProgress& p) { call(on_progress, p.stage, p.branches, p.points, p.message); };
+  }
+  if (!on_point.is_none()) {
+    hooks.on_point = [&](const StudyPoint& p, const StudyBranch& b) {
+      call(on_point, b.id, b.family, p.index, p.T, p.analysis.classification.physical, p.analysis.stability);
+    };
+  }
+  if (!on_note.is_none()) hooks.on_note = [&](const std::string& line) { call(on_note, line); };
+  hooks.stop_requested = [] { return interrupted.load(); };
+  StudyResult result;
+  std::string report_error;
+  {
+    InterruptGuard guard;
+    py::gil_scoped_release release;
+    result = model ? RunStudy(*model, options, hooks) : RunStudy(options, hooks);
+    if (assets && !options.out_dir.empty()) {
+      report_error = WriteReport(result, options.out_dir, *assets, model.get(), options.models_directory);
+    }
+  }
+  if (!callback_error.empty()) throw std::runtime_error("a callback of the study failed: " + callback_error);
+  py::dict out;
+  out["report_error"] = report_error;
+  out["model"] = result.model;
+  out["version"] = result.version;
+  out["status"] = ToString(result.status);
+  out["message"] = result.message;
+  out["interrupted"] = interrupted.load();
+  out["write_error"] = result.write_error;
+  out["wall_seconds"] = result.work.wall_seconds;
+  out["answer"] = OneScreenAnswer(result, result.work.wall_seconds);
+  out["report"] = result.report;
+  return out;
+}
+
+// The saved study's answer, status and model (the folder checked as LoadStudy checks it).
+py::dict LoadStudyFromPython(const std::string& dir) {
+  std::unique_ptr<StudyResult> study_ptr;
+  {
+    py::gil_scoped_release release;
+    study_ptr = std::make_unique<StudyResult>(LoadStudy(dir));
+  }
+  const StudyResult& study = *study_ptr;
+  py::dict out;
+  out["status"] = ToString(study.status);
+  out["message"] = study.message;
+  out["model"] = study.model;
+  out["version"] = study.version;
+  out["answer"] = OneScreenAnswer(study, study.work.wall_seconds);
+  return out;
+}
+
+std::string ReportHtml(const std::string& dir, const py::dict& assets, const ModelHandle& model,
+                       const std::string& models_directory) {
+  const ReportAssets a = AssetsOf(assets);
+  if (const std::string missing = a.Missing(); !missing.empty()) {
+    throw std::runtime_error("the report's files are missing: " + missing);
+  }
+  py::gil_scoped_release release;  // reading the folder, building the model (compiled on first use), drawing
+  const StudyResult study = LoadStudy(dir);
+  const std::unique_ptr<HybridModel> built = model ? nullptr : StudyModelIfKnown(study, models_directory);
+  return StudyReportHtml(study, a, model ? model.get() : built.get());
+}
+
+// ---- point-by-point continuation of one branch of the time-based map
+class Continuation {
+ public:
+  Continuation(const ModelHandle& model, const std::vector<double>& u0, const MapSpec& spec, const py::dict& options)
+      : model_(model), map_(*model, IntegratorOf(Get<double>(options, "rtol", 1e-10), Get<double>(options, "atol", 1e-10)),
+                            FreeOf(spec)) {
+    ContinuationOptions c;
+    c.direction = Get<int>(options, "direction", 1);
+    c.initial_step = Get<double>(options, "initial_step", c.initial_step);
+    c.max_step = Get<double>(options, "max_step", c.max_step);
+    c.min_step = Get<double>(options, "min_step", c.min_step);
+    c.max_points = Get<int>(options, "max_points", c.max_points);
+    if (options.contains("bounds") && !options["bounds"].is_none()) {
+      for (const py::handle item : options["bounds"]) {
+        const auto b = item.cast<std::tuple<std::string, double, double>>();
+        c.bounds.push_back({std::get<0>(b), std::get<1>(b), std::get<2>(b)});
+      }
+    }
+    CheckSize(u0, map_);
+    stepper_ = std::make_unique<ContinuationStepper>(&map_, c);
+    u0_ = ToVector(u0);
+  }
+
+  // Starts (corrects u0) or adds the next point; returns "continuing" or "finished" (see termination()).
+  std::string Step() {
+    StepStatus status;
+    {
+      py::gil_scoped_release release;
+      status = started_ ? stepper_->Step() : stepper_->Start(u0_);
+    }
+    started_ = true;
+    return status == StepStatus::kFinished ? "finished" : "continuing";
+  }
+  bool finished() const { return stepper_->finished(); }
+  int num_points() const { return static_cast<int>(stepper_->branch().points.size()); }
+  py::dict Point(int i) const {
+    const Branch& b = stepper_->branch();
+    if (i < 0 || i >= static_cast<int>(b.points.size())) throw py::index_error("no point " + std::to_string(i));
+    const ContinuationPoint& p = b.points[i];
+    py::dict out;
+    out["index"] = i;
+    out["u"] = ToArray(p.u);
+    out["tangent"] = ToArray(p.tangent);
+    out["step"] = p.step;
+    out["arclength"] = p.arclength;
+    out["newton_iterations"] = p.newton_iterations;
+    return out;
+  }
+  std::string termination() const { return ToString(stepper_->branch().termination); }
+  std::string message() const { return stepper_->branch().message; }
+  std::vector<std::string> unknowns() const { return map_.unknown_names(); }
+
+ private:
+  ModelHandle model_;  // the map refers to it
+  TimeBasedShooting map_;
+  std::unique_ptr<ContinuationStepper> stepper_;
+  Vector u0_;
+  bool started_ = false;
+};
+
+}  // namespace
+
+}  // namespace hybridcont::python
+
+PYBIND11_MODULE(_hybridcont, m) {
+  using namespace hybridcont;
+  using namespace hybridcont::python;
+  m.doc() = "hybridcont's C++ library (study API, model maps); use the package `hybridcont`, not this module.";
+  m.attr("__version__") = Version();
+  m.def("builtin_model_names", &BuiltinModelNames, "The names of the built-in C++ models.");
+
+  py::class_<MapSpec>(m, "MapSpec", "Free parameters of a map and the unknowns that hold them.")
+      .def(py::init<>())
+      .def(py::init<std::vector<std::string>, std::vector<std::pair<std::string, double>>>(), py::arg("free"),
+           py::arg("fix"))
+      .def_readwrite("free", &MapSpec::free)
+      .def_readwrite("fix", &MapSpec::fix);
+
+  py::class_<HybridModel, ModelHandle>(m, "NativeModel", "A hybrid model of the library (HybridModel).")
+      .def_property_readonly("name", &HybridModel::name)
+      .def_property_readonly("description", &HybridModel::description)
+      .def_property_readonly("num_first_integrals", &HybridModel::num_first_integrals)
+      .def_property_readonly("parameters",
+                             [](const HybridModel& model) {
+                               py::dict out;
+                               for (std::size_t i = 0; i < model.parameters().size(); ++i) {
+                                 out[py::str(model.parameters()[i].name)] = model.parameter_value(static_cast<int>(i));
+                               }
+                               return out;
+                             })
+      .def_property_readonly("phases",
+                             [](const HybridModel& model) {
+                               std::vector<std::pair<std::string, std::vector<std::string>>> out;
+                               for (int i = 0; i < model.num_phases(); ++i) {
+                                 out.push_back({model.phase(i).name(), model.phase(i).state_names()});
+                               }
+                               return out;
+                             })
+      .def("set_parameter", &HybridModel::SetParameter, py::arg("name"), py::arg("value"))
+      .def("clone", [](const HybridModel& model) { return Share(model.Clone()); })
+      .def("unknowns",
+           [](const ModelHandle& model, const MapSpec& spec) {
+             return TimeBasedShooting(*model, IntegratorOptions{}, FreeOf(spec)).unknown_names();
+           })
+      .def("evaluate", &Evaluate, py::arg("u"), py::arg("spec") = MapSpec{}, py::arg("jacobian") = true,
+           py::arg("rtol") = py::none(), py::arg("atol") = py::none())
+      .def("floquet", &Floquet, py::arg("u"), py::arg("spec") = MapSpec{}, py::arg("rtol") = py::none(),
+           py::arg("atol") = py::none())
+      .def("trace", &Trace, py::arg("u"), py::arg("samples") = 400, py::arg("rtol") = py::none(),
+           py::arg("atol") = py::none());
+
+  m.def(
+      "make_model",
+      [](const std::string& name, const std::vector<std::pair<std::string, double>>& parameters,
+         const std::string& models_directory, bool compile) {
+        std::vector<NamedValue> values;
+        for (const auto& [n, v] : parameters) values.push_back({n, v});
+        py::gil_scoped_release release;  // a model file is compiled on first use (seconds)
+        return Share(MakeStudyModel(name, values, models_directory, nullptr, compile));
+      },
+      py::arg("name"), py::arg("parameters"), py::arg("models_directory"), py::arg("compile") = true,
+      "A built-in model, a model file, or a shipped model file by its name.");
+  m.def(
+      "model_from_text",
+      [](const std::string& text, const std::string& source, bool compile) {
+        ModelFileOptions options;
+        options.compile = compile;
+        py::gil_scoped_release release;
+        return Share(LoadModelText(text, source, options));
+      },
+      py::arg("text"), py::arg("source"), py::arg("compile") = true, "A model from model-file text.");
+
+  m.def("run_study", &RunStudyFromPython, py::arg("options"), py::arg("model") = ModelHandle(),
+        py::arg("on_progress") = py::none(), py::arg("on_point") = py::none(), py::arg("on_note") = py::none(),
+        py::arg("report_assets") = py::none());
+  m.def("load_study", &LoadStudyFromPython, py::arg("dir"));
+  m.def("report_html", &ReportHtml, py::arg("dir"), py::arg("assets"), py::arg("model") = ModelHandle(),
+        py::arg("models_directory") = "");
+
+  py::class_<Continuation>(m, "NativeContinuation")
+      .def(py::init<const ModelHandle&, const std::vector<double>&, const MapSpec&, const py::dict&>(),
+           py::arg("model"), py::arg("u0"), py::arg("spec"), py::arg("options"))
+      .def("step", &Continuation::Step)
+      .def_property_readonly("finished", &Continuation::finished)
+      .def_property_readonly("num_points", &Continuation::num_points)
+      .def("point", &Continuation::Point)
+      .def_property_readonly("termination", &Continuation::termination)
+      .def_property_readonly("message", &Continuation::message)
+      .def_property_readonly("unknowns", &Continuation::unknowns);
+}

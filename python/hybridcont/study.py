@@ -1,0 +1,422 @@
+"""Studies: ``hybridcont.run`` (what ``hybridcont run`` does, from Python) and the results as DataFrames.
+
+    import hybridcont as hc
+    study = hc.run("slip", until={"H": 1.8})      # every option of `hybridcont run`, as keyword arguments
+    print(study)                                  # the one-screen answer
+    study.special_points                          # DataFrame: label, type, branch, H, T, status, precision ...
+    study.points                                  # every branch file's columns, one row per point
+    study.families                                # where each family is physical and stable
+    pd4 = study.continue_from("PD4")              # the period-doubled family born at PD4
+    study.save("results/slip"); hc.load("results/slip")
+
+A study is a results folder (docs/results-format.md): the library writes it as it computes, and the
+DataFrames are its files, so Python and the command line see the same columns and numbers. Without ``out``
+the folder is a temporary one, removed when the interpreter exits unless ``save``d.
+"""
+import atexit
+import html
+import json
+import os
+import shutil
+import tempfile
+import warnings
+
+import numpy as np
+import pandas as pd
+
+from . import _hybridcont as native
+from . import _paths
+from .models import Model, model as make_model
+
+_TEMPORARY = []
+
+
+@atexit.register
+def _remove_temporary_folders():
+    for path in _TEMPORARY:
+        shutil.rmtree(path, ignore_errors=True)
+
+
+def _pairs(value, what):
+    """{name: value} or [(name, value)] as [(name, float)]."""
+    if value is None:
+        return []
+    items = value.items() if isinstance(value, dict) else value
+    out = []
+    for item in items:
+        try:
+            name, v = item
+        except (TypeError, ValueError):
+            raise ValueError("%s: expected {name: value} or [(name, value)], got %r" % (what, item))
+        out.append((str(name), float(v)))
+    return out
+
+
+def _bounds(value):
+    """{name: (lower, upper)} (None: unbounded) as [(name, lower, upper)]."""
+    out = []
+    for name, interval in (value or {}).items():
+        try:
+            lo, hi = interval
+        except (TypeError, ValueError):
+            raise ValueError("bound: expected {name: (lower, upper)}, got %s=%r" % (name, interval))
+        out.append((str(name), -np.inf if lo is None else float(lo), np.inf if hi is None else float(hi)))
+    return out
+
+
+def _monitors(value):
+    """{name: value or [values]} as [(name, value)]."""
+    out = []
+    for name, values in (value or {}).items():
+        for v in (values if isinstance(values, (list, tuple, np.ndarray)) else [values]):
+            out.append((str(name), float(v)))
+    return out
+
+
+def _options(model_name, out, set=None, until=None, bound=None, monitor=None, rtol=None, atol=None,
+             max_branches=None, threads=None, formulation="time", no_symmetry=False, one_word=False,
+             period_doubling=False, free=None, fix=None, curves=None, overwrite=False, resume=False,
+             from_=None, at=None, as_="auto"):
+    if (from_ is None) != (at is None):
+        raise ValueError("from_ and at go together: a saved study (its folder or Study) and a label in it "
+                         "(PD4, B5, B5:12)")
+    fix_pairs = _pairs(fix, "fix")
+    if len(fix_pairs) > 1:
+        raise ValueError("fix: one unknown is held while `free` varies, got %d" % len(fix_pairs))
+    restart = None
+    if from_ is not None:
+        restart = (from_.path if isinstance(from_, Study) else os.fspath(from_), str(at), str(as_))
+    return {
+        "model": model_name, "models_directory": _paths.MODELS, "parameters": _pairs(set, "set"),
+        "until": _pairs(until, "until"), "bounds": _bounds(bound), "monitors": _monitors(monitor),
+        "rtol": rtol, "atol": atol, "max_branches": max_branches,
+        # As the command line: every core unless threads says otherwise (the result does not depend on it).
+        "threads": int(threads) if threads is not None else max(1, os.cpu_count() or 1),
+        "formulation": formulation, "use_symmetries": not no_symmetry, "follow_word_changes": not one_word,
+        "period_doubling": bool(period_doubling), "free": free or "", "fix": fix_pairs[0] if fix_pairs else None,
+        "curves": curves or "", "restart": restart, "out_dir": out, "overwrite": bool(overwrite),
+        "resume": bool(resume),
+    }
+
+
+def run(model, out=None, progress=True, **options):
+    """Runs a study of ``model`` (a name, a model file's path, or a Model) and returns its Study.
+
+    Keyword arguments are the options of ``hybridcont run``:
+      set={"k": 60}                   model parameters (--set)
+      until={"H": 1.8}                end every branch there (--until)
+      bound={"H": (0, 2)}             bounds of unknowns, None for an open side (--bound)
+      monitor={"H": [1.2, 1.5]}       locate where an observable takes these values, UZ points (--monitor)
+      rtol, atol                      integrator tolerances (default 1e-10)
+      max_branches, threads           half-branches at most; threads (default: every core)
+      formulation="time" | "state"    the shooting formulation
+      no_symmetry, one_word, period_doubling
+      free="k", fix={"H": 1.5}        continue in a parameter at a fixed value of an unknown
+      curves="k"                      special points continued in (H, k)
+      from_=study or folder, at="PD4", as_="auto"   restart from a labelled point (--from/--at/--as)
+      out="results/slip", overwrite, resume         the results folder (default: a temporary one)
+    progress: True shows a bar (tqdm where installed, else lines), False nothing, or a callable
+    f(stage, branches, points, message) called as the study goes.
+
+    Bad input raises ValueError with the library's message; a numerical failure is the study's status.
+    Ctrl-C ends the study after its current step: status "cancelled", the work so far kept (and warned)."""
+    if isinstance(model, Model):
+        native_model, name = model._native, model.name
+    else:
+        native_model, name = None, os.fspath(model)
+    temporary = out is None
+    if temporary:
+        out = tempfile.mkdtemp(prefix="hybridcont-")
+        _TEMPORARY.append(out)
+        options["overwrite"] = True
+    opts = _options(name, os.fspath(out), **options)
+    on_progress, close = _progress(progress)
+    try:
+        # report.html written as the command line writes it, from the study in memory
+        result = native.run_study(opts, native_model, on_progress, None, None, _paths.report_assets())
+    finally:
+        close()
+    if result["report_error"]:
+        warnings.warn("report.html not written: %s" % result["report_error"], RuntimeWarning, stacklevel=2)
+    study = Study(opts["out_dir"], model=model if isinstance(model, Model) else None, result=result)
+    if result["interrupted"]:
+        warnings.warn("the study was interrupted: the work so far is kept (status %s)" % result["status"],
+                      RuntimeWarning, stacklevel=2)
+    return study
+
+
+def load(path, model=None):
+    """The study saved in a results folder (ValueError naming the file and field of a damaged folder)."""
+    return Study(os.fspath(path), model=model)
+
+
+def _progress(progress):
+    """(callback, close) for run's progress argument."""
+    if progress is False or progress is None:
+        return None, lambda: None
+    if callable(progress):
+        return progress, lambda: None
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:
+        tqdm = None
+    if tqdm is None:
+        def say(stage, branches, points, message):
+            print("%s: %d branches, %d points %s" % (stage, branches, points, message))
+        return say, lambda: None
+    # The number of branches is what a study discovers: no total exists in advance, so the bar counts points.
+    bar = tqdm(total=None, unit=" points", desc="study", leave=False)
+
+    def update(stage, branches, points, message):
+        bar.set_description("%s, %d branches" % (stage, branches))
+        bar.update(max(0, points - bar.n))
+    return update, bar.close
+
+
+class Study:
+    """A study's results folder, read as DataFrames (attributes are read when first asked for)."""
+
+    def __init__(self, path, model=None, result=None):
+        self.path = os.path.abspath(path)
+        self.model = model
+        # A folder just written is the run's own; any other is checked as the library's LoadStudy checks it.
+        info = result if result is not None else native.load_study(self.path)
+        self.status = info["status"]
+        self.message = info["message"]
+        self.model_name = info["model"]
+        self.version = info["version"]
+        self._answer = info["answer"]
+        self.interrupted = bool(result and result["interrupted"])
+        self.wall_seconds = result["wall_seconds"] if result else None
+        with open(os.path.join(self.path, "summary.json"), encoding="utf-8") as f:
+            self.summary = json.load(f)
+        self._cache = {}
+
+    # ---- tables ------------------------------------------------------------------------------------------
+    def _table(self, key, make):
+        if key not in self._cache:
+            self._cache[key] = make()
+        return self._cache[key]
+
+    @property
+    def unknowns(self):
+        """The names of u's entries (the layout of the branch files' unknowns and special points' u)."""
+        return list(self.summary.get("unknowns") or [])
+
+    @property
+    def branches(self):
+        """One row per branch: id, family, parent special point, termination, points, word, image_of, ..."""
+        def make():
+            rows = []
+            for b in self.summary.get("branches") or []:
+                row = {k: v for k, v in b.items() if k not in ("physical_ranges", "stable_ranges")}
+                if isinstance(row.get("word"), list):
+                    row["word"] = " > ".join(row["word"])
+                row.setdefault("family", "")
+                rows.append(row)
+            first = ["id", "family", "parent", "direction", "depth", "points", "termination", "word", "image_of",
+                     "symmetry", "file"]
+            frame = pd.DataFrame(rows)
+            for column in first:
+                if column not in frame.columns:
+                    frame[column] = pd.Series(dtype=object)
+            return frame[first + [c for c in frame.columns if c not in first]]
+        return self._table("branches", make)
+
+    @property
+    def points(self):
+        """Every branch file's columns (docs/results-format.md), one row per point, with its branch's id
+        and family: index, H, T, the unknowns, physical, classification, stability, dT_dH, multipliers,
+        quantities and observables."""
+        def make():
+            frames = []
+            for b in self.summary.get("branches") or []:
+                path = os.path.join(self.path, b.get("file") or "branch-%d.csv" % b["id"])
+                if not os.path.exists(path):
+                    continue
+                frame = pd.read_csv(path, keep_default_na=True)
+                frame.insert(0, "family", b.get("family") or "")
+                frame.insert(0, "branch", b["id"])
+                frames.append(frame)
+            return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+        return self._table("points", make)
+
+    def branch(self, id):
+        """The points of one branch."""
+        points = self.points
+        return points[points["branch"] == id].reset_index(drop=True)
+
+    @property
+    def special_points(self):
+        """One row per located (or bracketed) special point: label, type, branch, index, H, T, status,
+        precision, residual, component, message, and u (the point in the study's unknowns)."""
+        def make():
+            rows = []
+            for sp in self.summary.get("special_points") or []:
+                if sp.get("duplicate_of", -1) >= 0:
+                    continue
+                row = dict(sp)
+                row["label"] = "%s%d" % (sp["type"], sp["id"]) if sp["type"] != "start" else "start%d" % sp["id"]
+                row["u"] = np.array(sp.get("u") or [], dtype=float)
+                rows.append(row)
+            frame = pd.DataFrame(rows)
+            if not frame.empty:
+                frame = frame[["label"] + [c for c in frame.columns if c != "label"]]
+            return frame
+        return self._table("special_points", make)
+
+    @property
+    def families(self):
+        """Where each family is physical and where stable: one row per range (family, branch, kind, from, to,
+        how each end is known, the special points at the ends, first and last point)."""
+        def make():
+            rows = []
+            for b in self.summary.get("branches") or []:
+                for kind in ("physical", "stable"):
+                    for r in b.get(kind + "_ranges") or []:
+                        row = {"family": r.get("family") or b.get("family"), "branch": b["id"], "kind": kind}
+                        row.update({k: v for k, v in r.items() if k != "family"})
+                        rows.append(row)
+            return pd.DataFrame(rows)
+        return self._table("families", make)
+
+    @property
+    def word_changes(self):
+        """An automaton's changes of phase sequence (summary "word_changes"), one row each."""
+        return self._table("word_changes", lambda: pd.DataFrame(self.summary.get("word_changes") or []))
+
+    @property
+    def curves(self):
+        """The two-parameter curves (``curves=p``): every curve file's columns (H, p, the other unknowns),
+        one row per point, with the curve's id, type and the special point it continues."""
+        def make():
+            frames = []
+            for c in self.summary.get("curves") or []:
+                path = os.path.join(self.path, c["file"])
+                if not os.path.exists(path):
+                    continue
+                frame = pd.read_csv(path)
+                frame.insert(0, "special_point", c.get("special_point"))
+                frame.insert(0, "type", c.get("type"))
+                frame.insert(0, "curve", c["id"])
+                frames.append(frame)
+            return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+        return self._table("curves", make)
+
+    @property
+    def orbits(self):
+        """The key-frame orbits, each one period as a time series (t, segment, phase, "<phase>.<state>",
+        draw.<point>.x/y), with its label, branch, index, H, T and monodromy in ``frame.attrs``."""
+        def make():
+            out = []
+            for o in self.summary.get("orbits") or []:
+                frame = pd.read_csv(os.path.join(self.path, o["file"]))
+                frame.attrs.update({k: v for k, v in o.items() if k != "monodromy"})
+                if "monodromy" in o:
+                    frame.attrs["monodromy"] = np.array(o["monodromy"], dtype=float)
+                out.append(frame)
+            return out
+        return self._table("orbits", make)
+
+    # ---- points ------------------------------------------------------------------------------------------
+    def u(self, branch, index):
+        """The point `index` of `branch` in the study's unknowns (numpy array)."""
+        rows = self.branch(branch)
+        row = rows[rows["index"] == index]
+        if row.empty:
+            raise ValueError("branch %d has no point %d" % (branch, index))
+        return row.iloc[0][self.unknowns].to_numpy(dtype=float)
+
+    def _model(self):
+        if self.model is None:
+            self.model = make_model(self.model_name)
+            for name, value in (self.summary.get("parameters") or {}).items():
+                self.model.set_parameter(name, value)
+        return self.model
+
+    def _map(self):
+        o = self.summary.get("options") or {}
+        return {"free": o.get("free") or [], "fix": o.get("fixed") or {}}
+
+    def evaluate(self, branch, index, jacobian=True):
+        """r and dr of the time-based map at a point of the study (Model.evaluate)."""
+        return self._model().evaluate(self.u(branch, index), jacobian=jacobian, **self._map())
+
+    def floquet(self, branch, index):
+        """The monodromy matrix and Floquet multipliers at a point of the study (Model.floquet)."""
+        return self._model().floquet(self.u(branch, index), **self._map())
+
+    def monodromy(self, branch, index):
+        """Φ_T at a point of the study."""
+        return self.floquet(branch, index)["monodromy"]
+
+    def orbit(self, branch, index, samples=400):
+        """One period of the orbit at a point of the study, as a time series (Model.orbit)."""
+        u = self.u(branch, index)
+        m = self._model()
+        free = self._map()["free"]
+        if free:
+            m = m.with_parameters(**{p: u[self.unknowns.index(p)] for p in free})
+            u = u[: len(u) - len(free)]
+        return m.orbit(u, samples)
+
+    # ---- restart, save ----------------------------------------------------------------------------------
+    def continue_from(self, label, as_="auto", out=None, progress=True, **options):
+        """A new study from a labelled point of this one ("PD4", "SB1", "B5", "B5:12"; ``as_`` as --as:
+        continue, switch, period-doubled, curve, free), with the options of ``run``."""
+        m = self.model if self.model is not None else self.model_name
+        return run(m, out=out, progress=progress, from_=self, at=label, as_=as_, **options)
+
+    def save(self, path, overwrite=False):
+        """Copies the results folder to path (refused where a folder is, unless overwrite); returns the saved
+        Study."""
+        path = os.path.abspath(os.fspath(path))
+        if os.path.exists(path):
+            if not overwrite:
+                raise ValueError("save '%s': the folder exists (overwrite=True replaces it)" % path)
+            shutil.rmtree(path)
+        shutil.copytree(self.path, path)
+        return Study(path, model=self.model)
+
+    # ---- pictures ----------------------------------------------------------------------------------------
+    def plot(self, x=None, y=None, svg=False, pdf=False, all=False):
+        """The figures of ``hybridcont plot`` written into the folder (or, with x and y, the diagram of column
+        y over column x); returns their paths."""
+        import importlib.util
+        import contextlib
+        import io
+        spec = importlib.util.spec_from_file_location("hybridcont_plot", _paths.PLOT_SCRIPT)
+        script = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(script)
+        argv = [self.path] + (["--svg"] if svg else []) + (["--pdf"] if pdf else []) + (["--all"] if all else [])
+        if (x is None) != (y is None):
+            raise ValueError("plot: x and y go together (the two columns of one diagram)")
+        if x is not None:
+            argv += ["--x", x, "--y", y]
+        out, err = io.StringIO(), io.StringIO()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            rc = script.main(argv)
+        if rc == 2:
+            raise ValueError(err.getvalue().strip())
+        if err.getvalue().strip():
+            warnings.warn(err.getvalue().strip(), RuntimeWarning, stacklevel=2)
+        return [line for line in out.getvalue().splitlines() if line]
+
+    def report_html(self):
+        """report.html of the study: one self-contained page (its diagram, orbits, multipliers, tables)."""
+        m = self.model._native if isinstance(self.model, Model) else None
+        return native.report_html(self.path, _paths.report_assets(), m, _paths.MODELS)
+
+    def _repr_html_(self):
+        # The report in an iframe of its own: its scripts and styles do not meet the notebook's.
+        return ('<iframe srcdoc="%s" style="width: 100%%; height: 900px; border: 1px solid #ddd"></iframe>'
+                % html.escape(self.report_html(), quote=True))
+
+    def __str__(self):
+        return self._answer
+
+    def __repr__(self):
+        n_families = len({f for f in (b.get("family") for b in self.summary.get("branches") or []) if f})
+        return "<hybridcont.Study %s: %d branches, %d families, %d special points, %s; %s>" % (
+            self.model_name, len(self.summary.get("branches") or []), n_families,
+            len(self.summary.get("special_points") or []), self.status, self.path)

@@ -1,0 +1,209 @@
+"""The Python package against the command line and against models written twice.
+
+Environment: PYTHONPATH holds the built package (build/python), HYBRIDCONT_BIN the built tool.
+"""
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import hybridcont as hc
+
+TOOL = os.environ.get("HYBRIDCONT_BIN", "build/hybridcont")
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, os.pardir)
+MODELS = os.path.join(ROOT, "models")
+
+
+def cli(*args):
+    proc = subprocess.run([TOOL, *args], capture_output=True, text=True, timeout=600)
+    return proc.returncode, proc.stdout, proc.stderr
+
+
+def special_points(summary):
+    return [(sp["type"], sp["branch"], sp["index"], sp["H"], sp["T"], sp["status"])
+            for sp in summary["special_points"]]
+
+
+@pytest.mark.parametrize("name", ["bouncing-ball", "rocking-block", "bouncing-rod", "slip"])
+def test_same_diagram_as_the_command_line_on_the_paper_models(tmp_path, name):
+    rc, _, err = cli("run", name, "--out", str(tmp_path / "cli"), "--quiet")
+    assert rc == 0, err
+    with open(tmp_path / "cli" / "summary.json") as f:
+        expected = json.load(f)
+    study = hc.run(name, out=tmp_path / "py", progress=False, threads=1)
+    assert study.status == "completed"
+    got = special_points(study.summary)
+    want = special_points(expected)
+    assert len(got) == len(want)
+    for g, w in zip(got, want):
+        assert g[:3] == w[:3] and g[5] == w[5], (g, w)
+        assert g[3] == pytest.approx(w[3], rel=1e-12, abs=1e-12) and g[4] == pytest.approx(w[4], rel=1e-12, abs=1e-12)
+    # The DataFrames are the folder's files: every column of every branch file, one row per point.
+    points = study.points
+    with open(tmp_path / "py" / "branch-0.csv") as f:
+        header = f.readline().strip().split(",")
+    assert list(points.columns) == ["branch", "family"] + header
+    assert len(points) == sum(b["points"] for b in study.summary["branches"])
+    assert os.path.exists(tmp_path / "py" / "report.html")
+
+
+def test_dataframes_name_what_they_hold():
+    study = hc.run("slip", progress=False, max_branches=8)
+    assert {"label", "type", "branch", "index", "H", "T", "status", "precision", "u"} <= set(study.special_points.columns)
+    assert {"family", "branch", "kind", "from", "to", "from_how", "to_how"} <= set(study.families.columns)
+    assert {"id", "family", "parent", "termination", "points", "word"} <= set(study.branches.columns)
+    hopping = study.families.query("family == 'hopping in place' and kind == 'stable'")
+    assert hopping["from"].iloc[0] == pytest.approx(1.282809324, abs=1e-9)
+    orbit = study.orbits[0]
+    assert {"t", "segment", "phase", "stance.alpha", "draw.body.x"} <= set(orbit.columns)
+    assert orbit.attrs["monodromy"].shape == (4, 4)
+    u = study.u(2, 10)
+    assert len(u) == len(study.unknowns)
+    e = study.evaluate(2, 10)
+    assert e["ok"] and np.abs(e["r"]).max() < 1e-9 and e["dr"].shape == (len(u) - 1, len(u))
+
+
+def test_bad_input_is_a_value_error_with_the_command_lines_message(tmp_path):
+    rc, _, err = cli("run", "slip", "--set", "k=-1", "--out", str(tmp_path / "cli"))
+    assert rc == 2
+    with pytest.raises(ValueError) as e:
+        hc.run("slip", set={"k": -1}, progress=False)
+    detail = str(e.value).split(": ", 1)[1]  # the message after the field's name (--set / parameters[0])
+    assert detail in err, (str(e.value), err)
+    with pytest.raises(ValueError, match="unknown model 'nosuch'"):
+        hc.run("nosuch", progress=False)
+    with pytest.raises(ValueError, match="bound: expected"):
+        hc.run("slip", bound={"H": 2}, progress=False)
+    with pytest.raises(ValueError, match=r"<text>:4: phases\[0\].name: expected a string"):  # line and field
+        hc.model(text="hybridcont = 1\nname = 'x'\n[[phases]]\nname = 3\n")
+    with pytest.raises(ValueError, match="model-file language has no"):
+        hc.ModelBuilder("x").family("f", when=sp.gamma(sp.Symbol("a")))
+    with pytest.raises(ValueError, match="a string where an expression belongs"):
+        hc.ModelBuilder("x").definition("l", "a + b")
+
+
+def test_a_model_file_from_python():
+    walker = hc.model(os.path.join(MODELS, "compass-gait.toml"), set={"gamma": 0.05})
+    assert walker.parameters["gamma"] == 0.05 and not walker.conservative
+    study = hc.run(walker, progress=False)
+    assert set(study.branches.family) == {"long-step gait", "short-step gait"}
+
+
+def bouncing_ball_in_python():
+    """models/bouncing-ball.toml, written with SymPy as a phase given by its vector field."""
+    b = hc.ModelBuilder("bouncing-ball-sympy", title="bouncing ball")
+    g = b.parameter("g", 1.0, range="(0, inf)")
+    m = b.parameter("m", 1.0, range="(0, inf)")
+    y, dy = sp.symbols("y dy")
+    b.phase("flight", states=[y, dy], typical=[0.5, 0.3], ode={y: dy, dy: -g}, energy=m * g * y + m * dy ** 2 / 2,
+            event=y, reset={y: y, dy: -dy}, anchor=dy)
+    b.symmetry("time-reversal", {"flight": [dy]}, reverses_time=True)
+    b.start("singular")
+    b.run(bounds={"xi": [-1, 1], "H": [-1, 1]}, keyframes={"component": "H", "value": 0.5})
+    return b
+
+
+def test_a_sympy_model_equals_its_model_file_twin():
+    twin = hc.model(os.path.join(MODELS, "bouncing-ball.toml"))
+    ball = bouncing_ball_in_python().build()
+    file_study = hc.run(twin, progress=False)
+    for branch, index in ((0, 5), (0, 15), (1, 10)):
+        u = file_study.u(branch, index)
+        ours, theirs = ball.evaluate(u), twin.evaluate(u)
+        assert np.abs(ours["r"] - theirs["r"]).max() <= 1e-12
+        assert np.abs(ours["dr"] - theirs["dr"]).max() <= 1e-12 * max(1.0, np.abs(theirs["dr"]).max())
+    study = hc.run(ball, progress=False)
+    a, b = study.special_points, file_study.special_points
+    assert list(a.type) == list(b.type)
+    assert np.allclose(a.H, b.H, atol=1e-9) and np.allclose(a["T"], b["T"], atol=1e-9)
+
+
+def test_progress_reaches_python_and_the_gil_is_released_while_computing():
+    calls = []
+    ticks = []
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.001)
+
+    counter = threading.Thread(target=count)
+    counter.start()
+    try:
+        hc.run("bipedal-slip", max_branches=6, threads=1,
+               progress=lambda stage, branches, points, message: calls.append((stage, points)))
+    finally:
+        stop.set()
+        counter.join()
+    assert calls and calls[-1][1] >= max(p for _, p in calls) > 100
+    # The counting thread ran throughout (it would stall for the whole study if the GIL were held).
+    assert len(ticks) > 100 and max(np.diff(ticks)) < 0.5
+
+
+def test_ctrl_c_ends_the_study_and_keeps_the_work(tmp_path):
+    script = ("import hybridcont as hc, warnings\n"
+              "warnings.simplefilter('always')\n"
+              "s = hc.run('bipedal-slip', out=%r, progress=False, threads=1)\n"
+              "print('status', s.status, 'branches', len(s.branches), 'interrupted', s.interrupted)\n"
+              % str(tmp_path / "run"))
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=dict(os.environ))
+    time.sleep(2.0)  # imported, the study under way (it takes ~5 s)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0, err
+    assert "status cancelled" in out and "interrupted True" in out, out
+    assert "the study was interrupted: the work so far is kept" in err
+    branches = int(out.split("branches ")[1].split()[0])
+    assert branches > 0
+    with open(tmp_path / "run" / "summary.json") as f:
+        assert json.load(f)["status"] != "complete"
+
+
+def test_restart_save_load_and_the_report(tmp_path):
+    study = hc.run("slip", progress=False, max_branches=6)
+    doubled = study.continue_from("PD4", progress=False)
+    rc, _, err = cli("run", "slip", "--from", study.path, "--at", "PD4", "--out", str(tmp_path / "cli"), "--quiet")
+    assert rc == 0, err
+    with open(tmp_path / "cli" / "summary.json") as f:
+        assert special_points(doubled.summary) == special_points(json.load(f))
+    saved = study.save(tmp_path / "saved")
+    loaded = hc.load(tmp_path / "saved")
+    assert loaded.points.equals(study.points) and str(loaded).startswith("\nslip:")
+    with pytest.raises(ValueError, match="exists"):
+        study.save(tmp_path / "saved")
+    (tmp_path / "broken").mkdir()
+    (tmp_path / "broken" / "summary.json").write_text("{")
+    with pytest.raises(ValueError, match="summary.json"):
+        hc.load(tmp_path / "broken")
+    page = saved._repr_html_()
+    assert page.startswith("<iframe srcdoc=") and "src=" not in page.split("srcdoc=", 1)[1].split("style=")[-1]
+    assert "<script src" not in saved.report_html()
+    files = study.plot(x="H", y="T", svg=True)
+    assert [os.path.basename(f) for f in files] == ["T_H.png", "T_H.svg"]
+
+
+def test_continuation_point_by_point():
+    slip = hc.model("slip")
+    study = hc.run(slip, progress=False, max_branches=4)
+    u0 = study.u(2, 20)
+    run = hc.continuation(slip, u0, max_points=12)
+    points = list(run)
+    assert len(points) == 12 and run.termination == "max-points"
+    assert run.unknowns == slip.unknowns() == study.unknowns
+    for p in points:  # every point is an orbit of the family: r = 0
+        assert np.abs(slip.evaluate(p["u"], jacobian=False)["r"]).max() < 1e-9
+
+
+def test_one_version():
+    rc, out, _ = cli("--version")
+    assert hc.__version__ in out
+    assert hc.run("bouncing-ball", progress=False).summary["version"] == hc.__version__
