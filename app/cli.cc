@@ -12,6 +12,7 @@
 #include "hybridcont/models.h"
 #include "hybridcont/version.h"
 #include "install_paths.h"
+#include "python_command.h"
 
 namespace hybridcont::app {
 
@@ -94,13 +95,19 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
   x_option->needs(y_option);
   y_option->needs(x_option);
 
+  // A study at every point of a parameter grid, on Dask: the Python package's command (python_command.h); its
+  // arguments are its own (`hybridcont sweep --help`).
+  auto* sweep = app.add_subcommand("sweep", "a study at every point of a parameter grid, on Dask (see `hybridcont sweep --help`)");
+  sweep->prefix_command();
+  sweep->set_help_flag();
+
   // A misspelt command would otherwise be reported as "A subcommand is required".
   const auto is_command = [&app](const std::string& word) {
     const auto commands = app.get_subcommands([](const CLI::App*) { return true; });
     return std::any_of(commands.begin(), commands.end(), [&](const CLI::App* c) { return c->check_name(word); });
   };
   if (argc > 1 && argv[1][0] != '-' && !is_command(argv[1])) {
-    err << "error: unknown command '" << Printable(argv[1]) << "' (expected list, check, run or plot)\n"
+    err << "error: unknown command '" << Printable(argv[1]) << "' (expected list, check, run, plot or sweep)\n"
         << "Run with --help for more information.\n";
     return 2;
   }
@@ -133,6 +140,7 @@ int RunCli(int argc, const char* const* argv, std::ostream& out, std::ostream& e
     if (*check) return CheckCommand(check_args, out, err);
     if (*run) return RunCommand(run_args, out, err);
     if (*plot) return PlotCommand(plot_dir, figures, out, err);
+    if (*sweep) return RunPythonModule("hybridcont.sweeps", sweep->remaining(), err);
   } catch (const std::invalid_argument& e) {
     err << "error: " << Printable(e.what()) << "\n";
     return 2;

@@ -9,6 +9,11 @@
 #if !defined(HYBRIDCONT_BIN_TO_DATA) || !defined(HYBRIDCONT_BUILD_BIN_DIR) || !defined(HYBRIDCONT_SOURCE_TREE)
 #error "install_paths.cc needs HYBRIDCONT_BIN_TO_DATA, HYBRIDCONT_BUILD_BIN_DIR and HYBRIDCONT_SOURCE_TREE"
 #endif
+//   HYBRIDCONT_BIN_TO_PYTHON path from the install bin dir to the folder the Python package is installed in
+//                            (empty: the build has no Python package)
+#ifndef HYBRIDCONT_BIN_TO_PYTHON
+#define HYBRIDCONT_BIN_TO_PYTHON ""
+#endif
 
 namespace hybridcont::app {
 
@@ -20,6 +25,7 @@ struct DataLocation {
   fs::path plot_script;
   fs::path models;
   ReportAssets report;
+  fs::path python;  // the folder holding the package hybridcont/
 };
 
 // The rule of install_paths.h; empty paths if the executable's path cannot be read.
@@ -34,12 +40,15 @@ DataLocation Locate() {
     const fs::path viewer = source / "report";
     return {source / "python" / "hybridcont_plot.py", source / "models",
             {viewer / "template.html", viewer / "viewer.js", viewer / "viewer.css",
-             exe_dir / "report" / "plotly-basic.min.js"}};
+             exe_dir / "report" / "plotly-basic.min.js"},
+            exe_dir / "python"};
   }
   const fs::path data = (exe_dir / HYBRIDCONT_BIN_TO_DATA).lexically_normal();
   const fs::path report = data / "report";
+  const std::string to_python = HYBRIDCONT_BIN_TO_PYTHON;
   return {data / "hybridcont_plot.py", data / "models",
-          {report / "template.html", report / "viewer.js", report / "viewer.css", report / "plotly-basic.min.js"}};
+          {report / "template.html", report / "viewer.js", report / "viewer.css", report / "plotly-basic.min.js"},
+          to_python.empty() ? fs::path() : (exe_dir / to_python).lexically_normal()};
 }
 
 fs::path IfExists(const fs::path& path) {
@@ -50,6 +59,11 @@ fs::path IfExists(const fs::path& path) {
 }  // namespace
 
 fs::path PlotScriptPath() { return IfExists(Locate().plot_script); }
+
+fs::path PythonPackageDirectory() {
+  const fs::path folder = Locate().python;
+  return IfExists(folder / "hybridcont" / "__init__.py").empty() ? fs::path() : folder;
+}
 
 ReportAssets ReportAssetsOfTool() { return Locate().report; }
 

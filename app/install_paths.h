@@ -27,6 +27,10 @@ namespace hybridcont::app {
 // or the executable's own path cannot be read.
 std::filesystem::path PlotScriptPath();
 
+// The folder holding the Python package (hybridcont/) by the same rule: in the build tree <build>/python,
+// installed where `cmake --install` put it (Python's dist-packages under the prefix); empty where there is none.
+std::filesystem::path PythonPackageDirectory();
+
 // The folder of model files (models/) the rule above selects; empty if it does not exist or the
 // executable's own path cannot be read.
 std::filesystem::path ModelsDirectory();

@@ -11,7 +11,7 @@ case "${1:-all}" in
   tool) ;;
   # The Python package (built by the full build): pybind11's and Python's headers, what the package imports,
   # and venv/pip for its installation test.
-  all) PACKAGES="$PACKAGES libgtest-dev libbenchmark-dev python3-pytest python3-scipy chromium pybind11-dev python3-dev python3-numpy python3-pandas python3-sympy python3-tomli-w python3-tqdm python3-venv python3-pip" ;;
+  all) PACKAGES="$PACKAGES libgtest-dev libbenchmark-dev python3-pytest python3-scipy chromium pybind11-dev python3-dev python3-numpy python3-pandas python3-sympy python3-tomli-w python3-tqdm python3-venv python3-pip python3-dask python3-distributed" ;;
   *) echo "usage: sh scripts/install-deps.sh [tool|all]" >&2; exit 2 ;;
 esac
 missing=""

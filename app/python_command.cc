@@ -1,0 +1,52 @@
+#include "python_command.h"
+
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+#include "install_paths.h"
+
+extern char** environ;
+
+namespace hybridcont::app {
+
+int RunPythonModule(const std::string& module, const std::vector<std::string>& args, std::ostream& err) {
+  const std::filesystem::path package = PythonPackageDirectory();
+  if (package.empty()) {
+    err << "error: the Python package is not built or installed (the full build makes it: pybind11-dev, "
+           "python3-dev); `hybridcont " << module.substr(module.rfind('.') + 1) << "` needs it\n";
+    return 127;
+  }
+  std::error_code ec;
+  const std::string python = std::filesystem::exists("/usr/bin/python3", ec) ? "/usr/bin/python3" : "python3";
+  // The package first on PYTHONPATH: this tool's own, whatever else the environment holds.
+  std::vector<std::string> environment;
+  const char* old_path = std::getenv("PYTHONPATH");
+  for (char** e = environ; *e != nullptr; ++e) {
+    if (std::strncmp(*e, "PYTHONPATH=", 11) != 0) environment.emplace_back(*e);
+  }
+  environment.push_back("PYTHONPATH=" + package.string() + (old_path && *old_path ? ":" + std::string(old_path) : ""));
+  std::vector<std::string> words = {python, "-m", module};
+  words.insert(words.end(), args.begin(), args.end());
+  std::vector<char*> argv, envp;
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  for (std::string& e : environment) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  pid_t pid = 0;
+  const int spawned = posix_spawnp(&pid, python.c_str(), nullptr, nullptr, argv.data(), envp.data());
+  if (spawned != 0) {
+    err << "error: cannot start " << python << ": " << std::strerror(spawned) << "\n";
+    return 127;
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+}  // namespace hybridcont::app

@@ -1,0 +1,52 @@
+#!/usr/bin/env python3
+"""Sweeps on Dask: the SLIP over 64 grid points with 1 and 2 local workers (speed-up, Dask's overhead per
+task against the work), and the 40 x 40 (k, w2) map of where hopping in place is stable.
+
+    PYTHONPATH=build/python /usr/bin/python3 bench/sweep_bench.py [map]
+"""
+import os
+import sys
+import tempfile
+import time
+
+import hybridcont as hc
+from hybridcont import sweeps
+
+
+def timed(**kwargs):
+    with tempfile.TemporaryDirectory() as work:
+        t = time.perf_counter()
+        table = hc.sweep("slip", out=os.path.join(work, "sweep"), progress=False, **kwargs)
+        return time.perf_counter() - t, table
+
+
+def work_alone(grid, **options):
+    """The studies alone, one after another in this process (what the tasks compute)."""
+    t = time.perf_counter()
+    with tempfile.TemporaryDirectory() as work:
+        for pid, values in sweeps.grid_points(sweeps.grid_values(grid)):
+            opts = dict(options)
+            opts["set"] = dict(values)
+            hc.run("slip", out=os.path.join(work, pid), progress=False, threads=1, **opts)
+    return time.perf_counter() - t
+
+
+def main():
+    grid = {"k": (20, 80, 8), "w2": (3, 7, 8)}
+    alone = work_alone(grid)
+    one, _ = timed(grid=grid, workers=1)
+    two, table = timed(grid=grid, workers=2)
+    print("64 grid points: studies alone %.2f s; Dask 1 worker %.2f s, 2 workers %.2f s (speed-up %.2f)"
+          % (alone, one, two, one / two))
+    print("per task: work %.1f ms, Dask + process start-up %.1f ms (1 worker)" % (1e3 * alone / 64, 1e3 * (one - alone) / 64))
+    if "map" in sys.argv[1:]:
+        grid = {"k": (10, 160, 40), "w2": (2, 10, 40)}
+        options = {"max_branches": 4, "until": {"H": 2.0}}
+        seconds, table = timed(grid=grid, workers=2, **options)
+        hopping = table[table.family == "hopping in place"]
+        print("40 x 40 map (k, w2), hopping in place stable at %d of 1600 points: %.1f s on 2 workers"
+              % (int(hopping.stable.sum()), seconds))
+
+
+if __name__ == "__main__":
+    main()

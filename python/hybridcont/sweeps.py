@@ -1,0 +1,315 @@
+"""Sweeps: a study at every point of a parameter grid, on Dask, that survives a killed worker and resumes.
+
+    import hybridcont as hc
+    table = hc.sweep("slip", grid={"k": (10, 160, 8), "w2": (2, 10, 8)}, out="results/slip-map")
+    table.query("family == 'hopping in place' and stable")     # where hopping in place has a stable range
+
+    hybridcont sweep slip --grid k=10:160:8 --grid w2=2:10:8 --out results/slip-map [--scheduler tcp://...]
+
+Every grid point is one task: the study of the model with the grid's parameters set (every option of
+``hybridcont run`` applies to each), run by a Dask worker on one thread, its results folder saved under
+``<out>/points/<id>/`` and its families summarized as rows of the tidy table ``<out>/table.csv``: one row per
+grid point and family (the grid's parameters by name, the family, whether it exists there, is physical
+somewhere, is stable somewhere, its physical and stable ranges, its located special points).
+
+Where it runs: a local cluster of one single-threaded worker process per core by default; ``scheduler=``
+(``--scheduler tcp://HOST:PORT``) an existing Dask cluster of many machines (a SLURM or PBS user starts one
+with dask-jobqueue and passes its address; the workers need the package and a shared ``out`` folder).
+
+Nothing lost, nothing twice. A task writes its study into a folder of its own and renames it to
+``points/<id>`` when complete (atomic on one file system); a second copy of a task (Dask re-runs the tasks of
+a worker that died) finds the folder there and keeps it. The table is assembled from the folders, so each
+grid point is in it exactly once. ``resume=True`` (``--resume``) skips the grid points whose folder is
+complete and computes the rest; the sweep's definition (``<out>/sweep.json``) must be the same.
+
+Strategy: ``explore`` — every grid point is a whole exploration from the model's start (0.15-0.4 s of one
+core for the SLIP), independent of its neighbours, so the points run in any order on any worker.
+"""
+import argparse
+import itertools
+import json
+import os
+import shutil
+import sys
+import time
+import uuid
+
+import numpy as np
+import pandas as pd
+
+SWEEP_FORMAT = 1
+
+
+def grid_values(spec):
+    """{name: (start, stop, count)} or {name: [values]} as {name: [values]} (linspace for a triple)."""
+    out = {}
+    for name, values in spec.items():
+        if isinstance(values, tuple) and len(values) == 3:
+            start, stop, count = values
+            if int(count) != count or count < 1:
+                raise ValueError("grid %s: the count must be a positive whole number, got %r" % (name, count))
+            out[name] = [float(v) for v in np.linspace(float(start), float(stop), int(count))]
+        else:
+            vals = [float(v) for v in values]
+            if not vals:
+                raise ValueError("grid %s: no values" % name)
+            out[name] = vals
+    if not out:
+        raise ValueError("sweep: the grid has no parameter")
+    return out
+
+
+def grid_points(values):
+    """[(id, {name: value})] in row-major order; id "i_j" holds the indices along each grid parameter."""
+    names = list(values)
+    points = []
+    for index in itertools.product(*(range(len(values[n])) for n in names)):
+        points.append(("_".join(str(i) for i in index), {n: values[n][i] for n, i in zip(names, index)}))
+    return points
+
+
+def family_rows(study, point_id, values):
+    """The tidy rows of one grid point: one per family of its study."""
+    summary = study.summary
+    names = [f for f in (summary.get("presentation") or {}).get("families") or []]
+    special = {sp["id"]: sp for sp in summary.get("special_points") or []}
+    found = {}
+    for b in summary.get("branches") or []:
+        family = b.get("family")
+        if not family:
+            continue
+        if family not in names:
+            names.append(family)
+        row = found.setdefault(family, {"branches": [], "physical": [], "stable": [], "special_points": set()})
+        row["branches"].append(b["id"])
+        for kind in ("physical", "stable"):
+            for r in b.get(kind + "_ranges") or []:
+                row[kind].append((min(r["from"], r["to"]), max(r["from"], r["to"])))
+        for sp in special.values():
+            if sp["branch"] == b["id"] and sp.get("duplicate_of", -1) < 0 and sp["type"] != "start" \
+                    and sp.get("status") == "located":
+                at = sp.get("H")
+                row["special_points"].add("%s%d" % (sp["type"], sp["id"]) + ("@%.10g" % at if at is not None else ""))
+    rows = []
+    for family in names:
+        f = found.get(family)
+        row = dict(values)
+        row.update({"point": point_id, "family": family, "exists": f is not None,
+                    "physical": bool(f and f["physical"]), "stable": bool(f and f["stable"]),
+                    "physical_from": min((a for a, _ in f["physical"]), default=np.nan) if f else np.nan,
+                    "physical_to": max((b for _, b in f["physical"]), default=np.nan) if f else np.nan,
+                    "stable_from": min((a for a, _ in f["stable"]), default=np.nan) if f else np.nan,
+                    "stable_to": max((b for _, b in f["stable"]), default=np.nan) if f else np.nan,
+                    "special_points": ";".join(sorted(f["special_points"])) if f else "",
+                    "status": study.status})
+        rows.append(row)
+    if not rows:  # no family anywhere: the point is still in the table, once
+        row = dict(values)
+        row.update({"point": point_id, "family": "", "exists": False, "physical": False, "stable": False,
+                    "physical_from": np.nan, "physical_to": np.nan, "stable_from": np.nan, "stable_to": np.nan,
+                    "special_points": "", "status": study.status})
+        rows.append(row)
+    return rows
+
+
+def run_grid_point(model, model_text, point_id, values, options, out):
+    """One task: the study at one grid point, saved as <out>/points/<id>; returns the point's id.
+
+    Runs in a worker process: it imports the package there and runs the library on one thread."""
+    import hybridcont as hc
+    final = os.path.join(out, "points", point_id)
+    if os.path.exists(os.path.join(final, "rows.json")):
+        return point_id  # done before (a resumed sweep, or another copy of this task)
+    partial = os.path.join(out, "points", ".partial-%s-%s" % (point_id, uuid.uuid4().hex))
+    m = hc.model(text=model_text) if model_text is not None else model
+    opts = dict(options)
+    opts["set"] = dict(opts.get("set") or {}, **values)
+    opts["threads"] = 1
+    study = hc.run(m, out=partial, progress=False, **opts)
+    with open(os.path.join(partial, "rows.json"), "w") as f:
+        json.dump(family_rows(study, point_id, values), f)
+    try:
+        os.rename(partial, final)  # atomic: the point appears whole, once
+    except OSError:
+        if not os.path.exists(os.path.join(final, "rows.json")):
+            raise
+        shutil.rmtree(partial, ignore_errors=True)  # another copy finished first: keep its folder
+    return point_id
+
+
+def _definition(model, grid, options):
+    return {"format": SWEEP_FORMAT, "model": model, "grid": grid,
+            "options": {k: v for k, v in sorted(options.items())}, "strategy": "explore"}
+
+
+def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrite=False, progress=True,
+          **options):
+    """Runs a study at every point of ``grid`` and returns the tidy table (also ``<out>/table.csv``).
+
+    model: a name, a model file's path, or a Model (sent to the workers as its model text).
+    grid: {parameter: (start, stop, count)} or {parameter: [values]}.
+    scheduler: a Dask scheduler's address (tcp://HOST:PORT); None starts a local cluster of ``workers``
+    single-threaded worker processes (default: one per core).
+    resume: compute only the grid points whose folder is not complete (the same sweep, same options).
+    options: those of ``hybridcont.run`` (set, until, bound, rtol, ...), for every grid point."""
+    from .models import Model
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    values = grid_values(grid)
+    points = grid_points(values)
+    model_text = model.text if isinstance(model, Model) else None
+    if isinstance(model, Model) and model_text is None:
+        model, model_text = model.source, None
+    model_name = model if isinstance(model, str) else (model.name if isinstance(model, Model) else os.fspath(model))
+    out = os.path.abspath(os.fspath(out))
+    definition = _definition(model_name, values, options)
+    definition_file = os.path.join(out, "sweep.json")
+    if os.path.exists(definition_file):
+        with open(definition_file) as f:
+            saved = json.load(f)
+        if resume and saved != json.loads(json.dumps(definition)):
+            raise ValueError("resume '%s': the sweep there has another definition (model, grid or options); "
+                             "resume it with its own" % out)
+        if not resume and not overwrite:
+            raise ValueError("sweep '%s': a sweep is there (resume=True continues it, overwrite=True replaces it)"
+                             % out)
+        if overwrite and not resume:
+            shutil.rmtree(out)
+    elif resume:
+        raise ValueError("resume '%s': no sweep there to resume" % out)
+    os.makedirs(os.path.join(out, "points"), exist_ok=True)
+    with open(definition_file + ".tmp", "w") as f:
+        json.dump(definition, f, indent=1)
+    os.replace(definition_file + ".tmp", definition_file)
+
+    todo = [(pid, v) for pid, v in points if not os.path.exists(os.path.join(out, "points", pid, "rows.json"))]
+    for stale in os.listdir(os.path.join(out, "points")):  # partial folders of an interrupted sweep
+        if stale.startswith(".partial-"):
+            shutil.rmtree(os.path.join(out, "points", stale), ignore_errors=True)
+    say = _progress(progress, len(points), len(points) - len(todo))
+    if todo:
+        cluster = None
+        if scheduler is None:
+            cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                                   dashboard_address=":0")
+        client = Client(scheduler or cluster)
+        try:
+            futures = [client.submit(run_grid_point, model, model_text, pid, v, options, out, key="point-" + pid,
+                                     pure=False)
+                       for pid, v in todo]
+            for future in as_completed(futures):
+                future.result()
+                say()
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    for stale in os.listdir(os.path.join(out, "points")):  # copies of tasks whose worker died
+        if stale.startswith(".partial-"):
+            shutil.rmtree(os.path.join(out, "points", stale), ignore_errors=True)
+    say(done=True)
+    return assemble(out, points)
+
+
+def assemble(out, points=None):
+    """The tidy table of a sweep's folder (every complete grid point, once), written to <out>/table.csv."""
+    if points is None:
+        with open(os.path.join(out, "sweep.json")) as f:
+            points = grid_points(json.load(f)["grid"])
+    rows = []
+    for pid, _ in points:
+        path = os.path.join(out, "points", pid, "rows.json")
+        if os.path.exists(path):
+            with open(path) as f:
+                rows.extend(json.load(f))
+    table = pd.DataFrame(rows)
+    table.to_csv(os.path.join(out, "table.csv.tmp"), index=False)
+    os.replace(os.path.join(out, "table.csv.tmp"), os.path.join(out, "table.csv"))
+    return table
+
+
+def _progress(progress, total, done):
+    """A function to call after each grid point: done/total, rate, time left (tqdm where installed)."""
+    start = time.perf_counter()
+    state = {"done": done, "new": 0}
+    if progress is False or progress is None:
+        return lambda done=False: None
+    try:
+        from tqdm.auto import tqdm
+        bar = tqdm(total=total, initial=done, unit=" points", desc="sweep")
+    except ImportError:
+        bar = None
+
+    def say(done=False):
+        if done:
+            if bar is not None:
+                bar.close()
+            return
+        state["done"] += 1
+        state["new"] += 1
+        if bar is not None:
+            bar.update(1)
+            return
+        elapsed = time.perf_counter() - start
+        rate = state["new"] / elapsed if elapsed > 0 else 0.0
+        left = (total - state["done"]) / rate if rate > 0 else float("nan")
+        print("sweep: %d/%d grid points, %.2f points/s, %.0f s left" % (state["done"], total, rate, left),
+              file=sys.stderr)
+    return say
+
+
+def _parse_grid(text):
+    name, _, spec = text.partition("=")
+    parts = spec.split(":")
+    if not name or len(parts) != 3:
+        raise argparse.ArgumentTypeError("--grid '%s': expected NAME=START:STOP:COUNT" % text)
+    try:
+        return name, (float(parts[0]), float(parts[1]), int(parts[2]))
+    except ValueError:
+        raise argparse.ArgumentTypeError("--grid '%s': START and STOP are numbers, COUNT a whole number" % text)
+
+
+def _parse_pair(text, option):
+    name, _, value = text.partition("=")
+    try:
+        return name, float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%s '%s': expected NAME=VALUE" % (option, text))
+
+
+def main(argv=None):
+    """`hybridcont sweep` (the tool runs this module): the grid, where to run, and the options of `run`."""
+    p = argparse.ArgumentParser(prog="hybridcont sweep", description="A study at every point of a parameter grid.")
+    p.add_argument("model")
+    p.add_argument("--grid", action="append", required=True, type=_parse_grid, help="NAME=START:STOP:COUNT")
+    p.add_argument("--out", help="the sweep's folder (default results/MODEL-sweep)")
+    p.add_argument("--scheduler", help="a Dask scheduler's address, tcp://HOST:PORT (default: a local cluster)")
+    p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    p.add_argument("--resume", action="store_true")
+    p.add_argument("--overwrite", action="store_true")
+    p.add_argument("--quiet", action="store_true")
+    p.add_argument("--set", action="append", default=[], type=lambda t: _parse_pair(t, "--set"))
+    p.add_argument("--until", action="append", default=[], type=lambda t: _parse_pair(t, "--until"))
+    p.add_argument("--rtol", type=float)
+    p.add_argument("--atol", type=float)
+    p.add_argument("--max-branches", type=int)
+    p.add_argument("--formulation", default="time")
+    p.add_argument("--no-symmetry", action="store_true")
+    args = p.parse_args(argv)
+    options = {"set": dict(args.set), "until": dict(args.until), "rtol": args.rtol, "atol": args.atol,
+               "max_branches": args.max_branches, "formulation": args.formulation, "no_symmetry": args.no_symmetry}
+    options = {k: v for k, v in options.items() if v not in (None, {}, False) or k == "formulation"}
+    out = args.out or os.path.join("results", os.path.basename(args.model).replace(".toml", "") + "-sweep")
+    try:
+        table = sweep(args.model, dict(args.grid), out, scheduler=args.scheduler, workers=args.workers,
+                      resume=args.resume, overwrite=args.overwrite, progress=not args.quiet, **options)
+    except ValueError as e:
+        print("error: %s" % e, file=sys.stderr)
+        return 2
+    points = table["point"].nunique() if len(table) else 0
+    print("%d grid points, %d rows: %s" % (points, len(table), os.path.join(os.path.abspath(out), "table.csv")))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,112 @@
+"""Sweeps on a real Dask cluster: a scheduler and two worker processes on 127.0.0.1, one of them killed mid-way
+(every grid point in the table exactly once), and a sweep killed and resumed (its table equal to an
+uninterrupted sweep's)."""
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+import pandas as pd
+import pytest
+
+import hybridcont as hc
+from hybridcont import sweeps
+
+GRID = {"k": (20, 80, 4), "w2": (3, 7, 4)}  # 16 grid points of the SLIP
+OPTIONS = {"until": {"H": 1.7}}
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def start(args):
+    return subprocess.Popen([sys.executable, "-m", *args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            env=dict(os.environ), start_new_session=True)
+
+
+def wait_for_workers(address, n, timeout=60):
+    from dask.distributed import Client
+    with Client(address, timeout=timeout) as client:
+        client.wait_for_workers(n, timeout=timeout)
+
+
+def complete_points(out):
+    folder = os.path.join(out, "points")
+    return [p for p in os.listdir(folder) if not p.startswith(".")] if os.path.isdir(folder) else []
+
+
+def test_a_killed_worker_costs_no_grid_point(tmp_path):
+    port = free_port()
+    address = "tcp://127.0.0.1:%d" % port
+    scheduler = start(["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port),
+                       "--dashboard-address", ":0"])
+    workers = [start(["distributed.cli.dask_worker", address, "--nthreads", "1", "--no-nanny",
+                      "--host", "127.0.0.1", "--dashboard-address", ":0"]) for _ in range(2)]
+    try:
+        wait_for_workers(address, 2)
+        out = str(tmp_path / "map")
+        result = {}
+        runner = threading.Thread(target=lambda: result.update(table=hc.sweep(
+            "slip", GRID, out, scheduler=address, progress=False, **OPTIONS)))
+        runner.start()
+        deadline = time.time() + 120
+        while len(complete_points(out)) < 3 and time.time() < deadline:
+            time.sleep(0.05)
+        assert len(complete_points(out)) < 16, "the sweep ended before a worker could be killed"
+        os.killpg(workers[0].pid, signal.SIGKILL)  # mid-way: its running task is lost with it
+        runner.join(timeout=300)
+        assert not runner.is_alive()
+        table = result["table"]
+        points = table.drop_duplicates(["point", "family"])
+        assert len(points) == len(table)  # no grid point twice
+        assert sorted(table["point"].unique()) == sorted(pid for pid, _ in sweeps.grid_points(sweeps.grid_values(GRID)))
+        assert sorted(complete_points(out)) == sorted(table["point"].unique())
+        assert not [p for p in os.listdir(os.path.join(out, "points")) if p.startswith(".partial")]
+        # The grid's parameters by name; hopping in place exists at every point, stable over a range of H.
+        hopping = table[table.family == "hopping in place"]
+        assert len(hopping) == 16 and hopping.exists.all() and hopping.stable.all()
+        assert set(hopping["k"]) == {20.0, 40.0, 60.0, 80.0}
+        # The same numbers a study at that grid point gives alone.
+        row = hopping[(hopping.k == 40.0) & (hopping.w2 == 3 + 4 / 3)].iloc[0]
+        alone = hc.run("slip", set={"k": 40.0, "w2": 3 + 4 / 3}, progress=False, **OPTIONS)
+        stable = alone.families.query("family == 'hopping in place' and kind == 'stable'")
+        assert row.stable_from == pytest.approx(stable["from"].min(), abs=1e-12)
+    finally:
+        for p in workers + [scheduler]:
+            try:
+                os.killpg(p.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+            p.wait()
+
+
+def test_an_interrupted_sweep_resumes_to_the_table_of_an_uninterrupted_one(tmp_path):
+    whole = hc.sweep("slip", GRID, str(tmp_path / "whole"), workers=2, progress=False, **OPTIONS)
+    out = str(tmp_path / "cut")
+    command = [sys.executable, "-m", "hybridcont.sweeps", "slip", "--grid", "k=20:80:4", "--grid", "w2=3:7:4",
+               "--until", "H=1.7", "--workers", "1", "--quiet", "--out", out]
+    proc = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=dict(os.environ),
+                            start_new_session=True)
+    deadline = time.time() + 120
+    while len(complete_points(out)) < 4 and time.time() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)  # the sweep, its cluster and its workers
+    proc.wait()
+    done = len(complete_points(out))
+    assert 0 < done < 16
+    proc = subprocess.run(command + ["--resume"], capture_output=True, text=True, env=dict(os.environ))
+    assert proc.returncode == 0, proc.stderr
+    resumed = pd.read_csv(os.path.join(out, "table.csv"))
+    expected = pd.read_csv(str(tmp_path / "whole" / "table.csv"))
+    pd.testing.assert_frame_equal(resumed, expected)
+    assert len(whole) == len(expected)
+    # A resume with another grid is refused, naming the folder.
+    proc = subprocess.run(command[:-2] + ["--out", out, "--resume", "--grid", "m=1:2:2"], capture_output=True,
+                          text=True, env=dict(os.environ))
+    assert proc.returncode == 2 and "another definition" in proc.stderr
