@@ -514,6 +514,14 @@ PYBIND11_MODULE(_hybridcont, m) {
         py::arg("on_progress") = py::none(), py::arg("on_point") = py::none(), py::arg("on_note") = py::none(),
         py::arg("report_assets") = py::none());
   m.def("load_study", &LoadStudyFromPython, py::arg("dir"));
+  m.def(
+      "check_options",
+      [](const py::dict& options) {
+        const StudyOptions o = OptionsOf(options);
+        py::gil_scoped_release release;  // builds (compiles) the model
+        return CheckStudyOptions(o);
+      },
+      py::arg("options"), "Validates study options against the model without computing; returns its notes.");
   m.def("report_html", &ReportHtml, py::arg("dir"), py::arg("assets"), py::arg("model") = ModelHandle(),
         py::arg("models_directory") = "");
 

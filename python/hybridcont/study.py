@@ -99,6 +99,15 @@ def _options(model_name, out, set=None, until=None, bound=None, monitor=None, rt
     }
 
 
+def check(model, **options):
+    """Validates ``run``'s options against the model without computing (ValueError as run raises it); returns
+    the notes the study would say."""
+    name = model.name if isinstance(model, Model) else os.fspath(model)
+    if isinstance(model, Model) and model.text is not None:
+        raise ValueError("check: a model built in Python is checked by running it")
+    return list(native.check_options(_options(name, "", **options)))
+
+
 def run(model, out=None, progress=True, **options):
     """Runs a study of ``model`` (a name, a model file's path, or a Model) and returns its Study.
 

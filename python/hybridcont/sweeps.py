@@ -125,9 +125,22 @@ def run_grid_point(model, model_text, point_id, values, options, out):
     opts = dict(options)
     opts["set"] = dict(opts.get("set") or {}, **values)
     opts["threads"] = 1
-    study = hc.run(m, out=partial, progress=False, **opts)
+    try:
+        study = hc.run(m, out=partial, progress=False, **opts)
+        rows = family_rows(study, point_id, values)
+    except ValueError as e:
+        # The options were checked before the sweep began: what fails here is this grid point's (a start guess
+        # that does not converge at its parameters, a value outside a parameter's range): its rows say so.
+        os.makedirs(partial, exist_ok=True)
+        with open(os.path.join(partial, "error.txt"), "w") as f:
+            f.write(str(e) + "\n")
+        row = dict(values)
+        row.update({"point": point_id, "family": "", "exists": False, "physical": False, "stable": False,
+                    "physical_from": np.nan, "physical_to": np.nan, "stable_from": np.nan, "stable_to": np.nan,
+                    "special_points": "", "status": "failed: " + str(e).splitlines()[0][:300]})
+        rows = [row]
     with open(os.path.join(partial, "rows.json"), "w") as f:
-        json.dump(family_rows(study, point_id, values), f)
+        json.dump(rows, f)
     try:
         os.rename(partial, final)  # atomic: the point appears whole, once
     except OSError:
@@ -143,7 +156,7 @@ def _definition(model, grid, options):
 
 
 def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrite=False, progress=True,
-          **options):
+          maps=True, **options):
     """Runs a study at every point of ``grid`` and returns the tidy table (also ``<out>/table.csv``).
 
     model: a name, a model file's path, or a Model (sent to the workers as its model text).
@@ -151,12 +164,24 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     scheduler: a Dask scheduler's address (tcp://HOST:PORT); None starts a local cluster of ``workers``
     single-threaded worker processes (default: one per core).
     resume: compute only the grid points whose folder is not complete (the same sweep, same options).
+    maps: draw ``map-<family>.png`` (plot_maps) when the sweep is complete.
     options: those of ``hybridcont.run`` (set, until, bound, rtol, ...), for every grid point."""
     from .models import Model
     from dask.distributed import Client, LocalCluster, as_completed
 
     values = grid_values(grid)
     points = grid_points(values)
+    # Bad options end the sweep before anything runs (checked at the model's own parameters, the grid's names
+    # against its parameters); what fails later at one grid point is that point's, in its rows.
+    from .models import model as make_model
+    m = model if isinstance(model, Model) else make_model(os.fspath(model))
+    unknown = [n for n in values if n not in m.parameters]
+    if unknown:
+        raise ValueError("grid %s: model '%s' has no parameter '%s' (parameters: %s)"
+                         % (unknown[0], m.name, unknown[0], ", ".join(m.parameters)))
+    if not (isinstance(model, Model) and model.text is not None):
+        from .study import check
+        check(model, **options)
     model_text = model.text if isinstance(model, Model) else None
     if isinstance(model, Model) and model_text is None:
         model, model_text = model.source, None
@@ -208,7 +233,10 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
         if stale.startswith(".partial-"):
             shutil.rmtree(os.path.join(out, "points", stale), ignore_errors=True)
     say(done=True)
-    return assemble(out, points)
+    table = assemble(out, points)
+    if maps:
+        plot_maps(out)
+    return table
 
 
 def assemble(out, points=None):
@@ -226,6 +254,92 @@ def assemble(out, points=None):
     table.to_csv(os.path.join(out, "table.csv.tmp"), index=False)
     os.replace(os.path.join(out, "table.csv.tmp"), os.path.join(out, "table.csv"))
     return table
+
+
+# The classes of a grid point for one family, drawn from light to dark. Absent is said only where the study
+# completed; a study that stopped at its limit (max-branches) may not have reached the family ("not found"),
+# and one whose start did not converge at the grid point's parameters knows nothing of it ("study failed").
+MAP_CLASSES = ["study failed (no start)", "not found (study stopped at its limit)", "absent",
+               "exists, no physical orbit", "physical, not stable", "stable"]
+
+
+def map_classes(table, family):
+    """{point: class index} of one family over the grid (MAP_CLASSES)."""
+    out = {}
+    for r in table.drop_duplicates("point").itertuples():
+        status = str(r.status)
+        out[r.point] = 0 if status.startswith("failed") else 2 if status == "completed" else 1
+    rows = table[(table.family == family) & table.exists.astype(bool)]
+    out.update({r.point: (5 if r.stable else 4 if r.physical else 3) for r in rows.itertuples()})
+    return out
+
+
+def plot_maps(out, formats=("png",)):
+    """The maps of a sweep's folder: per family, where over the grid it exists, is physical and is stable
+    (``map-<family>.png``; a 1-D grid as a strip); returns the paths written."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+    with open(os.path.join(out, "sweep.json")) as f:
+        definition = json.load(f)
+    grid = definition["grid"]
+    names = list(grid)
+    table = pd.read_csv(os.path.join(out, "table.csv"), keep_default_na=False)
+    families = [f for f in dict.fromkeys(table.family) if f]
+    palette = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#56B4E9", "#E69F00", "#000000"]
+    written = []
+    for k, family in enumerate(families):
+        classes = map_classes(table, family)
+        colour = palette[k % len(palette)]
+        shades = ["#f2c4c4", "#f3edc9", "white", "0.85", colour + "55", colour]
+        cmap = ListedColormap(shades)
+        x = grid[names[0]]
+        y = grid[names[1]] if len(names) > 1 else [0.0]
+        z = np.full((len(y), len(x)), np.nan)  # not computed (an unfinished sweep): blank
+        for pid, c in classes.items():
+            idx = [int(i) for i in pid.split("_")]
+            z[idx[1] if len(names) > 1 else 0, idx[0]] = c
+        fig, ax = plt.subplots(figsize=(6.2, 4.6 if len(names) > 1 else 1.8))
+        edges = lambda v: np.concatenate([[v[0] - (v[1] - v[0]) / 2 if len(v) > 1 else v[0] - 0.5],  # noqa: E731
+                                          (np.array(v[1:]) + np.array(v[:-1])) / 2 if len(v) > 1 else [],
+                                          [v[-1] + (v[-1] - v[-2]) / 2 if len(v) > 1 else v[-1] + 0.5]])
+        ax.pcolormesh(edges(x), edges(y), np.ma.masked_invalid(z), cmap=cmap, vmin=-0.5, vmax=5.5)
+        ax.set_xlabel("parameter %s" % names[0])
+        if len(names) > 1:
+            ax.set_ylabel("parameter %s" % names[1])
+        else:
+            ax.set_yticks([])
+        ax.set_title("%s: %s over %s" % (definition["model"], family, " and ".join(names[:2])), fontsize=10)
+        ax.legend(handles=[Patch(facecolor=c, edgecolor="0.6", label=l) for c, l in zip(shades, MAP_CLASSES)],
+                  loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
+        slug = "".join(ch if ch.isalnum() else "-" for ch in family).strip("-")
+        for ext in formats:
+            path = os.path.join(out, "map-%s.%s" % (slug, ext))
+            fig.savefig(path, dpi=160, bbox_inches="tight")
+            written.append(path)
+        plt.close(fig)
+        # Where it is stable somewhere on a 2-D grid: the ends of its stable range in the continued coordinate.
+        rows = table[(table.family == family) & (table.stable.astype(str) == "True")]
+        if len(names) > 1 and len(rows):
+            fig, axes = plt.subplots(1, 2, figsize=(10.5, 4.2), sharey=True)
+            for ax, column, what in zip(axes, ("stable_from", "stable_to"), ("from", "to")):
+                z = np.full((len(y), len(x)), np.nan)
+                for r in rows.itertuples():
+                    i, j = (int(v) for v in r.point.split("_")[:2])
+                    z[j, i] = float(getattr(r, column))
+                mesh = ax.pcolormesh(edges(x), edges(y), np.ma.masked_invalid(z), cmap="viridis")
+                fig.colorbar(mesh, ax=ax, label="stable %s" % what)
+                ax.set_xlabel("parameter %s" % names[0])
+                ax.set_title("%s: stable %s" % (family, what), fontsize=10)
+            axes[0].set_ylabel("parameter %s" % names[1])
+            for ext in formats:
+                path = os.path.join(out, "map-%s-stable-range.%s" % (slug, ext))
+                fig.savefig(path, dpi=160, bbox_inches="tight")
+                written.append(path)
+            plt.close(fig)
+    return written
 
 
 def _progress(progress, total, done):
@@ -288,6 +402,7 @@ def main(argv=None):
     p.add_argument("--resume", action="store_true")
     p.add_argument("--overwrite", action="store_true")
     p.add_argument("--quiet", action="store_true")
+    p.add_argument("--no-maps", action="store_true", help="draw no map figures")
     p.add_argument("--set", action="append", default=[], type=lambda t: _parse_pair(t, "--set"))
     p.add_argument("--until", action="append", default=[], type=lambda t: _parse_pair(t, "--until"))
     p.add_argument("--rtol", type=float)
@@ -302,7 +417,8 @@ def main(argv=None):
     out = args.out or os.path.join("results", os.path.basename(args.model).replace(".toml", "") + "-sweep")
     try:
         table = sweep(args.model, dict(args.grid), out, scheduler=args.scheduler, workers=args.workers,
-                      resume=args.resume, overwrite=args.overwrite, progress=not args.quiet, **options)
+                      resume=args.resume, overwrite=args.overwrite, progress=not args.quiet,
+                      maps=not args.no_maps, **options)
     except ValueError as e:
         print("error: %s" % e, file=sys.stderr)
         return 2
