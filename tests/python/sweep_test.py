@@ -110,3 +110,20 @@ def test_an_interrupted_sweep_resumes_to_the_table_of_an_uninterrupted_one(tmp_p
     proc = subprocess.run(command[:-2] + ["--out", out, "--resume", "--grid", "m=1:2:2"], capture_output=True,
                           text=True, env=dict(os.environ))
     assert proc.returncode == 2 and "another definition" in proc.stderr
+
+
+def test_the_tool_runs_a_sweep_and_refuses_a_bad_grid(tmp_path):
+    tool = os.environ.get("HYBRIDCONT_BIN", "build/hybridcont")
+    out = str(tmp_path / "tool")
+    proc = subprocess.run([tool, "sweep", "slip", "--grid", "k=20:40:2", "--grid", "w2=4:5:2", "--max-branches", "3",
+                           "--workers", "1", "--quiet", "--out", out], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert "4 grid points" in proc.stdout and os.path.exists(os.path.join(out, "map-hopping-in-place.png"))
+    table = pd.read_csv(os.path.join(out, "table.csv"))
+    assert list(table.columns[:4]) == ["k", "w2", "point", "family"] and table["point"].nunique() == 4
+    proc = subprocess.run([tool, "sweep", "slip", "--grid", "kk=1:2:2", "--out", str(tmp_path / "bad")],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2 and "grid kk: model 'slip' has no parameter 'kk'" in proc.stderr
+    assert not os.path.exists(tmp_path / "bad")  # nothing written
+    proc = subprocess.run([tool, "sweep", "slip", "--grid", "k=1:2"], capture_output=True, text=True)
+    assert proc.returncode == 2 and "NAME=START:STOP:COUNT" in proc.stderr
