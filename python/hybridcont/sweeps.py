@@ -22,8 +22,19 @@ a worker that died) finds the folder there and keeps it. The table is assembled 
 grid point is in it exactly once. ``resume=True`` (``--resume``) skips the grid points whose folder is
 complete and computes the rest; the sweep's definition (``<out>/sweep.json``) must be the same.
 
-Strategy: ``explore`` — every grid point is a whole exploration from the model's start (0.15-0.4 s of one
-core for the SLIP), independent of its neighbours, so the points run in any order on any worker.
+Strategies (the table's ``strategy`` column says which one each grid point took):
+  ``explore``    the study from the model's own starts. Every grid point of a model without guess starts
+                 (the built-in models, whose starts are singular points known at any parameters) and the
+                 first grid point of the others. Independent of the neighbours: any order, any worker.
+  ``neighbour``  a model file whose starts are guesses (orbits given by their unknowns) has them replaced by
+                 the orbits its neighbouring grid point's study found nearest to them (same word, same level),
+                 corrected there by Newton: a continuation in the grid's parameters from the neighbour's
+                 orbits. The grid is covered breadth-first from the point nearest the model's own parameters,
+                 each point after its neighbour one step closer (Dask runs a task once its neighbour's is done).
+                 The bipedal model's walking guess, written for k = 25.5, fails at k = 17.9, beta = 0.30; from
+                 its neighbours' orbits it walks there.
+Each grid point is still a whole exploration from its starts; continuing the neighbour's whole diagram (its
+branches, not only its starts) is not done.
 """
 import argparse
 import itertools
@@ -112,22 +123,112 @@ def family_rows(study, point_id, values):
     return rows
 
 
-def run_grid_point(model, model_text, point_id, values, options, out):
-    """One task: the study at one grid point, saved as <out>/points/<id>; returns the point's id.
+# ---- strategies ------------------------------------------------------------------------------------------
+# "explore": the study from the model's own starts. "neighbour": a model file whose starts are guesses (orbits
+# given by their unknowns, corrected by Newton) has them replaced by the orbits a neighbouring grid point's
+# study found nearest to them (same word, same level H): a zeroth-order continuation in the grid's
+# parameters, which keeps the starts converging far from the parameters they were written for. The grid is
+# covered from the point nearest the model's own parameters outwards (each point's neighbour one step
+# closer), so a task waits for its neighbour's; the table's `strategy` column says which one each point took.
 
-    Runs in a worker process: it imports the package there and runs the library on one thread."""
+def model_document(model):
+    """The parsed model file of a model (a path, a shipped model file's name, or a Model built from text), or
+    None (a built-in model)."""
+    import tomllib
+    from . import _paths
+    from .models import Model
+    if isinstance(model, Model):
+        if model.text is not None:
+            return tomllib.loads(model.text)
+        model = model.source
+    if model is None:
+        return None
+    path = os.fspath(model)
+    if not path.endswith(".toml"):
+        shipped = os.path.join(_paths.MODELS, path + ".toml")
+        from . import _hybridcont as native
+        if path in native.builtin_model_names() or not os.path.exists(shipped):
+            return None
+        path = shipped
+    elif not os.path.exists(path):
+        path = os.path.join(_paths.MODELS, os.path.basename(path))
+    with open(path, "rb") as f:
+        return tomllib.load(f)
+
+
+def guess_starts(document):
+    """{index: start} of the model file's starts that are guesses with numeric values."""
+    if not document or "start" not in document:
+        return {}
+    starts = document["start"] if isinstance(document["start"], list) else [document["start"]]
+    return {i: s for i, s in enumerate(starts) if s.get("kind") == "guess" and isinstance(s.get("values"), dict)
+            and all(isinstance(v, (int, float)) for v in s["values"].values())}
+
+
+def with_starts(document, starts):
+    """The model text of `document` with its guess starts' values replaced ({index: values})."""
+    import copy
+    import tomli_w
+    doc = copy.deepcopy(document)
+    listed = doc["start"] if isinstance(doc["start"], list) else [doc["start"]]
+    for i, values in starts.items():
+        listed[int(i)]["values"] = dict(values)
+    return tomli_w.dumps(doc)
+
+
+def orbits_near_starts(study, document, previous):
+    """{index: values} for the next grid points: per guess start, the physical orbit of the study nearest to it
+    (a branch of the start's word whose file has every unknown the start gives, the point nearest its H);
+    `previous` where the study has none (it failed, or lost the family)."""
+    found = dict(previous or {})
+    summary = study.summary
+    main_word = None
+    for b in summary.get("branches") or []:
+        main_word = main_word or b.get("word")
+    points = study.points
+    for i, start in guess_starts(document).items():
+        word = start.get("word") or main_word
+        keys = list(start["values"])
+        ids = [b["id"] for b in summary.get("branches") or [] if b.get("word") == word and b.get("family")]
+        if points.empty or not ids or not set(keys) <= set(points.columns):
+            continue
+        rows = points[points.branch.isin(ids) & (points.physical == 1)]
+        if rows.empty:
+            continue
+        target = start["values"].get("H")
+        row = rows.iloc[(rows["H"] - target).abs().argmin()] if target is not None else rows.iloc[0]
+        values = {k: float(row[k]) for k in keys}
+        if target is not None:
+            values["H"] = float(target)  # the start's own level: the orbit is corrected there
+        found[i] = values
+    return found
+
+
+def run_grid_point(model, model_text, point_id, values, options, out, document=None, parent=None):
+    """One task: the study at one grid point, saved as <out>/points/<id>.
+
+    With a model file's `document` and the `parent` grid point's result, the model's guess starts are the
+    orbits the parent found (strategy "neighbour"). Returns {"id", "starts"}: the orbits near the starts found
+    here, for the next grid points. Runs in a worker process, the library on one thread."""
     import hybridcont as hc
     final = os.path.join(out, "points", point_id)
-    if os.path.exists(os.path.join(final, "rows.json")):
-        return point_id  # done before (a resumed sweep, or another copy of this task)
+    if os.path.exists(os.path.join(final, "rows.json")):  # done before (resumed, or another copy of this task)
+        return {"id": point_id, "starts": _starts_of_folder(final, document, parent)}
     partial = os.path.join(out, "points", ".partial-%s-%s" % (point_id, uuid.uuid4().hex))
+    strategy = "explore"
+    if document is not None and parent is not None and parent.get("starts"):
+        model_text = with_starts(document, parent["starts"])
+        strategy = "neighbour " + parent["id"]
     m = hc.model(text=model_text) if model_text is not None else model
     opts = dict(options)
     opts["set"] = dict(opts.get("set") or {}, **values)
     opts["threads"] = 1
+    starts = dict((parent or {}).get("starts") or {})
     try:
         study = hc.run(m, out=partial, progress=False, **opts)
         rows = family_rows(study, point_id, values)
+        if document is not None:
+            starts = orbits_near_starts(study, document, starts)
     except ValueError as e:
         # The options were checked before the sweep began: what fails here is this grid point's (a start guess
         # that does not converge at its parameters, a value outside a parameter's range): its rows say so.
@@ -139,20 +240,58 @@ def run_grid_point(model, model_text, point_id, values, options, out):
                     "physical_from": np.nan, "physical_to": np.nan, "stable_from": np.nan, "stable_to": np.nan,
                     "special_points": "", "status": "failed: " + str(e).splitlines()[0][:300]})
         rows = [row]
+    for row in rows:
+        row["strategy"] = strategy
     with open(os.path.join(partial, "rows.json"), "w") as f:
         json.dump(rows, f)
+    with open(os.path.join(partial, "starts.json"), "w") as f:
+        json.dump({str(k): v for k, v in starts.items()}, f)
     try:
         os.rename(partial, final)  # atomic: the point appears whole, once
     except OSError:
         if not os.path.exists(os.path.join(final, "rows.json")):
             raise
         shutil.rmtree(partial, ignore_errors=True)  # another copy finished first: keep its folder
-    return point_id
+    return {"id": point_id, "starts": _starts_of_folder(final, document, parent)}
 
 
-def _definition(model, grid, options):
+def _starts_of_folder(folder, document, parent):
+    """The orbits near the starts a finished grid point passes on (its starts.json)."""
+    path = os.path.join(folder, "starts.json")
+    if document is None or not os.path.exists(path):
+        return dict((parent or {}).get("starts") or {})
+    with open(path) as f:
+        return {int(k): v for k, v in json.load(f).items()}
+
+
+def neighbour_tree(values, origin):
+    """{point id: parent id or None}: the grid covered from the point nearest `origin` ({name: value}) outwards
+    in breadth-first order, each point's parent a grid neighbour (one index apart along one parameter)."""
+    names = list(values)
+    shape = [len(values[n]) for n in names]
+
+    def nearest(n):
+        v = values[n]
+        return min(range(len(v)), key=lambda i: abs(v[i] - origin.get(n, v[0])))
+    root = tuple(nearest(n) for n in names)
+    parent = {root: None}
+    queue = [root]
+    for index in queue:
+        for axis in range(len(names)):
+            for step in (-1, 1):
+                j = list(index)
+                j[axis] += step
+                j = tuple(j)
+                if 0 <= j[axis] < shape[axis] and j not in parent:
+                    parent[j] = index
+                    queue.append(j)
+    key = lambda t: "_".join(str(i) for i in t)  # noqa: E731
+    return {key(i): (key(p) if p is not None else None) for i, p in parent.items()}, [key(i) for i in queue]
+
+
+def _definition(model, grid, options, strategy):
     return {"format": SWEEP_FORMAT, "model": model, "grid": grid,
-            "options": {k: v for k, v in sorted(options.items())}, "strategy": "explore"}
+            "options": {k: v for k, v in sorted(options.items())}, "strategy": strategy}
 
 
 def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrite=False, progress=True,
@@ -187,7 +326,11 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
         model, model_text = model.source, None
     model_name = model if isinstance(model, str) else (model.name if isinstance(model, Model) else os.fspath(model))
     out = os.path.abspath(os.fspath(out))
-    definition = _definition(model_name, values, options)
+    document = model_document(model)
+    if not guess_starts(document):
+        document = None  # nothing to carry from a neighbour: every grid point explores from the model's starts
+    strategy = "neighbour" if document is not None else "explore"
+    definition = _definition(model_name, values, options, strategy)
     definition_file = os.path.join(out, "sweep.json")
     if os.path.exists(definition_file):
         with open(definition_file) as f:
@@ -207,7 +350,8 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
         json.dump(definition, f, indent=1)
     os.replace(definition_file + ".tmp", definition_file)
 
-    todo = [(pid, v) for pid, v in points if not os.path.exists(os.path.join(out, "points", pid, "rows.json"))]
+    done = {pid for pid, _ in points if os.path.exists(os.path.join(out, "points", pid, "rows.json"))}
+    todo = [(pid, v) for pid, v in points if pid not in done]
     for stale in os.listdir(os.path.join(out, "points")):  # partial folders of an interrupted sweep
         if stale.startswith(".partial-"):
             shutil.rmtree(os.path.join(out, "points", stale), ignore_errors=True)
@@ -219,9 +363,26 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
                                    dashboard_address=":0")
         client = Client(scheduler or cluster)
         try:
-            futures = [client.submit(run_grid_point, model, model_text, pid, v, options, out, key="point-" + pid,
-                                     pure=False)
-                       for pid, v in todo]
+            futures = []
+            if document is None:
+                futures = [client.submit(run_grid_point, model, model_text, pid, v, options, out, key="point-" + pid,
+                                         pure=False) for pid, v in todo]
+            else:
+                # Breadth-first from the point nearest the model's own parameters: each task gets its neighbour's
+                # result (a future: Dask runs it after that one); finished points pass theirs from their folder.
+                base = m.parameters
+                tree, order = neighbour_tree(values, {n: base.get(n) for n in values})
+                by_id = dict(points)
+                results = {}
+                for pid in order:
+                    parent = results.get(tree[pid]) if tree[pid] is not None else None
+                    if pid in done:
+                        results[pid] = {"id": pid, "starts": _starts_of_folder(os.path.join(out, "points", pid),
+                                                                                document, None)}
+                        continue
+                    results[pid] = client.submit(run_grid_point, model, model_text, pid, by_id[pid], options, out,
+                                                 document, parent, key="point-" + pid, pure=False)
+                    futures.append(results[pid])
             for future in as_completed(futures):
                 future.result()
                 say()
@@ -286,7 +447,7 @@ def plot_maps(out, formats=("png",)):
         definition = json.load(f)
     grid = definition["grid"]
     names = list(grid)
-    table = pd.read_csv(os.path.join(out, "table.csv"), keep_default_na=False)
+    table = pd.read_csv(os.path.join(out, "table.csv"), keep_default_na=False, dtype={"point": str})
     families = [f for f in dict.fromkeys(table.family) if f]
     palette = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#56B4E9", "#E69F00", "#000000"]
     written = []

@@ -127,3 +127,17 @@ def test_the_tool_runs_a_sweep_and_refuses_a_bad_grid(tmp_path):
     assert not os.path.exists(tmp_path / "bad")  # nothing written
     proc = subprocess.run([tool, "sweep", "slip", "--grid", "k=1:2"], capture_output=True, text=True)
     assert proc.returncode == 2 and "NAME=START:STOP:COUNT" in proc.stderr
+
+
+def test_neighbours_orbits_start_a_grid_point_the_models_own_start_cannot(tmp_path):
+    """The bipedal model's walking guess, written for k = 25.5 and beta = 0.367, does not converge at k = 17.857,
+    beta = 0.30; the sweep covers the grid from the point nearest the model's own parameters outwards and
+    starts each point from the orbits its neighbour found: every point walks."""
+    with pytest.raises(ValueError, match="does not converge"):
+        hc.run("bipedal-slip", set={"k": 17.857, "beta": 0.30}, progress=False, max_branches=6)
+    table = hc.sweep("bipedal-slip", {"beta": (0.30, 0.3665, 4)}, str(tmp_path / "walk"), progress=False,
+                     max_branches=6, set={"k": 17.857}, maps=False)
+    walking = table[table.family == "walking"].sort_values("beta")
+    assert list(walking.exists) == [True] * 4
+    assert list(walking.strategy) == ["neighbour 1", "neighbour 2", "neighbour 3", "explore"]
+    assert walking.iloc[0].stable  # walking at beta = 0.30 has a stable stretch
