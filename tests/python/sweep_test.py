@@ -141,3 +141,38 @@ def test_neighbours_orbits_start_a_grid_point_the_models_own_start_cannot(tmp_pa
     assert list(walking.exists) == [True] * 4
     assert list(walking.strategy) == ["neighbour 1", "neighbour 2", "neighbour 3", "explore"]
     assert walking.iloc[0].stable  # walking at beta = 0.30 has a stable stretch
+
+
+def test_the_sweep_report_opens_offline_and_a_click_shows_a_grid_point(tmp_path):
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
+    from browser import CHROMIUM, Browser, wait_for
+    if CHROMIUM is None:
+        pytest.skip("no chromium (sh scripts/install-deps.sh installs it)")
+    out = tmp_path / "small"
+    hc.sweep("slip", {"k": (20, 60, 3), "w2": (3, 6, 3)}, str(out), workers=1, progress=False, max_branches=3,
+             maps=False)
+    page = out / "sweep-report.html"
+    text = page.read_text()
+    assert "<script src" not in text and "http" not in text.split("/*")[0][:2000]
+    browser = Browser(page.as_uri())
+    try:
+        wait_for(browser, "document.readyState === 'complete' && !!document.querySelector('#map .scatterlayer')")
+        assert browser.errors() == []
+        legend = browser.evaluate("[...document.querySelectorAll('#map .legendtext')].map(t => t.textContent)")
+        assert "stable" in legend, legend
+        # A real mouse click on the first grid point's square selects its row of the table.
+        where = browser.evaluate("""(() => {
+            const gd = document.getElementById('map'), pt = gd._fullData[0];
+            const xa = gd._fullLayout.xaxis, ya = gd._fullLayout.yaxis, box = gd.getBoundingClientRect();
+            return [box.left + xa._offset + xa.l2p(pt.x[0]), box.top + ya._offset + ya.l2p(pt.y[0])];
+        })()""")
+        browser.click(*where)
+        wait_for(browser, "document.getElementById('point').innerText.includes('grid point')")
+        shown = browser.evaluate("document.getElementById('point').innerText")
+        assert "hopping in place" in shown and "strategy" in shown, shown
+        browser.evaluate("document.getElementById('colour').value = 'stable_from';"
+                         "document.getElementById('colour').dispatchEvent(new Event('change'))")
+        wait_for(browser, "!!document.querySelector('#map .colorbar')")
+        assert browser.errors() == []
+    finally:
+        browser.close()
