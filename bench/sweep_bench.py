@@ -27,7 +27,7 @@ def work_alone(grid, **options):
         for pid, values in sweeps.grid_points(sweeps.grid_values(grid)):
             opts = dict(options)
             opts["set"] = dict(values)
-            hc.run("slip", out=os.path.join(work, pid), progress=False, threads=1, **opts)
+            hc.run("slip", out=os.path.join(work, pid), progress=False, threads=1, report=False, **opts)
     return time.perf_counter() - t
 
 
@@ -41,7 +41,7 @@ def main():
     print("per task: work %.1f ms, Dask + process start-up %.1f ms (1 worker)" % (1e3 * alone / 64, 1e3 * (one - alone) / 64))
     if "map" in sys.argv[1:]:
         grid = {"k": (10, 160, 40), "w2": (2, 10, 40)}
-        options = {"max_branches": 4, "until": {"H": 2.0}}
+        options = {"max_branches": 3, "until": {"H": 2.0}}
         seconds, table = timed(grid=grid, workers=2, **options)
         hopping = table[table.family == "hopping in place"]
         print("40 x 40 map (k, w2), hopping in place stable at %d of 1600 points: %.1f s on 2 workers"

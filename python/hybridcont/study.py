@@ -108,7 +108,7 @@ def check(model, **options):
     return list(native.check_options(_options(name, "", **options)))
 
 
-def run(model, out=None, progress=True, **options):
+def run(model, out=None, progress=True, report=True, **options):
     """Runs a study of ``model`` (a name, a model file's path, or a Model) and returns its Study.
 
     Keyword arguments are the options of ``hybridcont run``:
@@ -126,6 +126,7 @@ def run(model, out=None, progress=True, **options):
       out="results/slip", overwrite, resume         the results folder (default: a temporary one)
     progress: True shows a bar (tqdm where installed, else lines), False nothing, or a callable
     f(stage, branches, points, message) called as the study goes.
+    report: write report.html into the folder (2 MB: a sweep's grid points do without).
 
     Bad input raises ValueError with the library's message; a numerical failure is the study's status.
     Ctrl-C ends the study after its current step: status "cancelled", the work so far kept (and warned)."""
@@ -142,7 +143,8 @@ def run(model, out=None, progress=True, **options):
     on_progress, close = _progress(progress)
     try:
         # report.html written as the command line writes it, from the study in memory
-        result = native.run_study(opts, native_model, on_progress, None, None, _paths.report_assets())
+        result = native.run_study(opts, native_model, on_progress, None, None,
+                                  _paths.report_assets() if report else None)
     finally:
         close()
     if result["report_error"]:

@@ -226,7 +226,7 @@ def run_grid_point(model, model_text, point_id, values, options, out, document=N
     opts["threads"] = 1
     starts = dict((parent or {}).get("starts") or {})
     try:
-        study = hc.run(m, out=partial, progress=False, **opts)
+        study = hc.run(m, out=partial, progress=False, report=False, **opts)  # the sweep has its own report
         rows = family_rows(study, point_id, values)
         if document is not None:
             starts = orbits_near_starts(study, document, starts)
