@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <utility>
 
 #include "install_paths.h"
 
@@ -29,7 +30,9 @@ int RunPythonModule(const std::string& module, const std::vector<std::string>& a
   for (char** e = environ; *e != nullptr; ++e) {
     if (std::strncmp(*e, "PYTHONPATH=", 11) != 0) environment.emplace_back(*e);
   }
-  environment.push_back("PYTHONPATH=" + package.string() + (old_path && *old_path ? ":" + std::string(old_path) : ""));
+  std::string python_path = "PYTHONPATH=" + package.string();
+  if (old_path != nullptr && *old_path != '\0') python_path.append(":").append(old_path);
+  environment.push_back(std::move(python_path));
   std::vector<std::string> words = {python, "-m", module};
   words.insert(words.end(), args.begin(), args.end());
   std::vector<char*> argv, envp;
@@ -44,7 +47,12 @@ int RunPythonModule(const std::string& module, const std::vector<std::string>& a
     return 127;
   }
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  pid_t waited;
+  while ((waited = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
+  }
+  if (waited < 0) {
+    err << "error: lost the Python process (" << std::strerror(errno) << ")\n";
+    return 1;
   }
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
 }

@@ -16,6 +16,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <mutex>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -30,6 +31,7 @@
 #include "hybridcont/model_file.h"
 #include "hybridcont/models.h"
 #include "hybridcont/orbit_trace.h"
+#include "hybridcont/shooting_layout.h"
 #include "hybridcont/study.h"
 #include "hybridcont/study_answer.h"
 #include "hybridcont/study_report.h"
@@ -45,24 +47,34 @@ namespace {
 std::atomic<bool> interrupted{false};
 extern "C" void OnInterrupt(int) { interrupted = true; }
 
+// Studies may run on several Python threads at once: the handler is installed by the first and the previous
+// one restored by the last (a count under a mutex), and a Ctrl-C stops them all. A SIGINT the process ignores
+// stays ignored.
 class InterruptGuard {
  public:
   InterruptGuard() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (depth_++ > 0) return;
     interrupted = false;
     struct sigaction action {};
     action.sa_handler = OnInterrupt;
     sigemptyset(&action.sa_mask);
-    installed_ = sigaction(SIGINT, &action, &previous_) == 0;
+    struct sigaction current {};
+    installed_ = sigaction(SIGINT, nullptr, &current) == 0 && current.sa_handler != SIG_IGN &&
+                 sigaction(SIGINT, &action, &previous_) == 0;
   }
   ~InterruptGuard() {
-    if (installed_) sigaction(SIGINT, &previous_, nullptr);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (--depth_ == 0 && installed_) sigaction(SIGINT, &previous_, nullptr), installed_ = false;
   }
   InterruptGuard(const InterruptGuard&) = delete;
   InterruptGuard& operator=(const InterruptGuard&) = delete;
 
  private:
-  struct sigaction previous_ {};
-  bool installed_ = false;
+  static inline std::mutex mutex_;
+  static inline int depth_ = 0;
+  static inline struct sigaction previous_ {};
+  static inline bool installed_ = false;
 };
 
 // ---- options: a dict of plain values (the package's keyword arguments, already named as StudyOptions')
@@ -228,6 +240,12 @@ py::dict Floquet(const ModelHandle& model, const std::vector<double>& u, const M
 // One period of the orbit u (model layout, parameters as set on the model): samples t, segment, state.
 py::dict Trace(const ModelHandle& model, const std::vector<double>& u, int samples, std::optional<double> rtol,
                std::optional<double> atol) {
+  const int expected = ShootingLayout(*model).num_unknowns();
+  if (static_cast<int>(u.size()) != expected) {
+    throw std::invalid_argument("u has " + std::to_string(u.size()) + " entries; the orbit's unknowns (the model's own "
+                                "layout, no free parameters) are " + std::to_string(expected));
+  }
+  if (samples < 2) throw std::invalid_argument("samples must be at least 2, got " + std::to_string(samples));
   std::unique_ptr<OrbitTrace> trace;
   {
     py::gil_scoped_release release;
@@ -300,8 +318,9 @@ py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& mod
   // Hooks run on this (the calling) thread while the GIL is released: each takes it to call Python. An
   // exception in a callback ends the study like Ctrl-C and is raised again afterwards.
   std::string callback_error;
+  std::atomic<bool> stop_this{false};  // this call's own stop (a callback that failed), beside Ctrl-C's
   const auto call = [&](const py::object& f, auto&&... args) {
-    if (f.is_none() || interrupted) return;
+    if (f.is_none() || interrupted || stop_this) return;
     py::gil_scoped_acquire acquire;
     try {
       f(std::forward<decltype(args)>(args)...);
@@ -310,7 +329,7 @@ py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& mod
         interrupted = true;
       } else {
         callback_error = e.what();
-        interrupted = true;
+        stop_this = true;
       }
     }
   };
@@ -323,7 +342,7 @@ py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& mod
     };
   }
   if (!on_note.is_none()) hooks.on_note = [&](const std::string& line) { call(on_note, line); };
-  hooks.stop_requested = [] { return interrupted.load(); };
+  hooks.stop_requested = [&stop_this] { return interrupted.load() || stop_this.load(); };
   StudyResult result;
   std::string report_error;
   {

@@ -11,7 +11,7 @@ Names: a Symbol prints as its name; a dynamic symbol q(t) (``sympy.physics.mecha
     >>> import sympy as sp
     >>> x, k = sp.symbols("x k")
     >>> to_text(-k * x**2 / 2 + sp.sin(x))
-    '(((-1/2))*(k)*((x)^(2)) + sin(x))'
+    '((((-1)/2)*k*(x)^(2)) + sin(x))'
 """
 import math
 import re
@@ -49,6 +49,11 @@ def _number(value):
     return text if f >= 0 else "(%s)" % text
 
 
+def _dynamic_symbol(e):
+    """Whether e is q(t): an undefined function of one symbol (sympy.physics.mechanics' dynamicsymbols)."""
+    return isinstance(e, sp.core.function.AppliedUndef) and len(e.args) == 1 and e.args[0].is_Symbol
+
+
 def to_text(expr, velocities=None):
     """The expression in the model-file language.
 
@@ -83,11 +88,14 @@ def _print(e, vel):
     if e.is_Symbol:
         return _name(e.name, "symbol")
     if isinstance(e, sp.Derivative):
-        if len(e.variables) != 1 or not isinstance(e.expr, sp.core.function.AppliedUndef):
-            raise ValueError("only first time derivatives of coordinates are states: %s" % e)
+        if len(e.variables) != 1 or not _dynamic_symbol(e.expr) or e.variables[0] != e.expr.args[0]:
+            raise ValueError("only first time derivatives of coordinates q(t) are states: %s" % e)
         name = e.expr.func.__name__
         return _name(vel.get(name, "d" + name), "velocity")
-    if isinstance(e, sp.core.function.AppliedUndef):  # a dynamic symbol q(t)
+    if isinstance(e, sp.core.function.AppliedUndef):
+        if not _dynamic_symbol(e):
+            raise ValueError("%s: an undefined function of anything but time is no name of the model-file language "
+                             "(give coordinates as symbols or dynamic symbols q(t))" % e)
         return _name(e.func.__name__, "coordinate")
     if e.is_Add:
         return "(" + " + ".join(_print(a, vel) for a in e.args) + ")"

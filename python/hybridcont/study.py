@@ -102,9 +102,9 @@ def _options(model_name, out, set=None, until=None, bound=None, monitor=None, rt
 def check(model, **options):
     """Validates ``run``'s options against the model without computing (ValueError as run raises it); returns
     the notes the study would say."""
-    name = model.name if isinstance(model, Model) else os.fspath(model)
     if isinstance(model, Model) and model.text is not None:
         raise ValueError("check: a model built in Python is checked by running it")
+    name = (model.source or model.name) if isinstance(model, Model) else os.fspath(model)
     return list(native.check_options(_options(name, "", **options)))
 
 
@@ -147,6 +147,9 @@ def run(model, out=None, progress=True, report=True, **options):
                                   _paths.report_assets() if report else None)
     finally:
         close()
+    if result["write_error"]:
+        warnings.warn("the results folder could not be written whole (%s): the study is kept as far as it was "
+                      "written" % result["write_error"], RuntimeWarning, stacklevel=2)
     if result["report_error"]:
         warnings.warn("report.html not written: %s" % result["report_error"], RuntimeWarning, stacklevel=2)
     study = Study(opts["out_dir"], model=model if isinstance(model, Model) else None, result=result)
@@ -198,6 +201,7 @@ class Study:
         self.version = info["version"]
         self._answer = info["answer"]
         self.interrupted = bool(result and result["interrupted"])
+        self.write_error = result["write_error"] if result else ""
         self.wall_seconds = result["wall_seconds"] if result else None
         with open(os.path.join(self.path, "summary.json"), encoding="utf-8") as f:
             self.summary = json.load(f)
@@ -382,6 +386,8 @@ class Study:
         """Copies the results folder to path (refused where a folder is, unless overwrite); returns the saved
         Study."""
         path = os.path.abspath(os.fspath(path))
+        if os.path.realpath(path) == os.path.realpath(self.path):
+            raise ValueError("save '%s': that is the study's own folder" % path)
         if os.path.exists(path):
             if not overwrite:
                 raise ValueError("save '%s': the folder exists (overwrite=True replaces it)" % path)

@@ -227,19 +227,24 @@ def run_grid_point(model, model_text, point_id, values, options, out, document=N
     starts = dict((parent or {}).get("starts") or {})
     try:
         study = hc.run(m, out=partial, progress=False, report=False, **opts)  # the sweep has its own report
+        if study.interrupted or study.status == "cancelled" or study.write_error:
+            # Not this grid point's answer: left unfinished, so that a resume computes it again.
+            raise RuntimeError("grid point %s: the study was %s" % (
+                point_id, "stopped (%s)" % study.status if not study.write_error else "not written: " + study.write_error))
         rows = family_rows(study, point_id, values)
         if document is not None:
             starts = orbits_near_starts(study, document, starts)
     except ValueError as e:
-        # The options were checked before the sweep began: what fails here is this grid point's (a start guess
-        # that does not converge at its parameters, a value outside a parameter's range): its rows say so.
+        # The options were checked before the sweep began: what fails here is this grid point's (a model file's
+        # start guess that does not converge at its parameters, a value outside a parameter's range): its rows
+        # say so. (A start the exploration cannot correct is the study's status start-failed, not an error.)
         os.makedirs(partial, exist_ok=True)
         with open(os.path.join(partial, "error.txt"), "w") as f:
             f.write(str(e) + "\n")
         row = dict(values)
         row.update({"point": point_id, "family": "", "exists": False, "physical": False, "stable": False,
                     "physical_from": np.nan, "physical_to": np.nan, "stable_from": np.nan, "stable_to": np.nan,
-                    "special_points": "", "status": "failed: " + str(e).splitlines()[0][:300]})
+                    "special_points": "", "status": "failed: " + (str(e).splitlines() or ["(no message)"])[0][:300]})
         rows = [row]
     for row in rows:
         row["strategy"] = strategy
@@ -319,15 +324,21 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     if unknown:
         raise ValueError("grid %s: model '%s' has no parameter '%s' (parameters: %s)"
                          % (unknown[0], m.name, unknown[0], ", ".join(m.parameters)))
-    if not (isinstance(model, Model) and model.text is not None):
+    model_text = None
+    if isinstance(model, Model):
+        # Workers get the model as data (its text, or its name or path): a Model object holds the library's
+        # model, which does not travel between processes. Its parameters travel as `set`.
+        options = dict(options, set=dict(m.parameters, **(options.get("set") or {})))
+        model_text = model.text
+        model = None if model_text is not None else model.source
+    if isinstance(model, str) and model.endswith(".toml") and os.path.exists(model):
+        model = os.path.abspath(model)  # the workers may run elsewhere
+    if model_text is None:
         from .study import check
         check(model, **options)
-    model_text = model.text if isinstance(model, Model) else None
-    if isinstance(model, Model) and model_text is None:
-        model, model_text = model.source, None
-    model_name = model if isinstance(model, str) else (model.name if isinstance(model, Model) else os.fspath(model))
+    model_name = m.name if model is None else os.fspath(model)
     out = os.path.abspath(os.fspath(out))
-    document = model_document(model)
+    document = model_document(model) if model_text is None else __import__("tomllib").loads(model_text)
     if not guess_starts(document):
         document = None  # nothing to carry from a neighbour: every grid point explores from the model's starts
     strategy = "neighbour" if document is not None else "explore"
@@ -364,9 +375,13 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
                                    dashboard_address=":0")
         client = Client(scheduler or cluster)
         try:
+            # Task names of this sweep's own (a shared scheduler runs other sweeps: the same name would be
+            # taken for the same task).
+            from dask.base import tokenize
+            prefix = "point-%s-" % tokenize(out, json.dumps(definition, sort_keys=True))[:12]
             futures = []
             if document is None:
-                futures = [client.submit(run_grid_point, model, model_text, pid, v, options, out, key="point-" + pid,
+                futures = [client.submit(run_grid_point, model, model_text, pid, v, options, out, key=prefix + pid,
                                          pure=False) for pid, v in todo]
             else:
                 # Breadth-first from the point nearest the model's own parameters: each task gets its neighbour's
@@ -382,7 +397,7 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
                                                                                 document, None)}
                         continue
                     results[pid] = client.submit(run_grid_point, model, model_text, pid, by_id[pid], options, out,
-                                                 document, parent, key="point-" + pid, pure=False)
+                                                 document, parent, key=prefix + pid, pure=False)
                     futures.append(results[pid])
             for future in as_completed(futures):
                 future.result()
@@ -398,7 +413,11 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     table = assemble(out, points)
     write_report(out)
     if maps:
-        plot_maps(out)
+        try:
+            plot_maps(out)
+        except ImportError as e:  # matplotlib is the figures' (python3-matplotlib), not the sweep's
+            import warnings
+            warnings.warn("maps not drawn: %s" % e, RuntimeWarning, stacklevel=2)
     return table
 
 
@@ -431,7 +450,7 @@ def map_classes(table, family):
     out = {}
     for r in table.drop_duplicates("point").itertuples():
         status = str(r.status)
-        out[r.point] = 0 if status.startswith("failed") else 2 if status == "completed" else 1
+        out[r.point] = 0 if status.startswith("failed") or status == "start-failed" else 2 if status == "completed" else 1
     rows = table[(table.family == family) & table.exists.astype(bool)]
     out.update({r.point: (5 if r.stable else 4 if r.physical else 3) for r in rows.itertuples()})
     return out
@@ -449,6 +468,11 @@ def plot_maps(out, formats=("png",)):
         definition = json.load(f)
     grid = definition["grid"]
     names = list(grid)
+    if len(names) > 2:
+        import warnings
+        warnings.warn("maps are drawn for grids of one or two parameters; this one has %d (table.csv has it all)"
+                      % len(names), RuntimeWarning, stacklevel=2)
+        return []
     table = pd.read_csv(os.path.join(out, "table.csv"), keep_default_na=False, dtype={"point": str})
     families = [f for f in dict.fromkeys(table.family) if f]
     palette = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#56B4E9", "#E69F00", "#000000"]
@@ -628,7 +652,7 @@ def main(argv=None):
     args = p.parse_args(argv)
     options = {"set": dict(args.set), "until": dict(args.until), "rtol": args.rtol, "atol": args.atol,
                "max_branches": args.max_branches, "formulation": args.formulation, "no_symmetry": args.no_symmetry}
-    options = {k: v for k, v in options.items() if v not in (None, {}, False) or k == "formulation"}
+    options = {k: v for k, v in options.items() if not (v is None or v is False or (isinstance(v, dict) and not v))}
     out = args.out or os.path.join("results", os.path.basename(args.model).replace(".toml", "") + "-sweep")
     try:
         table = sweep(args.model, dict(args.grid), out, scheduler=args.scheduler, workers=args.workers,

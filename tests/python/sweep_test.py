@@ -1,6 +1,7 @@
 """Sweeps on a real Dask cluster: a scheduler and two worker processes on 127.0.0.1, one of them killed mid-way
 (every grid point in the table exactly once), and a sweep killed and resumed (its table equal to an
 uninterrupted sweep's)."""
+import json
 import os
 import signal
 import socket
@@ -176,3 +177,17 @@ def test_the_sweep_report_opens_offline_and_a_click_shows_a_grid_point(tmp_path)
         assert browser.errors() == []
     finally:
         browser.close()
+
+
+def test_a_model_written_in_python_is_swept_with_its_parameters(tmp_path):
+    """A Model built with SymPy travels to the workers as its model text (the library's model does not travel
+    between processes), with the parameters set on it."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from package_test import bouncing_ball_in_python
+    ball = bouncing_ball_in_python().build().with_parameters(m=2.0)
+    table = hc.sweep(ball, {"g": [1.0, 4.0]}, str(tmp_path / "ball"), workers=1, progress=False, maps=False)
+    assert list(table.point) == ["0", "1"] and table.exists.all()
+    # H = m g y + m dy^2 / 2: at m = 2 the family's physical range ends where H's bound does, whatever g is
+    assert (table.physical_to == 1.0).all()
+    with open(os.path.join(str(tmp_path / "ball"), "sweep.json")) as f:
+        assert json.load(f)["options"]["set"] == {"g": 1.0, "m": 2.0}
