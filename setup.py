@@ -41,6 +41,9 @@ class CMakeBuild(build_ext):
             subprocess.run(["cmake", "-S", ROOT, "-B", build, *generator, "-DCMAKE_BUILD_TYPE=Release",
                             "-DBUILD_TESTING=OFF", "-DHYBRIDCONT_BUILD_BENCH=OFF",
                             "-DPython_EXECUTABLE=" + sys.executable], check=True)
+        else:  # an existing build tree: for this interpreter (a reconfigure that changes nothing is quick)
+            subprocess.run(["cmake", build, "-DPython_EXECUTABLE=" + sys.executable], check=True,
+                           stdout=subprocess.DEVNULL)
         subprocess.run(["cmake", "--build", build, "--target", "hybridcont_python_package", "--parallel"], check=True)
         self.copy_package(os.path.join(build, "python", "hybridcont"))
 

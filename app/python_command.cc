@@ -13,6 +13,11 @@
 
 extern char** environ;
 
+// Set by CMakeLists.txt for this file alone: the Python the package was built for.
+#ifndef HYBRIDCONT_PYTHON_EXECUTABLE
+#define HYBRIDCONT_PYTHON_EXECUTABLE "python3"
+#endif
+
 namespace hybridcont::app {
 
 int RunPythonModule(const std::string& module, const std::vector<std::string>& args, std::ostream& err) {
@@ -22,8 +27,9 @@ int RunPythonModule(const std::string& module, const std::vector<std::string>& a
            "python3-dev); `hybridcont " << module.substr(module.rfind('.') + 1) << "` needs it\n";
     return 127;
   }
-  std::error_code ec;
-  const std::string python = std::filesystem::exists("/usr/bin/python3", ec) ? "/usr/bin/python3" : "python3";
+  // The interpreter the package was built for (CMake's Python_EXECUTABLE); HYBRIDCONT_PYTHON overrides it.
+  const char* chosen = std::getenv("HYBRIDCONT_PYTHON");
+  const std::string python = chosen != nullptr && *chosen != '\0' ? chosen : HYBRIDCONT_PYTHON_EXECUTABLE;
   // The package first on PYTHONPATH: this tool's own, whatever else the environment holds.
   std::vector<std::string> environment;
   const char* old_path = std::getenv("PYTHONPATH");

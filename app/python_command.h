@@ -1,6 +1,6 @@
 // Commands the tool hands to its Python package: `hybridcont sweep` runs the module hybridcont.sweeps (Dask
-// lives in Python), found by the rule of install_paths.h, in Debian's python3 (which has Dask), as a child
-// process sharing the terminal (its progress, its Ctrl-C).
+// lives in Python), found by the rule of install_paths.h, in the Python the package was built for
+// (HYBRIDCONT_PYTHON overrides it), as a child process sharing the terminal (its progress, its Ctrl-C).
 //   return RunPythonModule("hybridcont.sweeps", {"slip", "--grid", "k=10:160:8"}, err);
 #ifndef HYBRIDCONT_APP_PYTHON_COMMAND_H_
 #define HYBRIDCONT_APP_PYTHON_COMMAND_H_

@@ -4,6 +4,14 @@
 # build (cmake -P) after the extension module is linked into DEST; copies only what changed.
 file(GLOB modules ${SOURCE}/python/hybridcont/*.py)
 file(COPY ${modules} DESTINATION ${DEST})
+# A module removed from the source leaves the package too.
+file(GLOB built ${DEST}/*.py)
+foreach(module ${built})
+  get_filename_component(name ${module} NAME)
+  if(NOT EXISTS ${SOURCE}/python/hybridcont/${name})
+    file(REMOVE ${module})
+  endif()
+endforeach()
 file(COPY ${SOURCE}/models/ DESTINATION ${DEST}/data/models)
 file(COPY ${SOURCE}/python/hybridcont_plot.py DESTINATION ${DEST}/data)
 file(COPY ${SOURCE}/report/template.html ${SOURCE}/report/viewer.js ${SOURCE}/report/viewer.css

@@ -252,6 +252,8 @@ def run_grid_point(model, model_text, point_id, values, options, out, document=N
         json.dump(rows, f)
     with open(os.path.join(partial, "starts.json"), "w") as f:
         json.dump({str(k): v for k, v in starts.items()}, f)
+    if os.path.isdir(final) and not os.path.exists(os.path.join(final, "rows.json")):
+        shutil.rmtree(final, ignore_errors=True)  # a folder without its rows is no finished point
     try:
         os.rename(partial, final)  # atomic: the point appears whole, once
     except OSError:
@@ -364,9 +366,8 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
 
     done = {pid for pid, _ in points if os.path.exists(os.path.join(out, "points", pid, "rows.json"))}
     todo = [(pid, v) for pid, v in points if pid not in done]
-    for stale in os.listdir(os.path.join(out, "points")):  # partial folders of an interrupted sweep
-        if stale.startswith(".partial-"):
-            shutil.rmtree(os.path.join(out, "points", stale), ignore_errors=True)
+    # Partial folders of an interrupted sweep stay until this one ends: a task of it may still run on an
+    # external cluster and write into its own (each task's name is unique), never into this sweep's.
     say = _progress(progress, len(points), len(points) - len(todo))
     if todo:
         cluster = None
