@@ -282,12 +282,8 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     return 1;
   }
   // The model again (compiled code cached) for the orbits' drawings; without it the report has no animations.
-  std::unique_ptr<HybridModel> model;
-  try {
-    model = std::make_unique<HybridModel>(MakeStudyModel(options.model, options.parameters, options.models_directory));
-  } catch (const std::exception&) {
-    model.reset();
-  }
+  const std::unique_ptr<HybridModel> model =
+      MakeStudyModelIfKnown(options.model, options.parameters, options.models_directory);
   const bool report = WriteReport(study, dir, model.get(), err);
   out << fmt::format("results written to {}/ (summary.json, branch-*.csv, orbit-*.csv{})\n", dir,
                      report ? ", report.html: open it in a browser" : "");
@@ -319,12 +315,9 @@ int PlotCommand(const std::string& dir, const FigureOptions& figures, std::ostre
   if (rc == 0) {
     out << "figures written to " << dir << "/\n";
     const StudyResult study = LoadStudy(dir);
-    std::unique_ptr<HybridModel> model;
-    try {  // a built-in model or a shipped model file by its name: the orbits drawn; otherwise none
-      model = std::make_unique<HybridModel>(MakeStudyModel(study.model, study.parameters, ModelsDirectory().string()));
-    } catch (const std::exception&) {
-      model.reset();
-    }
+    // a built-in model or a shipped model file by its name: the orbits drawn; otherwise none
+    const std::unique_ptr<HybridModel> model =
+        MakeStudyModelIfKnown(study.model, study.parameters, ModelsDirectory().string());
     if (WriteReport(study, dir, model.get(), err)) out << "report written to " << dir << "/report.html\n";
   }
   return rc == 0 ? 0 : rc == 2 ? 2 : 1;  // 2: the script found the results malformed (bad input)

@@ -31,6 +31,7 @@
 #include <functional>
 #include <iosfwd>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -286,6 +287,10 @@ struct StudyHooks {
 HybridModel MakeStudyModel(const std::string& model, const std::vector<NamedValue>& parameters = {},
                            const std::string& models_directory = "", std::ostream* log = nullptr,
                            bool compile = true);
+// The same, or null where the library cannot make it (a model the caller built, a file that has gone): for
+// what only draws with the model (a report's animations).
+std::unique_ptr<HybridModel> MakeStudyModelIfKnown(const std::string& model, const std::vector<NamedValue>& parameters,
+                                                   const std::string& models_directory);
 
 // Validates the options (throws StudyOptionError / ModelInputError), prepares out_dir, runs the study.
 StudyResult RunStudy(const StudyOptions& options, const StudyHooks& hooks = {});

@@ -279,22 +279,12 @@ ReportAssets AssetsOf(const py::dict& assets) {
                       assets["viewer_css"].cast<std::string>(), assets["plotly_js"].cast<std::string>()};
 }
 
-// The model of a study the library can make by its name (a built-in model, a shipped model file), whose
-// orbits the report draws; null for another (a model of the caller's, then passed in).
-std::unique_ptr<HybridModel> StudyModelIfKnown(const StudyResult& study, const std::string& models_directory) {
-  try {
-    return std::make_unique<HybridModel>(MakeStudyModel(study.model, study.parameters, models_directory));
-  } catch (const std::exception&) {
-    return nullptr;
-  }
-}
-
 // Writes report.html into the study's folder (as the command line does, atomically); the reason it could not,
 // empty when written.
 std::string WriteReport(const StudyResult& study, const std::string& dir, const ReportAssets& assets,
                         const HybridModel* model, const std::string& models_directory) {
   if (const std::string missing = assets.Missing(); !missing.empty()) return "the report's files are missing: " + missing;
-  const std::unique_ptr<HybridModel> built = model ? nullptr : StudyModelIfKnown(study, models_directory);
+  const std::unique_ptr<HybridModel> built = model ? nullptr : MakeStudyModelIfKnown(study.model, study.parameters, models_directory);
   try {
     const std::filesystem::path path = std::filesystem::path(dir) / "report.html";
     {
@@ -393,7 +383,7 @@ std::string ReportHtml(const std::string& dir, const py::dict& assets, const Mod
   }
   py::gil_scoped_release release;  // reading the folder, building the model (compiled on first use), drawing
   const StudyResult study = LoadStudy(dir);
-  const std::unique_ptr<HybridModel> built = model ? nullptr : StudyModelIfKnown(study, models_directory);
+  const std::unique_ptr<HybridModel> built = model ? nullptr : MakeStudyModelIfKnown(study.model, study.parameters, models_directory);
   return StudyReportHtml(study, a, model ? model.get() : built.get());
 }
 

@@ -173,6 +173,7 @@ void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log,
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.branch < b.branch; });
   std::vector<Vector> drawn;
+  TimeBasedShooting floquet_map(model, setup.integrator, setup.free);  // the orbits' monodromy matrices
   for (const Candidate& c : candidates) {
     if (static_cast<int>(drawn.size()) >= sc.max_keyframe_orbits) break;
     const auto branch = std::find_if(diagram.branches.begin(), diagram.branches.end(),
@@ -186,8 +187,7 @@ void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log,
     HybridModel at_point = model.Clone();
     SetFreeParameters(layout, u, &at_point);
     const OrbitTrace trace(at_point, OrbitPart(layout, u), setup.integrator);
-    TimeBasedShooting map(model, setup.integrator, setup.free);
-    const FloquetResult floquet = ComputeFloquet(map, u);
+    const FloquetResult floquet = ComputeFloquet(floquet_map, u);
     writer.AddOrbit(trace, c.branch, c.point, layout.has_level() ? u(layout.H_index()) : std::nan(""),
                     layout.Period(u), c.family, floquet.ok() ? floquet.monodromy : Matrix());
   }

@@ -67,4 +67,13 @@ HybridModel MakeStudyModel(const std::string& name, const std::vector<NamedValue
   return model;
 }
 
+std::unique_ptr<HybridModel> MakeStudyModelIfKnown(const std::string& model, const std::vector<NamedValue>& parameters,
+                                                   const std::string& models_directory) {
+  try {
+    return std::make_unique<HybridModel>(MakeStudyModel(model, parameters, models_directory));
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
 }  // namespace hybridcont

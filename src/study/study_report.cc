@@ -36,19 +36,20 @@ json RangesJson(const std::vector<Range>& ranges) {
 // row [x0, y0, x1, y1, ...] over the presentation's points per instant. A family continued in a parameter
 // (its last unknown) is drawn on the model at each point's value of it.
 json AnimationJson(const StudyBranch& b, const HybridModel& model, const OrbitPresentation& presentation) {
-  const bool in_parameter = b.continued != "H";
+  // One copy of the model for the branch, its parameter set at each point.
+  const std::unique_ptr<HybridModel> copy = b.continued != "H" ? std::make_unique<HybridModel>(model.Clone()) : nullptr;
   json frames = json::array();
   for (const StudyPoint& p : b.points) {
     if (!p.analysis.classification.physical) {
       frames.push_back(nullptr);
       continue;
     }
-    std::unique_ptr<HybridModel> at_point;
+    const HybridModel* at_point = nullptr;
     Vector state = p.u;
-    if (in_parameter) {
+    if (copy) {
       try {
-        at_point = std::make_unique<HybridModel>(model.Clone());
-        at_point->SetParameter(b.continued, p.u(p.u.size() - 1));
+        copy->SetParameter(b.continued, p.u(p.u.size() - 1));
+        at_point = copy.get();
       } catch (const std::invalid_argument&) {  // a value outside the parameter's range: not drawn
         frames.push_back(nullptr);
         continue;
