@@ -48,6 +48,8 @@ struct RunArguments {
   bool one_word = false;               // an automaton: follow the start's word only (no phase-sequence changes)
   bool period_doubling = false;        // explore the period-doubled family of every located PD point
   bool resume = false;                 // continue the study interrupted in --out
+  std::string families_of;             // a saved study whose families guide this one (StudyOptions::families_of)
+  std::vector<std::string> families;   // only these of its families (StudyOptions::families)
   std::string from;                    // a saved study (results folder) to restart from, at label `at`
   std::string at;                      // "PD4", "SB36", "B5", "B5:12"
   std::string as = "auto";             // what to do there: continue, switch, period-doubled, curve, free

@@ -83,6 +83,13 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
                            "with --from: continue (the family beyond the point), switch (every branch through an SB "
                            "point), period-doubled (the family born at a PD point), curve (the point in (H, --curves)), "
                            "free (the family in --free from the orbit); default: what the label's type implies"));
+  NonEmpty(run->add_option("--families-of", args->families_of,
+                           "a saved study of this model at nearby parameter values (a results folder): trace only "
+                           "the half-branches whose counterparts there led to a family, not the whole exploration "
+                           "(what a sweep does from grid point to grid point)"));
+  NonEmpty(run->add_option("--family", args->families,
+                           "with --families-of: continue only this family of it (its name, as the answer names it; "
+                           "repeat for several)"));
   run->add_flag("--resume", args->resume,
                 "continue the run interrupted in --out (killed, stopped, out of disk): the branches it traced are "
                 "taken as they are, the rest computed; the options must be those of that run");
@@ -151,6 +158,8 @@ StudyOptions StudyOptionsOf(const RunArguments& args) {
     o.fix = NamedValue{name, value};
   }
   o.curves = args.curves;
+  o.families_of = args.families_of;
+  o.families = args.families;
   o.out_dir = args.out_dir;
   o.overwrite = args.overwrite;
   o.resume = args.resume;

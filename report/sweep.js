@@ -1,6 +1,7 @@
 // The report of a hybridcont sweep (sweep-report.html): per family, the grid coloured by where the family
 // exists, is physical and is stable (or by the ends of its ranges), a click on a grid point shows its row of
-// the table. Everything it shows is in the data block of the page (python/hybridcont/sweeps.py, write_report).
+// the table; with curves (a sweep with curves = p), the (p, H) plane along the grid line through the selected
+// point. Everything it shows is in the data block of the page (python/hybridcont/sweeps.py, write_report).
 (function () {
   'use strict';
   const data = JSON.parse(document.getElementById('sweep-data').textContent);
@@ -57,9 +58,52 @@
       yaxis: names.length > 1 ? {title: {text: names[1]}, zeroline: false} : {visible: false},
     }, {responsive: true, displaylogo: false});
   }
+  // The (p, H) plane along the grid line through a grid point (a sweep with curves = p): the selected
+  // family's ranges at each grid point of the line — physical thin and light, stable thick — and the
+  // two-parameter curves of the line's curve point over them.
+  const curves = data.curves || null;
+  const CURVE_DASH = {'period-doubling': 'dash', 'neimark-sacker': 'dashdot', 'branch-point': 'dot', 'fold': 'longdash',
+                      'boundary': 'solid'};
+  let lineOf = null;
+  function drawPlane() {
+    if (!curves || lineOf === null) return;
+    const family = familySelect.value, axis = names.indexOf(curves.parameter);
+    const key = lineOf.split('_').map((v, i) => (i === axis ? '*' : v)).join('_');
+    const line = curves.lines[key];
+    const onLine = data.points.filter((p) => p.id.split('_').map((v, i) => (i === axis ? '*' : v)).join('_') === key);
+    const colour = shades(family)[5], traces = [];
+    for (const [kind, width, opacity] of [['physical', 3, 0.35], ['stable', 9, 1]]) {
+      const x = [], y = [];
+      for (const p of onLine) {
+        const f = p.families[family] || {}, a = f[kind + '_from'], b = f[kind + '_to'];
+        if (typeof a !== 'number' || typeof b !== 'number') continue;
+        x.push(p.values[curves.parameter], p.values[curves.parameter], null);
+        y.push(a, b, null);
+      }
+      traces.push({type: 'scatter', mode: 'lines', name: family + ': ' + kind + ' range', x: x, y: y, opacity: opacity,
+                   line: {color: colour, width: width}, hoverinfo: 'skip'});
+    }
+    for (const c of (line ? line.curves : [])) {
+      traces.push({type: 'scatter', mode: 'lines', name: c.type + ' curve of ' + c.label + (c.family ? ' (' + c.family + ')' : ''),
+                   x: c.p, y: c.H, line: {color: c.family === family ? '#222' : '#999', width: 1.5, dash: CURVE_DASH[c.type] || 'solid'},
+                   hovertemplate: c.label + ': ' + curves.parameter + ' = %{x}, H = %{y}<extra></extra>'});
+    }
+    const others = names.filter((n) => n !== curves.parameter).map((n) => n + ' = ' + fmt(onLine.length ? onLine[0].values[n] : NaN));
+    document.getElementById('plane-title').textContent = family + ' in (' + curves.parameter + ', H)' +
+        (others.length ? ' along ' + others.join(', ') : '') + (line ? ': curves continued from grid point ' + line.point : ': no curves on this line');
+    Plotly.react('plane', traces, {
+      margin: {l: 60, r: 10, t: 10, b: 50}, hovermode: 'closest', legend: {font: {size: 11}},
+      xaxis: {title: {text: 'parameter ' + curves.parameter}, zeroline: false},
+      yaxis: {title: {text: 'energy H'}, zeroline: false},
+    }, {responsive: true, displaylogo: false});
+  }
   function select(id) {
     const p = data.points.find((q) => q.id === id);
     if (!p) return;
+    if (curves) {
+      lineOf = id;
+      drawPlane();
+    }
     const table = document.createElement('table');
     const rows = [['grid point', p.id], ...names.map((n) => [n, fmt(p.values[n])]), ['status', p.status], ['strategy', p.strategy]];
     for (const [family, f] of Object.entries(p.families)) {
@@ -72,9 +116,14 @@
     }
     document.getElementById('point').replaceChildren(table);
   }
-  familySelect.addEventListener('change', draw);
+  familySelect.addEventListener('change', () => { draw(); drawPlane(); });
   colourSelect.addEventListener('change', draw);
   window.addEventListener('resize', draw);
   draw();
+  if (curves) {  // the line through the first curve point, until a click selects another
+    const first = Object.values(curves.lines)[0];
+    lineOf = first ? first.point : (data.points[0] || {}).id || null;
+    drawPlane();
+  }
   document.getElementById('map').on('plotly_click', (e) => { if (e.points && e.points[0]) select(e.points[0].customdata); });
 })();

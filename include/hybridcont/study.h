@@ -103,6 +103,15 @@ struct StudyOptions {
   std::optional<NamedValue> fix;       // the unknown held fixed while `free` varies (H=1.5, t2=0, speed=1)
   std::string curves;                  // a parameter: special points continued in (H, it) after the run
   std::optional<RestartSpec> restart;  // begin at a labelled point of a saved study instead of the model's start
+  // A saved study of the same model at nearby parameter values (a sweep's neighbouring grid point): trace only
+  // the half-branches whose counterpart there led to a family; the others, which found no physical orbit
+  // there, are not traced (src/study/family_guide.h says how counterparts are matched). The saved study's
+  // families are continued to these parameter values without repeating its whole exploration. Empty: the
+  // whole exploration. summary.json's "guided" says what was pruned.
+  std::string families_of;
+  // With families_of: only the half-branches that led to these of its families (by name, as its branches are
+  // named) are traced. Empty: every family.
+  std::vector<std::string> families;
   // The results folder (docs/results-format.md), written as the study grows; empty: nothing is written.
   std::string out_dir;
   bool overwrite = false;  // replace another model's results in out_dir (refused otherwise)

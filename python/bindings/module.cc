@@ -31,6 +31,7 @@
 #include "hybridcont/model_file.h"
 #include "hybridcont/models.h"
 #include "hybridcont/orbit_trace.h"
+#include "hybridcont/setup_evaluation.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/study.h"
 #include "hybridcont/study_answer.h"
@@ -123,6 +124,8 @@ StudyOptions OptionsOf(const py::dict& d) {
     o.fix = NamedValue{fix.first, fix.second};
   }
   o.curves = Get<std::string>(d, "curves", "");
+  o.families_of = Get<std::string>(d, "families_of", "");
+  if (d.contains("families") && !d["families"].is_none()) o.families = d["families"].cast<std::vector<std::string>>();
   if (d.contains("restart") && !d["restart"].is_none()) {
     const auto r = d["restart"].cast<std::tuple<std::string, std::string, std::string>>();
     RestartSpec spec{std::get<0>(r), std::get<1>(r), RestartSpec::Kind::kAuto};
@@ -485,6 +488,8 @@ PYBIND11_MODULE(_hybridcont, m) {
                                }
                                return out;
                              })
+      .def_property_readonly("family_names",
+                             [](const HybridModel& model) { return OrbitPresentation(model).family_names(); })
       .def("set_parameter", &HybridModel::SetParameter, py::arg("name"), py::arg("value"))
       .def("clone", [](const HybridModel& model) { return Share(model.Clone()); })
       .def("unknowns",

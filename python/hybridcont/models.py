@@ -84,6 +84,11 @@ class Model:
         """[(phase name, [state names])] in the cycle's order."""
         return [(name, list(states)) for name, states in self._native.phases]
 
+    @property
+    def families(self):
+        """The names the model's family rules give its families ([[families]] of a model file), in order."""
+        return list(self._native.family_names)
+
     def set_parameter(self, name, value):
         """Sets a parameter (ValueError for an unknown name or a value outside its range)."""
         self._native.set_parameter(name, float(value))

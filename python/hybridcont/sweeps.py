@@ -23,18 +23,22 @@ grid point is in it exactly once. ``resume=True`` (``--resume``) skips the grid 
 complete and computes the rest; the sweep's definition (``<out>/sweep.json``) must be the same.
 
 Strategies (the table's ``strategy`` column says which one each grid point took):
-  ``explore``    the study from the model's own starts. Every grid point of a model without guess starts
-                 (the built-in models, whose starts are singular points known at any parameters) and the
-                 first grid point of the others. Independent of the neighbours: any order, any worker.
-  ``neighbour``  a model file whose starts are guesses (orbits given by their unknowns) has them replaced by
-                 the orbits its neighbouring grid point's study found nearest to them (same word, same level),
-                 corrected there by Newton: a continuation in the grid's parameters from the neighbour's
-                 orbits. The grid is covered breadth-first from the point nearest the model's own parameters,
-                 each point after its neighbour one step closer (Dask runs a task once its neighbour's is done).
-                 The bipedal model's walking guess, written for k = 25.5, fails at k = 17.9, beta = 0.30; from
-                 its neighbours' orbits it walks there.
-Each grid point is still a whole exploration from its starts; continuing the neighbour's whole diagram (its
-branches, not only its starts) is not done.
+  ``continue``   (the default) the grid is covered breadth-first from the point nearest the model's own
+                 parameters, each point after a neighbour one step closer (Dask runs a task once its
+                 neighbour's is done), whose families it continues: its study traces only the half-branches
+                 whose counterparts at the neighbour led to a family (``families_of``, src/study/family_guide.h),
+                 not the branches that found no physical orbit there. The SLIP's exploration is 23 half-branches,
+                 its families' 5. Where a family of the neighbour is not found, the grid point is explored whole
+                 instead ("explore (a family of 3_4 not continued)"): the family may have ended there, or its
+                 branch may leave another switch point than the guide's. The first grid point is explored whole.
+  ``explore``    every grid point explored whole from the model's starts, independently of the others (any
+                 order, any worker).
+A model file whose starts are guesses (orbits given by their unknowns) has them replaced, in either strategy, by
+the orbits its neighbour's study found nearest to them (same word, same level H), corrected there by Newton: a
+continuation of the starts in the grid's parameters. The bipedal model's walking guess, written for k = 25.5,
+fails at k = 17.9, beta = 0.30; from its neighbours' orbits it walks there.
+What ``continue`` cannot see: a family born on a branch that had no physical orbit at the neighbour and has
+some at this grid point (the guide left that branch out); ``strategy="explore"`` traces everything.
 """
 import argparse
 import itertools
@@ -80,8 +84,8 @@ def grid_points(values):
     return points
 
 
-def family_rows(study, point_id, values):
-    """The tidy rows of one grid point: one per family of its study."""
+def family_rows(study, point_id, values, families=None):
+    """The tidy rows of one grid point: one per family of its study (of `families` only, when given)."""
     summary = study.summary
     names = [f for f in (summary.get("presentation") or {}).get("families") or []]
     special = {sp["id"]: sp for sp in summary.get("special_points") or []}
@@ -102,6 +106,8 @@ def family_rows(study, point_id, values):
                     and sp.get("status") == "located":
                 at = sp.get("H")
                 row["special_points"].add("%s%d" % (sp["type"], sp["id"]) + ("@%.10g" % at if at is not None else ""))
+    if families:
+        names = [f for f in families]
     rows = []
     for family in names:
         f = found.get(family)
@@ -124,13 +130,11 @@ def family_rows(study, point_id, values):
     return rows
 
 
-# ---- strategies ------------------------------------------------------------------------------------------
-# "explore": the study from the model's own starts. "neighbour": a model file whose starts are guesses (orbits
-# given by their unknowns, corrected by Newton) has them replaced by the orbits a neighbouring grid point's
-# study found nearest to them (same word, same level H): a zeroth-order continuation in the grid's
-# parameters, which keeps the starts converging far from the parameters they were written for. The grid is
-# covered from the point nearest the model's own parameters outwards (each point's neighbour one step
-# closer), so a task waits for its neighbour's; the table's `strategy` column says which one each point took.
+# ---- strategies (the module's docstring) -------------------------------------------------------------------
+# A model file's guess starts are replaced by the orbits a neighbouring grid point's study found nearest to
+# them (same word, same level H): a zeroth-order continuation in the grid's parameters, which keeps the starts
+# converging far from the parameters they were written for. "continue" also traces only the half-branches that
+# led to the neighbour's families (StudyOptions::families_of).
 
 def model_document(model):
     """The parsed model file of a model (a path, a shipped model file's name, or a Model built from text), or
@@ -205,33 +209,41 @@ def orbits_near_starts(study, document, previous):
     return found
 
 
-def run_grid_point(model, model_text, point_id, values, options, out, document=None, parent=None):
-    """One task: the study at one grid point, saved as <out>/points/<id>.
+def _failed_rows(point_id, values, message):
+    row = dict(values)
+    row.update({"point": point_id, "family": "", "exists": False, "physical": False, "stable": False,
+                "physical_from": np.nan, "physical_to": np.nan, "stable_from": np.nan, "stable_to": np.nan,
+                "special_points": "", "status": "failed: " + (message.splitlines() or ["(no message)"])[0][:300]})
+    return [row]
 
-    With a model file's `document` and the `parent` grid point's result, the model's guess starts are the
-    orbits the parent found (strategy "neighbour"). Returns {"id", "starts"}: the orbits near the starts found
-    here, for the next grid points. Runs in a worker process, the library on one thread."""
+
+def families_of_rows(rows):
+    """The families a grid point's study found (sorted), or None where it has no study (it failed)."""
+    if any(str(r["status"]).startswith("failed") for r in rows):
+        return None
+    return sorted({r["family"] for r in rows if r["exists"] and r["family"]})
+
+
+def _study_at(m, point_id, values, options, out, document, starts, families_of, extra=None, families=None):
+    """One study at a grid point into a new partial folder: (folder, rows, starts passed on, families)."""
     import hybridcont as hc
-    final = os.path.join(out, "points", point_id)
-    if os.path.exists(os.path.join(final, "rows.json")):  # done before (resumed, or another copy of this task)
-        return {"id": point_id, "starts": _starts_of_folder(final, document, parent)}
     partial = os.path.join(out, "points", ".partial-%s-%s" % (point_id, uuid.uuid4().hex))
-    strategy = "explore"
-    if document is not None and parent is not None and parent.get("starts"):
-        model_text = with_starts(document, parent["starts"])
-        strategy = "neighbour " + parent["id"]
-    m = hc.model(text=model_text) if model_text is not None else model
     opts = dict(options)
     opts["set"] = dict(opts.get("set") or {}, **values)
     opts["threads"] = 1
-    starts = dict((parent or {}).get("starts") or {})
+    for key, value in (extra or {}).items():  # the line's curves (sweep's `curves`) and their bound
+        opts[key] = dict(opts.get(key) or {}, **value) if isinstance(value, dict) else value
+    if families_of is not None:
+        opts["families_of"] = families_of
+        if families:
+            opts["families"] = list(families)
     try:
         study = hc.run(m, out=partial, progress=False, report=False, **opts)  # the sweep has its own report
         if study.interrupted or study.status == "cancelled" or study.write_error:
             # Not this grid point's answer: left unfinished, so that a resume computes it again.
             raise RuntimeError("grid point %s: the study was %s" % (
                 point_id, "stopped (%s)" % study.status if not study.write_error else "not written: " + study.write_error))
-        rows = family_rows(study, point_id, values)
+        rows = family_rows(study, point_id, values, families)
         if document is not None:
             starts = orbits_near_starts(study, document, starts)
     except ValueError as e:
@@ -241,17 +253,53 @@ def run_grid_point(model, model_text, point_id, values, options, out, document=N
         os.makedirs(partial, exist_ok=True)
         with open(os.path.join(partial, "error.txt"), "w") as f:
             f.write(str(e) + "\n")
-        row = dict(values)
-        row.update({"point": point_id, "family": "", "exists": False, "physical": False, "stable": False,
-                    "physical_from": np.nan, "physical_to": np.nan, "stable_from": np.nan, "stable_to": np.nan,
-                    "special_points": "", "status": "failed: " + (str(e).splitlines() or ["(no message)"])[0][:300]})
-        rows = [row]
+        rows = _failed_rows(point_id, values, str(e))
+    return partial, rows, starts
+
+
+def run_grid_point(model, model_text, point_id, values, options, out, document=None, parent=None, guided=False,
+                   extra=None, families=None):
+    """One task: the study at one grid point, saved as <out>/points/<id>.
+
+    parent: the result of the neighbouring grid point this one continues from ({"id", "starts", "families"}),
+    or None. With `guided`, the study traces only the half-branches that led to its families there
+    (StudyOptions::families_of: strategy "continue"); where a family of the neighbour is not found, the point
+    is explored whole instead (the family may have ended, or its branch left another switch point). With a model
+    file's `document`, its guess starts are the orbits the neighbour found. Returns {"id", "starts",
+    "families"} for the next grid points. extra: options of this grid point's own (the curves of its line).
+    families: the families to continue and tabulate (names; None: all).
+    Runs in a worker process, the library on one thread."""
+    import hybridcont as hc
+    final = os.path.join(out, "points", point_id)
+    if os.path.exists(os.path.join(final, "rows.json")):  # done before (resumed, or another copy of this task)
+        return passed_on(final, document, parent)
+    starts = dict((parent or {}).get("starts") or {})
+    if document is not None and starts:
+        model_text = with_starts(document, starts)
+    m = hc.model(text=model_text) if model_text is not None else model
+    from_orbits = " from %s's orbits" % parent["id"] if document is not None and starts else ""
+    partial = None
+    if guided and parent is not None and parent.get("families"):
+        partial, rows, found = _study_at(m, point_id, values, options, out, document, starts,
+                                         os.path.join(out, "points", parent["id"]), extra, families)
+        strategy = "continue from %s" % parent["id"]
+        here = families_of_rows(rows)
+        if here is not None and not set(parent["families"]) <= set(here):
+            # A family of the neighbour not found: it may have ended here, or its branch may now leave another
+            # switch point than the guide's. The whole exploration says which.
+            shutil.rmtree(partial, ignore_errors=True)
+            partial = None
+            strategy = "explore%s (a family of %s not continued)" % (from_orbits, parent["id"])
+    else:
+        strategy = "explore" + from_orbits
+    if partial is None:
+        partial, rows, found = _study_at(m, point_id, values, options, out, document, starts, None, extra, families)
     for row in rows:
         row["strategy"] = strategy
     with open(os.path.join(partial, "rows.json"), "w") as f:
         json.dump(rows, f)
     with open(os.path.join(partial, "starts.json"), "w") as f:
-        json.dump({str(k): v for k, v in starts.items()}, f)
+        json.dump({str(k): v for k, v in found.items()}, f)
     if os.path.isdir(final) and not os.path.exists(os.path.join(final, "rows.json")):
         shutil.rmtree(final, ignore_errors=True)  # a folder without its rows is no finished point
     try:
@@ -260,7 +308,15 @@ def run_grid_point(model, model_text, point_id, values, options, out, document=N
         if not os.path.exists(os.path.join(final, "rows.json")):
             raise
         shutil.rmtree(partial, ignore_errors=True)  # another copy finished first: keep its folder
-    return {"id": point_id, "starts": _starts_of_folder(final, document, parent)}
+    return passed_on(final, document, parent)
+
+
+def passed_on(folder, document, parent):
+    """What a finished grid point passes on to its neighbours: {"id", "starts", "families"}."""
+    with open(os.path.join(folder, "rows.json")) as f:
+        families = families_of_rows(json.load(f))
+    return {"id": os.path.basename(folder), "starts": _starts_of_folder(folder, document, parent),
+            "families": families}
 
 
 def _starts_of_folder(folder, document, parent):
@@ -297,13 +353,65 @@ def neighbour_tree(values, origin):
     return {key(i): (key(p) if p is not None else None) for i, p in parent.items()}, [key(i) for i in queue]
 
 
+def curve_points(values, parameter, own):
+    """{point id: extra options}: on each line of the grid along `parameter`, the grid point nearest the model's
+    own value (`own`) runs the curves in (H, parameter), bounded to the grid's range of it."""
+    names = list(values)
+    axis = names.index(parameter)
+    v = values[parameter]
+    at = min(range(len(v)), key=lambda i: abs(v[i] - (own if own is not None else v[0])))
+    extra = {"curves": parameter, "bound": {parameter: (min(v), max(v))}}
+    return {pid: extra for pid, _ in grid_points(values) if int(pid.split("_")[axis]) == at}
+
+
+def curve_lines(out):
+    """The two-parameter curves of a sweep run with ``curves=p``: {line: {"point", "curves"}}, a line named by
+    its grid point ids' indices with p's replaced by "*" ("*_3"), each curve {"id", "type", "label", "family",
+    "p", "H"} (the special point it continues, its family, and its points in (p, H))."""
+    with open(os.path.join(out, "sweep.json")) as f:
+        definition = json.load(f)
+    parameter = definition.get("curves")
+    if not parameter:
+        return {}
+    axis = list(definition["grid"]).index(parameter)
+    lines = {}
+    for pid in sorted(os.listdir(os.path.join(out, "points"))):
+        folder = os.path.join(out, "points", pid)
+        summary_path = os.path.join(folder, "summary.json")
+        if pid.startswith(".") or not os.path.exists(summary_path):
+            continue
+        with open(summary_path) as f:
+            summary = json.load(f)
+        if not summary.get("curves"):
+            continue
+        special = {sp["id"]: sp for sp in summary.get("special_points") or []}
+        families = {b["id"]: b.get("family") or "" for b in summary.get("branches") or []}
+        drawn = []
+        for c in summary["curves"]:
+            path = os.path.join(folder, c.get("file", ""))
+            if c.get("status") != "traced" or not os.path.exists(path):
+                continue
+            frame = pd.read_csv(path)
+            if parameter not in frame.columns or "H" not in frame.columns:
+                continue
+            sp = special.get(c.get("special_point"), {})
+            drawn.append({"id": c["id"], "type": c.get("type", ""),
+                          "label": "%s%d" % (sp["type"], sp["id"]) if sp else c.get("name", ""),
+                          "family": families.get(sp.get("branch"), "") if sp else "",
+                          "p": [float(x) for x in frame[parameter]], "H": [float(x) for x in frame["H"]]})
+        index = pid.split("_")
+        index[axis] = "*"
+        lines["_".join(index)] = {"point": pid, "curves": drawn}
+    return lines
+
+
 def _definition(model, grid, options, strategy):
     return {"format": SWEEP_FORMAT, "model": model, "grid": grid,
             "options": {k: v for k, v in sorted(options.items())}, "strategy": strategy}
 
 
 def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrite=False, progress=True,
-          maps=True, **options):
+          maps=True, strategy="continue", curves=None, families=None, **options):
     """Runs a study at every point of ``grid`` and returns the tidy table (also ``<out>/table.csv``).
 
     model: a name, a model file's path, or a Model (sent to the workers as its model text).
@@ -312,9 +420,22 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     single-threaded worker processes (default: one per core).
     resume: compute only the grid points whose folder is not complete (the same sweep, same options).
     maps: draw ``map-<family>.png`` (plot_maps) when the sweep is complete.
+    strategy: "continue" (each grid point continues its neighbour's families, explored whole where they
+    change) or "explore" (every grid point explored whole from the model's starts, independently).
+    curves: a grid parameter p: on every line of the grid along p, one grid point (the one nearest the model's
+    own p) continues its families' special points in (H, p) over the grid's range of p (``run``'s curves), and
+    the report draws them over the families' ranges along the line (``curve_lines``).
+    families: the families to map (names, e.g. ["hopping in place"]): the table has their rows only, and with
+    "continue" each grid point traces only the half-branches that led to them (the first is explored whole).
     options: those of ``hybridcont.run`` (set, until, bound, rtol, ...), for every grid point."""
     from .models import Model
     from dask.distributed import Client, LocalCluster, as_completed
+
+    if scheduler is None and sys._getframe(1).f_globals.get("__name__") == "__mp_main__":
+        # A local cluster's worker process starts by importing the main script: a sweep at the script's top
+        # level would start a cluster in every worker, which then never starts.
+        raise RuntimeError("hybridcont.sweep: called while a worker process imports the script that sweeps; "
+                           "call it under `if __name__ == \"__main__\":` (as every local Dask cluster needs)")
 
     values = grid_values(grid)
     points = grid_points(values)
@@ -343,13 +464,31 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     document = model_document(model) if model_text is None else __import__("tomllib").loads(model_text)
     if not guess_starts(document):
         document = None  # nothing to carry from a neighbour: every grid point explores from the model's starts
-    strategy = "neighbour" if document is not None else "explore"
-    definition = _definition(model_name, values, options, strategy)
+    families = [families] if isinstance(families, str) else list(families) if families else None
+    for i, name in enumerate(families or []):
+        # A family is named by the model's rules, or (an automaton's family of another word) by its word.
+        if name not in m.families and " > " not in name:
+            raise ValueError("families[%d] '%s': not a family of model '%s' (families: %s; an automaton's family of "
+                             "another word is named by its word, 'stance > flight > ...')"
+                             % (i, name, m.name, ", ".join(m.families) or "none named"))
+    if curves is not None and curves not in values:
+        raise ValueError("curves '%s': not a parameter of the grid (%s)" % (curves, ", ".join(values)))
+    if strategy not in ("continue", "explore"):
+        raise ValueError("sweep: strategy '%s': expected 'continue' or 'explore'" % strategy)
+    guided = strategy == "continue"
+    definition = _definition(model_name, values, options, strategy + (" (starts from the neighbours' orbits)"
+                                                                       if document is not None else ""))
+    if curves is not None:
+        definition["curves"] = curves
+    if families:
+        definition["families"] = families
     definition_file = os.path.join(out, "sweep.json")
     if os.path.exists(definition_file):
         with open(definition_file) as f:
             saved = json.load(f)
-        if resume and saved != json.loads(json.dumps(definition)):
+        same = {k: v for k, v in saved.items() if k != "strategy"} == \
+            {k: v for k, v in json.loads(json.dumps(definition)).items() if k != "strategy"}
+        if resume and not same:
             raise ValueError("resume '%s': the sweep there has another definition (model, grid or options); "
                              "resume it with its own" % out)
         if not resume and not overwrite:
@@ -369,6 +508,11 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     # Partial folders of an interrupted sweep stay until this one ends: a task of it may still run on an
     # external cluster and write into its own (each task's name is unique), never into this sweep's.
     say = _progress(progress, len(points), len(points) - len(todo))
+    # The order of the tasks: a tree over the grid from the point nearest the model's own parameters, each point
+    # after the neighbour it continues from; none (any order) where nothing passes between grid points.
+    tree_order = neighbour_tree(values, {n: m.parameters.get(n) for n in values}) \
+        if guided or document is not None else None
+    extras = curve_points(values, curves, m.parameters.get(curves)) if curves is not None else {}
     if todo:
         cluster = None
         if scheduler is None:
@@ -381,24 +525,23 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
             from dask.base import tokenize
             prefix = "point-%s-" % tokenize(out, json.dumps(definition, sort_keys=True))[:12]
             futures = []
-            if document is None:
-                futures = [client.submit(run_grid_point, model, model_text, pid, v, options, out, key=prefix + pid,
-                                         pure=False) for pid, v in todo]
+            if not tree_order:
+                futures = [client.submit(run_grid_point, model, model_text, pid, v, options, out, None, None, False,
+                                         extras.get(pid), families, key=prefix + pid, pure=False) for pid, v in todo]
             else:
                 # Breadth-first from the point nearest the model's own parameters: each task gets its neighbour's
                 # result (a future: Dask runs it after that one); finished points pass theirs from their folder.
-                base = m.parameters
-                tree, order = neighbour_tree(values, {n: base.get(n) for n in values})
+                tree, order = tree_order
                 by_id = dict(points)
                 results = {}
                 for pid in order:
                     parent = results.get(tree[pid]) if tree[pid] is not None else None
                     if pid in done:
-                        results[pid] = {"id": pid, "starts": _starts_of_folder(os.path.join(out, "points", pid),
-                                                                                document, None)}
+                        results[pid] = passed_on(os.path.join(out, "points", pid), document, None)
                         continue
                     results[pid] = client.submit(run_grid_point, model, model_text, pid, by_id[pid], options, out,
-                                                 document, parent, key=prefix + pid, pure=False)
+                                                 document, parent, guided, extras.get(pid), families,
+                                                 key=prefix + pid, pure=False)
                     futures.append(results[pid])
             for future in as_completed(futures):
                 future.result()
@@ -477,6 +620,7 @@ def plot_maps(out, formats=("png",)):
     table = pd.read_csv(os.path.join(out, "table.csv"), keep_default_na=False, dtype={"point": str})
     families = [f for f in dict.fromkeys(table.family) if f]
     palette = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#56B4E9", "#E69F00", "#000000"]
+    lines = curve_lines(out) if definition.get("curves") else {}
     written = []
     for k, family in enumerate(families):
         classes = map_classes(table, family)
@@ -527,6 +671,50 @@ def plot_maps(out, formats=("png",)):
                 fig.savefig(path, dpi=160, bbox_inches="tight")
                 written.append(path)
             plt.close(fig)
+        if lines:
+            written += _plot_plane(out, definition, table, family, colour, lines, formats, slug)
+    return written
+
+
+def _plot_plane(out, definition, table, family, colour, lines, formats, slug):
+    """plane-<family>.png: the family's ranges in (p, H) along the grid line of the sweep's first curve point,
+    the two-parameter curves over them (a sweep with curves = p)."""
+    import matplotlib.pyplot as plt
+    parameter = definition["curves"]
+    names = list(definition["grid"])
+    axis = names.index(parameter)
+    key, line = next(iter(lines.items()))
+    on_line = table[table.point.map(lambda pid: "_".join("*" if i == axis else v for i, v in enumerate(pid.split("_")))
+                                    == key) & (table.family == family)]
+    fig, ax = plt.subplots(figsize=(6.6, 4.4))
+    for kind, width, alpha in (("physical", 2.5, 0.35), ("stable", 7, 1.0)):
+        first = True
+        for r in on_line.itertuples():
+            a, b = getattr(r, kind + "_from"), getattr(r, kind + "_to")
+            if a in ("", None) or b in ("", None) or pd.isna(a) or pd.isna(b):
+                continue
+            p = float(getattr(r, parameter))
+            ax.plot([p, p], [float(a), float(b)], color=colour, lw=width, alpha=alpha, solid_capstyle="butt",
+                    label="%s range" % kind if first else None)
+            first = False
+    dashes = {"period-doubling": "--", "neimark-sacker": "-.", "branch-point": ":", "fold": (0, (8, 3))}
+    for c in line["curves"]:
+        mine = c["family"] == family
+        ax.plot(c["p"], c["H"], color="0.1" if mine else "0.6", lw=1.3 if mine else 0.9,
+                linestyle=dashes.get(c["type"], "-"), label="%s curve of %s" % (c["type"], c["label"]))
+    others = [n for n in names if n != parameter]
+    where = ", ".join("%s = %.6g" % (n, float(on_line.iloc[0][n])) for n in others) if len(on_line) and others else ""
+    ax.set_xlabel("parameter %s" % parameter)
+    ax.set_ylabel("energy H")
+    ax.set_title("%s: %s in (%s, H)%s" % (definition["model"], family, parameter, " at " + where if where else ""),
+                 fontsize=10)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    written = []
+    for ext in formats:
+        path = os.path.join(out, "plane-%s.%s" % (slug, ext))
+        fig.savefig(path, dpi=160, bbox_inches="tight")
+        written.append(path)
+    plt.close(fig)
     return written
 
 
@@ -565,6 +753,8 @@ def write_report(out):
         points.append(entry)
     data = {"model": definition["model"], "grid": definition["grid"], "strategy": definition["strategy"],
             "version": native.__version__, "classes": MAP_CLASSES, "families": families, "points": points}
+    if definition.get("curves"):
+        data["curves"] = {"parameter": definition["curves"], "lines": curve_lines(out)}
 
     def inert(text):  # "</script" (any case) would end the inline script early; "<\/" means the same to JS and JSON
         return re.sub(r"</(script)", r"<\\/\1", text, flags=re.IGNORECASE)
@@ -623,6 +813,17 @@ def _parse_grid(text):
         raise argparse.ArgumentTypeError("--grid '%s': START and STOP are numbers, COUNT a whole number" % text)
 
 
+def _parse_bound(text):
+    name, _, spec = text.partition("=")
+    parts = spec.split(":")
+    try:
+        if not name or len(parts) != 2:
+            raise ValueError
+        return name, tuple(float(v) if v.strip() else None for v in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError("--bound '%s': expected NAME=LO:HI (either side may be empty)" % text)
+
+
 def _parse_pair(text, option):
     name, _, value = text.partition("=")
     try:
@@ -643,22 +844,33 @@ def main(argv=None):
     p.add_argument("--overwrite", action="store_true")
     p.add_argument("--quiet", action="store_true")
     p.add_argument("--no-maps", action="store_true", help="draw no map figures")
+    p.add_argument("--strategy", choices=("continue", "explore"), default="continue",
+                   help="continue: each grid point continues its neighbour's families (explored whole where they "
+                        "change); explore: every grid point explored whole")
     p.add_argument("--set", action="append", default=[], type=lambda t: _parse_pair(t, "--set"))
     p.add_argument("--until", action="append", default=[], type=lambda t: _parse_pair(t, "--until"))
+    p.add_argument("--bound", action="append", default=[], type=_parse_bound, help="NAME=LO:HI")
     p.add_argument("--rtol", type=float)
     p.add_argument("--atol", type=float)
     p.add_argument("--max-branches", type=int)
     p.add_argument("--formulation", default="time")
     p.add_argument("--no-symmetry", action="store_true")
+    p.add_argument("--family", action="append", dest="families",
+                   help="map only this family (its name; repeatable): the table has its rows, each grid point "
+                        "traces only what led to it")
+    p.add_argument("--curves", help="a grid parameter P: on every grid line along P, one grid point continues its "
+                                    "families' special points in (H, P); the report draws them over the ranges")
     args = p.parse_args(argv)
-    options = {"set": dict(args.set), "until": dict(args.until), "rtol": args.rtol, "atol": args.atol,
+    options = {"set": dict(args.set), "until": dict(args.until), "bound": dict(args.bound), "rtol": args.rtol,
+               "atol": args.atol,
                "max_branches": args.max_branches, "formulation": args.formulation, "no_symmetry": args.no_symmetry}
     options = {k: v for k, v in options.items() if not (v is None or v is False or (isinstance(v, dict) and not v))}
     out = args.out or os.path.join("results", os.path.basename(args.model).replace(".toml", "") + "-sweep")
     try:
         table = sweep(args.model, dict(args.grid), out, scheduler=args.scheduler, workers=args.workers,
                       resume=args.resume, overwrite=args.overwrite, progress=not args.quiet,
-                      maps=not args.no_maps, **options)
+                      maps=not args.no_maps, strategy=args.strategy, curves=args.curves, families=args.families,
+                      **options)
     except ValueError as e:
         print("error: %s" % e, file=sys.stderr)
         return 2

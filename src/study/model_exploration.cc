@@ -396,6 +396,13 @@ ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point
       on_point(numbered, scaled_->FromScaled(v));
     };
   }
+  if (ray_filter_) {
+    options.known_ray = [this, known = options.known_ray](const Vector& u, const Vector& v) {
+      if (known && known(u, v)) return true;
+      const Vector u_model = scaled_->FromScaled(u);
+      return ray_filter_(u_model, scaled_->FromScaled(u + v) - u_model);
+    };
+  }
   if (store_ != nullptr) {
     const int offset = store_offset_ + branch_offset;
     options.recorded_branch = [store = store_, offset](int id) { return store->Lookup(offset + id); };

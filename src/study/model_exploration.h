@@ -74,6 +74,13 @@ class ModelExploration {
   // ends the exploration with the branches traced so far (status kCancelled).
   void set_cancel(std::function<bool()> cancel) { options_.continuation.cancel = std::move(cancel); }
 
+  // Half-branches not to trace (ExplorationOptions::known_ray) of the explorations Run, RunFromStarts and
+  // RunFromPoint: asked with the switch point u and the direction v in model units (the time-based layout),
+  // on the exploring thread. A study guided by a saved one's families (family_guide.h) prunes with it.
+  void set_ray_filter(std::function<bool(const Vector& u, const Vector& v)> filter) { ray_filter_ = std::move(filter); }
+  // The typical magnitude of each unknown (the engine's scaling, scaled_problem.h).
+  const Vector& unknown_scales() const { return scaled_->scales(); }
+
   // The start of Run, checked before anything runs (Run does it when it was not called): a singular start
   // must be an orbit (r = 0 to SingularStartTolerance), a guess must converge under Newton at its level H.
   // False with the reason in *why, which names every part of the cycle that does not close and the unknowns
@@ -153,6 +160,7 @@ class ModelExploration {
   std::unique_ptr<StateBasedShooting> state_;
   std::unique_ptr<ScaledProblem> scaled_;
   ExplorationOptions options_;  // in scaled units
+  std::function<bool(const Vector& u, const Vector& v)> ray_filter_;  // model units
   ExplorationOptions time_options_;  // the time-based scenario's (model units), to find a state start
   std::shared_ptr<TestWorkSink> test_work_;
   bool start_prepared_ = false;

@@ -23,6 +23,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "family_guide.h"
 #include "family_report.h"
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/conservation_check.h"
@@ -491,6 +492,8 @@ nlohmann::json ResultOptionsJson(const StudyOptions& o, const HybridModel& model
                       {"fix", o.fix ? nlohmann::json({o.fix->name, o.fix->value}) : nlohmann::json(nullptr)},
                       {"curves", o.curves}};
   if (o.restart) j["restart"] = {o.restart->from, o.restart->label, ToString(o.restart->kind)};
+  if (!o.families_of.empty()) j["families_of"] = o.families_of;
+  if (!o.families.empty()) j["families"] = o.families;
   return j;
 }
 
@@ -522,6 +525,7 @@ struct PreparedStudy {
   std::unique_ptr<HybridModel> model;
   RunSetup setup;
   std::unique_ptr<ModelExploration> exploration;
+  std::unique_ptr<FamilyGuide> guide;  // options.families_of: prunes the exploration's half-branches
 };
 
 // `given`: the caller's model (copied; options.model and models_directory are then not read).
@@ -599,6 +603,24 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
                                     "(checked on the word " + automaton.WordName(word) + "): " + e.what());
       }
     }
+  }
+  if (!options.families.empty() && options.families_of.empty()) {
+    throw StudyOptionError("families", 0, "'" + options.families[0] + "': needs families_of (a saved study whose "
+                           "families are continued)");
+  }
+  if (!options.families_of.empty()) {
+    const auto refuse = [&](const std::string& why) {
+      throw StudyOptionError("families_of", -1, "'" + options.families_of + "': " + why);
+    };
+    if (options.restart) refuse("not with a restart (a restart traces from its point; families_of from the model's start)");
+    if (!options.free.empty()) refuse("not with a free parameter (free '" + options.free + "')");
+    if (options.formulation != Formulation::kTimeBased) refuse("needs the time-based formulation");
+    p.guide = std::make_unique<FamilyGuide>(
+        FamilyGuide::Load(options.families_of, model, p.exploration->shooting().layout(), options.families));
+    p.exploration->set_ray_filter([guide = p.guide.get(), exploration = p.exploration.get()](const Vector& u,
+                                                                                           const Vector& v) {
+      return guide->Prune(u, v, exploration->unknown_scales());
+    });
   }
   // The ordinary run's start, checked (a guess corrected) before anything is written: a start that is not an
   // orbit is an error of the model's input, said per part of the cycle that does not close.
@@ -722,6 +744,17 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
     // one written says "running").
     writer.Fail(e.what());
     throw;
+  }
+  if (p.guide) {
+    const nlohmann::json guided = p.guide->Json();
+    writer.Annotate("guided", guided);
+    if (hooks.on_note) {
+      hooks.on_note(fmt::format("families of {}: {} half-branches not traced (their counterparts there led to no "
+                                "family{}; {} of its {} half-branches did)",
+                                options.families_of, guided["pruned_half_branches"].get<int>(),
+                                options.families.empty() ? "" : " continued", guided["rays_to_families"].get<int>(),
+                                guided["rays"].get<int>()));
+    }
   }
   // A stopped study ends its folder as "cancelled": whole, but not the whole study (--resume completes it).
   if (!writer.Finish(result.status == ExplorationStatus::kCancelled)) writer.Fail(writer.write_error());  // a full disk: the folder is marked incomplete

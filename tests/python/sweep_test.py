@@ -3,6 +3,7 @@
 uninterrupted sweep's)."""
 import json
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -10,6 +11,7 @@ import sys
 import threading
 import time
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -140,7 +142,7 @@ def test_neighbours_orbits_start_a_grid_point_the_models_own_start_cannot(tmp_pa
                      max_branches=6, set={"k": 17.857}, maps=False)
     walking = table[table.family == "walking"].sort_values("beta")
     assert list(walking.exists) == [True] * 4
-    assert list(walking.strategy) == ["neighbour 1", "neighbour 2", "neighbour 3", "explore"]
+    assert list(walking.strategy) == ["continue from 1", "continue from 2", "continue from 3", "explore"]
     assert walking.iloc[0].stable  # walking at beta = 0.30 has a stable stretch
 
 
@@ -191,3 +193,73 @@ def test_a_model_written_in_python_is_swept_with_its_parameters(tmp_path):
     assert (table.physical_to == 1.0).all()
     with open(os.path.join(str(tmp_path / "ball"), "sweep.json")) as f:
         assert json.load(f)["options"]["set"] == {"g": 1.0, "m": 2.0}
+
+
+def test_continuing_the_neighbours_families_gives_the_whole_explorations_table(tmp_path):
+    """Strategy "continue" (each grid point traces only the half-branches that led to its neighbour's families)
+    against "explore" (every grid point explored whole) over the SLIP's (k, w2) from 10 to 160 and 2 to 10: the
+    same rows, range for range and special point for special point (their ids are each study's own)."""
+    grid = {"k": (10, 160, 4), "w2": (2, 10, 4)}
+    tables = {s: hc.sweep("slip", grid, str(tmp_path / s), workers=2, progress=False, maps=False, strategy=s)
+              for s in ("continue", "explore")}
+    kinds = tables["continue"].strategy.str.split(" ").str[0].value_counts().to_dict()
+    assert kinds == {"continue": len(tables["continue"]) - 3, "explore": 3}  # the first point's 3 families
+    columns = ["point", "family", "exists", "physical", "stable", "physical_from", "physical_to", "stable_from",
+               "stable_to", "status"]
+
+    def same_form(t):
+        t = t.assign(special_points=t.special_points.fillna("").map(
+            lambda s: ";".join(sorted(re.sub(r"^([A-Z]+)\d+", r"\1", p) for p in s.split(";")))))
+        return t[columns + ["special_points"]].sort_values(["point", "family"]).reset_index(drop=True)
+    pd.testing.assert_frame_equal(same_form(tables["continue"]), same_form(tables["explore"]), check_exact=True)
+    # Each grid point's saved study says what the guide left out, and which neighbour guided it.
+    row = tables["continue"][tables["continue"].strategy.str.startswith("continue")].iloc[0]
+    with open(os.path.join(str(tmp_path / "continue"), "points", row.point, "summary.json")) as f:
+        guided = json.load(f)["guided"]
+    assert guided["pruned_half_branches"] >= 3
+    assert "continue from " + os.path.basename(guided["from"]) == row.strategy
+
+
+def test_curves_over_a_line_of_the_grid_pass_through_its_grid_points_ranges(tmp_path):
+    """A sweep with curves="k": the grid point nearest the model's own k continues its families' special points
+    in (H, k) over the grid's range of k; the period-doubling curve of hopping in place (its PD4, where its
+    stable range begins) passes through the stable range's beginning that each grid point's own study
+    located, and the report draws the plane."""
+    out = str(tmp_path / "line")
+    table = hc.sweep("slip", {"k": (20, 80, 5)}, out, workers=2, progress=False, maps=False, curves="k",
+                     until={"H": 2})
+    lines = sweeps.curve_lines(out)
+    assert list(lines) == ["*"] and lines["*"]["point"] == "1"  # k = 35, nearest the model's k = 40
+    pd_curves = [c for c in lines["*"]["curves"] if c["type"] == "period-doubling" and c["family"] == "hopping in place"]
+    assert len(pd_curves) == 1
+    curve = pd_curves[0]
+    assert min(curve["p"]) == pytest.approx(20) and max(curve["p"]) == pytest.approx(80)
+    p, H = np.array(curve["p"]), np.array(curve["H"])
+    order = np.argsort(p)
+    p, H = p[order], H[order]
+    assert np.all(np.diff(p) > 0)  # one H per k: no fold in k
+    slope = np.diff(H) / np.diff(p)
+    hopping = table[table.family == "hopping in place"].sort_values("k")
+    assert len(hopping) == 5 and hopping.stable.all()
+    for r in hopping.itertuples():
+        # Between the curve's two samples around the grid's k the curve is the chord, to within its bending
+        # over that step (the change of the chords' slopes next to it, times the step).
+        i = int(np.clip(np.searchsorted(p, r.k) - 1, 0, len(p) - 2))
+        h = p[i + 1] - p[i]
+        bend = max(abs(slope[j + 1] - slope[j]) for j in range(max(0, i - 1), min(len(slope) - 1, i + 1)))
+        at = H[i] + slope[i] * (r.k - p[i])
+        assert abs(at - r.stable_from) <= bend * h + 1e-8, (r.k, at, r.stable_from, bend * h)
+    # The report draws the plane along the line: the family's ranges and the curves.
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
+    from browser import CHROMIUM, Browser, wait_for
+    if CHROMIUM is None:
+        pytest.skip("no chromium (sh scripts/install-deps.sh installs it)")
+    browser = Browser((tmp_path / "line" / "sweep-report.html").as_uri())
+    try:
+        wait_for(browser, "document.readyState === 'complete' && !!document.querySelector('#plane .scatterlayer')")
+        assert browser.errors() == []
+        names = browser.evaluate("document.getElementById('plane').data.map(t => t.name)")
+        assert "hopping in place: stable range" in names and "period-doubling curve of PD4 (hopping in place)" in names, names
+        assert "curves continued from grid point 1" in browser.evaluate("document.getElementById('plane-title').textContent")
+    finally:
+        browser.close()

@@ -1,0 +1,196 @@
+#include "family_guide.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "hybridcont/setup_evaluation.h"
+#include "hybridcont/study.h"
+
+namespace hybridcont::study {
+
+namespace {
+
+[[noreturn]] void Refuse(const std::string& dir, const std::string& why) {
+  throw StudyOptionError("families_of", -1, "'" + dir + "': " + why);
+}
+
+Vector FromJson(const nlohmann::json& a) {
+  Vector v(static_cast<Eigen::Index>(a.size()));
+  for (std::size_t i = 0; i < a.size(); ++i) v(static_cast<Eigen::Index>(i)) = a[i].get<double>();
+  return v;
+}
+
+nlohmann::json ToJson(const Vector& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v(i));
+  return a;
+}
+
+}  // namespace
+
+FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, const ShootingLayout& layout,
+                              const std::vector<std::string>& families) {
+  StudyResult saved;
+  try {
+    saved = LoadStudy(dir);
+  } catch (const std::invalid_argument& e) {
+    Refuse(dir, std::string("not a saved study: ") + e.what());
+  }
+  if (saved.model != model.name()) {
+    Refuse(dir, "the saved study is of model '" + saved.model + "', not '" + model.name() + "'");
+  }
+  if (saved.unknown_names != layout.unknown_names()) {
+    Refuse(dir, "the saved study's unknowns are not the model's own layout (a study in a free parameter, or "
+                "with other observables among its unknowns)");
+  }
+  // The families asked for must be names the model's rules give, or names the saved study's branches have (an
+  // automaton's families of other words are named by their words).
+  std::vector<std::string> known = OrbitPresentation(model).family_names();
+  for (const StudyBranch& b : saved.branches) {
+    if (!b.family.empty() && std::find(known.begin(), known.end(), b.family) == known.end()) known.push_back(b.family);
+  }
+  for (std::size_t i = 0; i < families.size(); ++i) {
+    if (std::find(known.begin(), known.end(), families[i]) == known.end()) {
+      std::string names;
+      for (const std::string& k : known) names += (names.empty() ? "'" : ", '") + k + "'";
+      throw StudyOptionError("families", static_cast<int>(i), "'" + families[i] + "': not a family of model '" +
+                             model.name() + "' nor of '" + dir + "' (families: " + names + ")");
+    }
+  }
+  const auto wanted = [&](const std::string& family) {
+    return !family.empty() && (families.empty() || std::find(families.begin(), families.end(), family) != families.end());
+  };
+  FamilyGuide guide;
+  guide.dir_ = dir;
+  const int n = static_cast<int>(saved.branches.size());
+  // Each half-branch of the model's own families that leaves a switch point, and what it led to.
+  std::vector<int> ray_of(n, -1);
+  std::vector<bool> fruitful(n, false);
+  for (const StudyBranch& b : saved.branches) {
+    fruitful[b.id] = wanted(b.family);
+    if (!b.origin.empty() || b.unknown_names != saved.unknown_names || b.points.size() < 2) continue;
+    if (b.parent_special_point < 0 || b.parent_special_point >= static_cast<int>(saved.special_points.size())) continue;
+    const StudySpecialPoint& from = saved.special_points[b.parent_special_point];
+    Ray ray;
+    ray.u = from.u.size() == b.points[0].u.size() ? from.u : b.points[0].u;
+    ray.v = b.points[1].u - b.points[0].u;
+    if (!ray.u.allFinite() || !ray.v.allFinite() || !(ray.v.norm() > 0)) continue;
+    ray_of[b.id] = static_cast<int>(guide.rays_.size());
+    guide.rays_.push_back(std::move(ray));
+  }
+  // What a branch led to: the branches switched to at its special points, the period-doubled families born
+  // at its PD points, the families of other words its orbits were handed over to; and a branch and its
+  // image under a symmetry lead to the images of each other's families. A fixed point of these relations.
+  std::vector<std::vector<int>> children(n);
+  const auto on_branch = [&](int special_point) {
+    return special_point >= 0 && special_point < static_cast<int>(saved.special_points.size())
+               ? saved.special_points[special_point].branch
+               : -1;
+  };
+  for (const StudyBranch& b : saved.branches) {
+    for (const int parent : {on_branch(b.parent_special_point), on_branch(b.period_doubled_from), b.image_of}) {
+      if (parent >= 0 && parent < n && parent != b.id) children[parent].push_back(b.id);
+    }
+    if (b.image_of >= 0 && b.image_of < n) children[b.id].push_back(b.image_of);
+  }
+  const nlohmann::json summary = nlohmann::json::parse(saved.summary_json, nullptr, false);
+  if (summary.is_object() && summary.contains("word_changes") && summary["word_changes"].is_array()) {
+    for (const nlohmann::json& change : summary["word_changes"]) {
+      const int from = change.value("from_branch", -1);
+      if (from < 0 || from >= n || !change.contains("to_branches")) continue;
+      for (const nlohmann::json& to : change["to_branches"]) {
+        if (to.is_number_integer() && to.get<int>() >= 0 && to.get<int>() < n) children[from].push_back(to.get<int>());
+      }
+    }
+  }
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int b = 0; b < n; ++b) {
+      if (fruitful[b]) continue;
+      if (std::any_of(children[b].begin(), children[b].end(), [&](int c) { return fruitful[c]; })) {
+        fruitful[b] = changed = true;
+      }
+    }
+  }
+  for (int b = 0; b < n; ++b) {
+    if (ray_of[b] >= 0) guide.rays_[ray_of[b]].fruitful = fruitful[b];
+  }
+  // The rays the saved study pruned itself (it was guided too): they led to no family.
+  if (summary.is_object() && summary.contains("guided") && summary["guided"].contains("pruned")) {
+    for (const nlohmann::json& p : summary["guided"]["pruned"]) {
+      if (!p.contains("u") || !p.contains("v") || !p["u"].is_array() || !p["v"].is_array()) continue;
+      Ray ray;
+      try {
+        ray.u = FromJson(p["u"]);
+        ray.v = FromJson(p["v"]);
+      } catch (const nlohmann::json::exception& e) {
+        Refuse(dir, std::string("summary.json: guided.pruned: ") + e.what());
+      }
+      if (ray.u.size() != static_cast<Eigen::Index>(layout.num_unknowns()) || ray.v.size() != ray.u.size() ||
+          !ray.u.allFinite() || !ray.v.allFinite()) {
+        Refuse(dir, "summary.json: guided.pruned: a ray of another length or not finite");
+      }
+      guide.rays_.push_back(std::move(ray));
+    }
+  }
+  return guide;
+}
+
+bool FamilyGuide::Prune(const Vector& u, const Vector& v, const Vector& scales) {
+  // The orbit's own unknowns (observables joined to the unknowns come last and are left out).
+  Eigen::Index m = std::min(u.size(), std::min(v.size(), scales.size()));
+  for (const Ray& r : rays_) m = std::min(m, r.u.size());
+  if (m == 0 || rays_.empty()) return false;
+  const Vector us = u.head(m).cwiseQuotient(scales.head(m));
+  const double norm = 1 + us.lpNorm<Eigen::Infinity>();
+  const auto distance = [&](const Vector& w) {
+    return (us - w.head(m).cwiseQuotient(scales.head(m))).lpNorm<Eigen::Infinity>() / norm;
+  };
+  std::vector<double> d(rays_.size());
+  std::size_t nearest = 0;
+  for (std::size_t i = 0; i < rays_.size(); ++i) {
+    d[i] = distance(rays_[i].u);
+    if (d[i] < d[nearest]) nearest = i;
+  }
+  if (!(d[nearest] <= kMaxPointDistance)) return false;
+  // The nearest saved switch point (with the rays of points located there twice), clearly nearer than any other.
+  const Vector& at = rays_[nearest].u;
+  const Vector at_scaled = at.head(m).cwiseQuotient(scales.head(m));
+  const double same = 1e-6 * (1 + at_scaled.lpNorm<Eigen::Infinity>());
+  std::vector<std::size_t> here;
+  for (std::size_t i = 0; i < rays_.size(); ++i) {
+    const double apart = (rays_[i].u.head(m).cwiseQuotient(scales.head(m)) - at_scaled).lpNorm<Eigen::Infinity>();
+    if (apart <= same) {
+      here.push_back(i);
+    } else if (d[i] < 2 * d[nearest]) {
+      return false;  // two saved switch points about as near: no clear counterpart
+    }
+  }
+  const Vector vs = v.head(m).cwiseQuotient(scales.head(m)).normalized();
+  double best = -1;
+  for (const std::size_t i : here) {
+    const double c = vs.dot(rays_[i].v.head(m).cwiseQuotient(scales.head(m)).normalized());
+    if (c >= kCloseDirectionCosine && rays_[i].fruitful) return false;
+    best = std::max(best, c);
+  }
+  if (!(best >= kSameDirectionCosine)) return false;
+  pruned_.push_back({u, v, false});
+  return true;
+}
+
+int FamilyGuide::num_fruitful() const {
+  return static_cast<int>(std::count_if(rays_.begin(), rays_.end(), [](const Ray& r) { return r.fruitful; }));
+}
+
+nlohmann::json FamilyGuide::Json() const {
+  nlohmann::json pruned = nlohmann::json::array();
+  for (const Ray& r : pruned_) pruned.push_back({{"u", ToJson(r.u)}, {"v", ToJson(r.v)}});
+  return {{"from", dir_},
+          {"rays", rays_.size()},
+          {"rays_to_families", num_fruitful()},
+          {"pruned_half_branches", pruned_.size()},
+          {"pruned", pruned}};
+}
+
+}  // namespace hybridcont::study
