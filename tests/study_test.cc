@@ -200,6 +200,34 @@ TEST(Study, OptionErrorsNameTheFieldAndWriteNothing) {
   refused(o, "restart", "not a saved study");
 }
 
+// The bipedal model's walking guess (written for k = 25.5, beta = 0.367) does not converge at k = 15,
+// beta = 0.42: bad input for a study of those parameters, unless the start may fail — then the study's status
+// says so, and the running start (in its own word) still gives running.
+TEST(Study, AStartThatMayFailIsTheStudysStatusAndTheOtherStartsGoOn) {
+  StudyOptions o;
+  o.model = "bipedal-slip";
+  o.models_directory = HYBRIDCONT_SOURCE_DIR "/models";
+  o.parameters = {{"k", 15}, {"beta", 0.42}};
+  o.max_branches = 6;
+  EXPECT_THROW(RunStudy(o), ModelInputError);
+  o.start_must_converge = false;
+  std::vector<std::string> notes;
+  StudyHooks hooks;
+  hooks.on_note = [&](const std::string& line) { notes.push_back(line); };
+  const StudyResult s = RunStudy(o, hooks);
+  EXPECT_EQ(s.status, ExplorationStatus::kStartFailed);
+  EXPECT_NE(s.message.find("the guess does not converge"), std::string::npos) << s.message;
+  bool walking = false, running = false;
+  for (const StudyBranch& b : s.branches) {
+    walking = walking || b.family == "walking";
+    running = running || b.family == "stance > flight > stance > flight";
+  }
+  EXPECT_FALSE(walking);
+  EXPECT_TRUE(running);
+  ASSERT_FALSE(notes.empty());
+  EXPECT_NE(notes.front().find("the study goes on without it"), std::string::npos) << notes.front();
+}
+
 // Period doubling on a model with one phase: the doubled model has two phases of one name (copies), which its
 // drawing names once; the study completes (it failed as bad input after the whole run before).
 TEST(Study, PeriodDoublingOfAOnePhaseModelIsDrawn) {

@@ -109,6 +109,11 @@ struct StudyOptions {
   // families are continued to these parameter values without repeating its whole exploration. Empty: the
   // whole exploration. summary.json's "guided" says what was pruned.
   std::string families_of;
+  // The model's start (a guess Newton must correct, a singular start that must be an orbit) failing is bad input
+  // (true: ModelInputError before anything runs — the model file's start is wrong where it was written) or the
+  // study's status (false: status start-failed for the families from it, the model's starts in other words still
+  // explored — a sweep's grid point far from where the start was written).
+  bool start_must_converge = true;
   // With families_of: only the half-branches that led to these of its families (by name, as its branches are
   // named) are traced. Empty: every family.
   std::vector<std::string> families;

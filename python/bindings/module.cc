@@ -125,6 +125,7 @@ StudyOptions OptionsOf(const py::dict& d) {
   }
   o.curves = Get<std::string>(d, "curves", "");
   o.families_of = Get<std::string>(d, "families_of", "");
+  o.start_must_converge = Get<bool>(d, "start_must_converge", true);
   if (d.contains("families") && !d["families"].is_none()) o.families = d["families"].cast<std::vector<std::string>>();
   if (d.contains("restart") && !d["restart"].is_none()) {
     const auto r = d["restart"].cast<std::tuple<std::string, std::string, std::string>>();

@@ -76,7 +76,7 @@ def _monitors(value):
 def _options(model_name, out, set=None, until=None, bound=None, monitor=None, rtol=None, atol=None,
              max_branches=None, threads=None, formulation="time", no_symmetry=False, one_word=False,
              period_doubling=False, free=None, fix=None, curves=None, overwrite=False, resume=False,
-             from_=None, at=None, as_="auto", families_of=None, families=None):
+             from_=None, at=None, as_="auto", families_of=None, families=None, start_must_converge=True):
     if (from_ is None) != (at is None):
         raise ValueError("from_ and at go together: a saved study (its folder or Study) and a label in it "
                          "(PD4, B5, B5:12)")
@@ -99,6 +99,7 @@ def _options(model_name, out, set=None, until=None, bound=None, monitor=None, rt
         "families_of": (families_of.path if isinstance(families_of, Study) else os.fspath(families_of))
         if families_of is not None else "",
         "families": [families] if isinstance(families, str) else list(families or []),
+        "start_must_converge": bool(start_must_converge),
     }
 
 
@@ -129,6 +130,8 @@ def run(model, out=None, progress=True, report=True, **options):
       families_of=study or folder     trace only the half-branches that led to a family in that saved study
                                       of the model at nearby parameters (--families-of)
       families=["hopping in place"]   with families_of: only these of its families (--family)
+      start_must_converge=False       a start that does not converge is the status start-failed, not a
+                                      ValueError (the model's starts in other words still explored)
       out="results/slip", overwrite, resume         the results folder (default: a temporary one)
     progress: True shows a bar (tqdm where installed, else lines), False nothing, or a callable
     f(stage, branches, points, message) called as the study goes.

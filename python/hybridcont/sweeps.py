@@ -231,6 +231,9 @@ def _study_at(m, point_id, values, options, out, document, starts, families_of, 
     opts = dict(options)
     opts["set"] = dict(opts.get("set") or {}, **values)
     opts["threads"] = 1
+    # A start that does not converge at this grid point is its status (start-failed), not the end of its study:
+    # the model's starts in other words are still explored (the bipedal model's running where walking's fails).
+    opts["start_must_converge"] = False
     for key, value in (extra or {}).items():  # the line's curves (sweep's `curves`) and their bound
         opts[key] = dict(opts.get(key) or {}, **value) if isinstance(value, dict) else value
     if families_of is not None:

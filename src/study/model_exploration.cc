@@ -475,6 +475,14 @@ void ModelExploration::ToModelUnits(BifurcationDiagram* diagram) const {
 }
 
 bool ModelExploration::PrepareStart(std::string* why) {
+  std::string reason;
+  const bool ok = CheckAndCorrectStart(&reason);
+  start_failure_ = ok ? std::string() : (reason.empty() ? std::string("the start failed") : reason);
+  if (why != nullptr) *why = reason;
+  return ok;
+}
+
+bool ModelExploration::CheckAndCorrectStart(std::string* why) {
   start_prepared_ = true;
   prepared_start_ = scenario_.start;
   start_report_.clear();
@@ -593,14 +601,13 @@ bool ModelExploration::SingularStartHasDirections(std::string* why) {
 
 BifurcationDiagram ModelExploration::Run(const PointCallback& on_point) {
   ExplorationOptions options = EngineOptions(on_point);
-  if (!start_prepared_) {
-    std::string why;
-    if (!PrepareStart(&why)) {
-      BifurcationDiagram failed;
-      failed.status = ExplorationStatus::kStartFailed;
-      failed.message = why;
-      return failed;
-    }
+  if (!start_prepared_) PrepareStart(nullptr);
+  if (!start_failure_.empty()) {  // checked before (PrepareStart) or now: no start to explore from
+    BifurcationDiagram failed;
+    failed.unknown_names = problem().unknown_names();
+    failed.status = ExplorationStatus::kStartFailed;
+    failed.message = start_failure_;
+    return failed;
   }
   Vector start = prepared_start_;
   if (!state_ && shooting_.layout().num_observables() > 0 && start.size() != shooting_.num_unknowns()) {

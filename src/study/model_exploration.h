@@ -149,6 +149,8 @@ class ModelExploration {
   // Whether the singular start (an orbit) has branch directions under the start conditions; if not, false with
   // the kernel of dr there in *why.
   bool SingularStartHasDirections(std::string* why);
+  // PrepareStart's work: checks (and corrects) the start into prepared_start_.
+  bool CheckAndCorrectStart(std::string* why);
   // The first physical point of the time-based scenario, or an empty vector (message in *why).
   Vector FindPhysicalStart(std::string* why);
 
@@ -165,6 +167,7 @@ class ModelExploration {
   std::shared_ptr<TestWorkSink> test_work_;
   bool start_prepared_ = false;
   Vector prepared_start_;        // the time-based start (model units), a guess corrected
+  std::string start_failure_;    // why the prepared start failed (empty: it did not)
   std::string start_report_;
   ResumeStore* store_ = nullptr;
   int store_offset_ = 0;

@@ -494,6 +494,7 @@ nlohmann::json ResultOptionsJson(const StudyOptions& o, const HybridModel& model
   if (o.restart) j["restart"] = {o.restart->from, o.restart->label, ToString(o.restart->kind)};
   if (!o.families_of.empty()) j["families_of"] = o.families_of;
   if (!o.families.empty()) j["families"] = o.families;
+  if (!o.start_must_converge) j["start_must_converge"] = false;
   return j;
 }
 
@@ -629,7 +630,11 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
     if (!p.exploration->PrepareStart(&why)) {
       SourceLocation where = model.setup().start.where;
       if (where.field.empty()) where.field = "start";
-      throw ModelInputError(where, why);
+      if (options.start_must_converge) throw ModelInputError(where, why);
+      if (hooks.on_note) {
+        const std::string message = ModelInputError(where, why).what();
+        hooks.on_note(message.substr(0, message.find('\n')) + " (the study goes on without it)");
+      }
     }
   }
   return p;
