@@ -86,7 +86,8 @@ std::string FlagOf(const std::string& field) {
       {"max_branches", "--max-branches"}, {"threads", "--threads"}, {"formulation", "--formulation"},
       {"free", "--free"},          {"fix", "--fix"},           {"curves", "--curves"},
       {"out_dir", "--out"},        {"period_doubling", "--period-doubling"}, {"model", "MODEL"},
-      {"restart", "--from/--at"},    {"resume", "--resume"}};
+      {"restart", "--from/--at"},    {"resume", "--resume"},     {"families_of", "--families-of"},
+      {"families", "--family"}};
   const auto it = kFlags.find(field);
   return it == kFlags.end() ? field : it->second;
 }

@@ -178,3 +178,73 @@ TEST(FamilyGuide, RefusedGuidesAreNamedAndNothingIsWritten) {
 
 }  // namespace
 }  // namespace hybridcont
+
+namespace hybridcont {
+namespace {
+
+TEST(FamilyGuide, AnIncompleteGuideIsRefused) {
+  const fs::path limited = Scratch("limited"), out = Scratch("limited_out");
+  StudyOptions o = SlipAt(40, limited);
+  o.max_branches = 5;  // stops before the families' branches below the first branch points are all followed
+  ASSERT_EQ(RunStudy(o).status, ExplorationStatus::kMaxBranches);
+  o = SlipAt(30, out);
+  o.families_of = limited.string();
+  try {
+    RunStudy(o);
+    ADD_FAILURE() << "an incomplete guide accepted";
+  } catch (const StudyOptionError& e) {
+    EXPECT_EQ(e.field(), "families_of");
+    EXPECT_NE(std::string(e.what()).find("did not complete (its exploration: max-branches)"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(out));
+  for (const fs::path& d : {limited, out}) fs::remove_all(d);
+}
+
+// A study that continued one family pruned the half-branches of the others: as a guide it serves a study of
+// that family, not one of every family (which would lose forward and backward hopping).
+TEST(FamilyGuide, RaysPrunedForOneFamilyDoNotPruneTheOthers) {
+  const fs::path whole = Scratch("whole"), one = Scratch("one"), all = Scratch("all");
+  RunStudy(SlipAt(40, whole));
+  StudyOptions o = SlipAt(35, one);
+  o.families_of = whole.string();
+  o.families = {"hopping in place"};
+  const StudyResult hopping = RunStudy(o);
+  EXPECT_EQ(Families(hopping).size(), 1u);
+  EXPECT_EQ(hopping.branches.size(), 1u);
+  const nlohmann::json guided = nlohmann::json::parse(hopping.summary_json)["guided"];
+  EXPECT_EQ(guided["families"], nlohmann::json::array({"hopping in place"}));
+  // Three at the start; at SB1 and at SB5 both directions, forward and backward hopping.
+  EXPECT_EQ(guided["pruned_half_branches"], 7);
+  o = SlipAt(30, all);
+  o.families_of = one.string();
+  o.families = {};
+  const StudyResult every = RunStudy(o);
+  ExpectSameFamilies(every, RunStudy(SlipAt(30)));
+  EXPECT_EQ(Families(every).size(), 3u);
+  // The same guide, asked for the family it continued, prunes what it pruned.
+  o.out_dir.clear();
+  o.families = {"hopping in place"};
+  EXPECT_EQ(RunStudy(o).branches.size(), 1u);
+  for (const fs::path& d : {whole, one, all}) fs::remove_all(d);
+}
+
+// What a guided study says it pruned does not depend on its threads (speculative switches ask about rays the
+// serial exploration never reaches).
+TEST(FamilyGuide, WhatIsPrunedIsTheSameOnOneThreadAndTwo) {
+  const fs::path whole = Scratch("threads_whole");
+  RunStudy(SlipAt(40, whole));
+  nlohmann::json guided[2];
+  for (const int threads : {1, 2}) {
+    StudyOptions o = SlipAt(25);
+    o.families_of = whole.string();
+    o.threads = threads;
+    const StudyResult s = RunStudy(o);
+    guided[threads - 1] = nlohmann::json::parse(s.summary_json)["guided"];
+    EXPECT_EQ(s.branches.size(), 5u) << threads;
+  }
+  EXPECT_EQ(guided[0], guided[1]);
+  fs::remove_all(whole);
+}
+
+}  // namespace
+}  // namespace hybridcont

@@ -30,7 +30,9 @@ Strategies (the table's ``strategy`` column says which one each grid point took)
                  not the branches that found no physical orbit there. The SLIP's exploration is 23 half-branches,
                  its families' 5. Where a family of the neighbour is not found, the grid point is explored whole
                  instead ("explore (a family of 3_4 not continued)"): the family may have ended there, or its
-                 branch may leave another switch point than the guide's. The first grid point is explored whole.
+                 branch may leave another switch point than the guide's. The first grid point is explored whole,
+                 and so is a point whose neighbour's study did not complete (stopped at max_branches: it never
+                 followed some branches) or lacks a family of `families` ("explore (3_4 did not complete)").
   ``explore``    every grid point explored whole from the model's starts, independently of the others (any
                  order, any worker).
 A model file whose starts are guesses (orbits given by their unknowns) has them replaced, in either strategy, by
@@ -41,6 +43,7 @@ What ``continue`` cannot see: a family born on a branch that had no physical orb
 some at this grid point (the guide left that branch out); ``strategy="explore"`` traces everything.
 """
 import argparse
+import contextlib
 import itertools
 import json
 import os
@@ -282,19 +285,28 @@ def run_grid_point(model, model_text, point_id, values, options, out, document=N
     m = hc.model(text=model_text) if model_text is not None else model
     from_orbits = " from %s's orbits" % parent["id"] if document is not None and starts else ""
     partial = None
-    if guided and parent is not None and parent.get("families"):
-        partial, rows, found = _study_at(m, point_id, values, options, out, document, starts,
-                                         os.path.join(out, "points", parent["id"]), extra, families)
-        strategy = "continue from %s" % parent["id"]
-        here = families_of_rows(rows)
-        if here is not None and not set(parent["families"]) <= set(here):
-            # A family of the neighbour not found: it may have ended here, or its branch may now leave another
-            # switch point than the guide's. The whole exploration says which.
-            shutil.rmtree(partial, ignore_errors=True)
-            partial = None
-            strategy = "explore%s (a family of %s not continued)" % (from_orbits, parent["id"])
-    else:
-        strategy = "explore" + from_orbits
+    strategy = "explore" + from_orbits
+    if guided and parent is not None:
+        # A neighbour guides only where its study completed (one stopped at max_branches never followed some
+        # branches) and found the families to continue (a family it lacks may be on a branch it would prune).
+        missing = [f for f in (families or []) if f not in (parent.get("families") or [])]
+        if not parent.get("completed"):
+            strategy += " (%s did not complete)" % parent["id"]
+        elif not parent.get("families") or missing:
+            strategy += " (no %s at %s)" % (", ".join(missing) if missing else "family", parent["id"])
+        else:
+            partial, rows, found = _study_at(m, point_id, values, options, out, document, starts,
+                                             os.path.join(out, "points", parent["id"]), extra, families)
+            here = families_of_rows(rows)
+            if here is None or not set(parent["families"]) <= set(here):
+                # A family of the neighbour not found: it may have ended here, or its branch may now leave
+                # another switch point than the guide's (or the guided study failed). The whole exploration
+                # says which.
+                shutil.rmtree(partial, ignore_errors=True)
+                partial = None
+                strategy += " (a family of %s not continued)" % parent["id"]
+            else:
+                strategy = "continue from %s" % parent["id"]
     if partial is None:
         partial, rows, found = _study_at(m, point_id, values, options, out, document, starts, None, extra, families)
     for row in rows:
@@ -315,11 +327,12 @@ def run_grid_point(model, model_text, point_id, values, options, out, document=N
 
 
 def passed_on(folder, document, parent):
-    """What a finished grid point passes on to its neighbours: {"id", "starts", "families"}."""
+    """What a finished grid point passes on to its neighbours: {"id", "starts", "families", "completed"} (its
+    study completed: it can guide theirs)."""
     with open(os.path.join(folder, "rows.json")) as f:
-        families = families_of_rows(json.load(f))
+        rows = json.load(f)
     return {"id": os.path.basename(folder), "starts": _starts_of_folder(folder, document, parent),
-            "families": families}
+            "families": families_of_rows(rows), "completed": all(r["status"] == "completed" for r in rows)}
 
 
 def _starts_of_folder(folder, document, parent):
@@ -367,6 +380,12 @@ def curve_points(values, parameter, own):
     return {pid: extra for pid, _ in grid_points(values) if int(pid.split("_")[axis]) == at}
 
 
+def _finite(x):
+    """A float for JSON: None (a gap in a drawn line) for NaN or infinity."""
+    x = float(x)
+    return x if np.isfinite(x) else None
+
+
 def curve_lines(out):
     """The two-parameter curves of a sweep run with ``curves=p``: {line: {"point", "curves"}}, a line named by
     its grid point ids' indices with p's replaced by "*" ("*_3"), each curve {"id", "type", "label", "family",
@@ -401,7 +420,7 @@ def curve_lines(out):
             drawn.append({"id": c["id"], "type": c.get("type", ""),
                           "label": "%s%d" % (sp["type"], sp["id"]) if sp else c.get("name", ""),
                           "family": families.get(sp.get("branch"), "") if sp else "",
-                          "p": [float(x) for x in frame[parameter]], "H": [float(x) for x in frame["H"]]})
+                          "p": [_finite(x) for x in frame[parameter]], "H": [_finite(x) for x in frame["H"]]})
         index = pid.split("_")
         index[axis] = "*"
         lines["_".join(index)] = {"point": pid, "curves": drawn}
@@ -411,6 +430,35 @@ def curve_lines(out):
 def _definition(model, grid, options, strategy):
     return {"format": SWEEP_FORMAT, "model": model, "grid": grid,
             "options": {k: v for k, v in sorted(options.items())}, "strategy": strategy}
+
+
+@contextlib.contextmanager
+def _main_script_hidden():
+    """While the local cluster starts its worker processes: the main module without its file and spec, so that
+    multiprocessing does not run the user's script again in each worker (spawn does, to find functions defined
+    there; the tasks of a sweep are this module's). A script that sweeps at its top level, or one read from
+    standard input, would otherwise start a cluster in every worker, or fail to start any."""
+    main = sys.modules.get("__main__")
+    saved = {k: main.__dict__[k] for k in ("__file__", "__spec__") if main is not None and k in main.__dict__}
+    try:
+        if main is not None:
+            main.__dict__.pop("__file__", None)
+            main.__dict__["__spec__"] = None
+        yield
+    finally:
+        if main is not None:
+            main.__dict__.pop("__spec__", None)
+            main.__dict__.update(saved)
+
+
+def _importing_main_script():
+    """True while a process started by multiprocessing runs the parent's main script as ``__mp_main__``."""
+    frame = sys._getframe(1)
+    while frame is not None:
+        if frame.f_globals.get("__name__") == "__mp_main__":
+            return True
+        frame = frame.f_back
+    return False
 
 
 def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrite=False, progress=True,
@@ -434,7 +482,7 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     from .models import Model
     from dask.distributed import Client, LocalCluster, as_completed
 
-    if scheduler is None and sys._getframe(1).f_globals.get("__name__") == "__mp_main__":
+    if scheduler is None and _importing_main_script():
         # A local cluster's worker process starts by importing the main script: a sweep at the script's top
         # level would start a cluster in every worker, which then never starts.
         raise RuntimeError("hybridcont.sweep: called while a worker process imports the script that sweeps; "
@@ -461,7 +509,7 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
         model = os.path.abspath(model)  # the workers may run elsewhere
     if model_text is None:
         from .study import check
-        check(model, **options)
+        check(model, **dict(options, curves=curves) if curves is not None else options)
     model_name = m.name if model is None else os.fspath(model)
     out = os.path.abspath(os.fspath(out))
     document = model_document(model) if model_text is None else __import__("tomllib").loads(model_text)
@@ -491,6 +539,11 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
             saved = json.load(f)
         same = {k: v for k, v in saved.items() if k != "strategy"} == \
             {k: v for k, v in json.loads(json.dumps(definition)).items() if k != "strategy"}
+        # 0.5.0 wrote "explore" or "neighbour" (every point whole, from its neighbour's orbits): both "explore".
+        saved_strategy = str(saved.get("strategy", "explore")).split(" ")[0].replace("neighbour", "explore")
+        if resume and same and saved_strategy != strategy:
+            raise ValueError("resume '%s': the sweep there has strategy '%s'; resume it with strategy='%s' "
+                             "(--strategy %s)" % (out, saved_strategy, saved_strategy, saved_strategy))
         if resume and not same:
             raise ValueError("resume '%s': the sweep there has another definition (model, grid or options); "
                              "resume it with its own" % out)
@@ -519,8 +572,9 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     if todo:
         cluster = None
         if scheduler is None:
-            cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                                   dashboard_address=":0")
+            with _main_script_hidden():
+                cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
+                                       processes=True, dashboard_address=":0")
         client = Client(scheduler or cluster)
         try:
             # Task names of this sweep's own (a shared scheduler runs other sweeps: the same name would be
@@ -703,7 +757,7 @@ def _plot_plane(out, definition, table, family, colour, lines, formats, slug):
     dashes = {"period-doubling": "--", "neimark-sacker": "-.", "branch-point": ":", "fold": (0, (8, 3))}
     for c in line["curves"]:
         mine = c["family"] == family
-        ax.plot(c["p"], c["H"], color="0.1" if mine else "0.6", lw=1.3 if mine else 0.9,
+        ax.plot(np.asarray(c["p"], dtype=float), np.asarray(c["H"], dtype=float), color="0.1" if mine else "0.6", lw=1.3 if mine else 0.9,
                 linestyle=dashes.get(c["type"], "-"), label="%s curve of %s" % (c["type"], c["label"]))
     others = [n for n in names if n != parameter]
     where = ", ".join("%s = %.6g" % (n, float(on_line.iloc[0][n])) for n in others) if len(on_line) and others else ""

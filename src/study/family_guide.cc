@@ -40,6 +40,17 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
   if (saved.model != model.name()) {
     Refuse(dir, "the saved study is of model '" + saved.model + "', not '" + model.name() + "'");
   }
+  const nlohmann::json summary = nlohmann::json::parse(saved.summary_json, nullptr, false);
+  const std::string folder_status =
+      summary.is_object() && summary.contains("status") && summary["status"].is_string() ? summary["status"].get<std::string>() : "";
+  if (folder_status != "complete" || saved.status != ExplorationStatus::kCompleted) {
+    // A branch whose switch points were never followed (the study stopped at max_branches, was cancelled, or
+    // failed) would look like one that led to no family.
+    Refuse(dir, "the saved study did not complete (" +
+                    (folder_status != "complete" ? "its folder is " + (folder_status.empty() ? std::string("not marked") : folder_status)
+                                                 : "its exploration: " + ToString(saved.status)) +
+                    "): the branches it did not follow cannot guide");
+  }
   if (saved.unknown_names != layout.unknown_names()) {
     Refuse(dir, "the saved study's unknowns are not the model's own layout (a study in a free parameter, or "
                 "with other observables among its unknowns)");
@@ -94,11 +105,11 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
     }
     if (b.image_of >= 0 && b.image_of < n) children[b.id].push_back(b.image_of);
   }
-  const nlohmann::json summary = nlohmann::json::parse(saved.summary_json, nullptr, false);
   if (summary.is_object() && summary.contains("word_changes") && summary["word_changes"].is_array()) {
     for (const nlohmann::json& change : summary["word_changes"]) {
-      const int from = change.value("from_branch", -1);
-      if (from < 0 || from >= n || !change.contains("to_branches")) continue;
+      if (!change.is_object() || !change.contains("from_branch") || !change["from_branch"].is_number_integer()) continue;
+      const int from = change["from_branch"].get<int>();
+      if (from < 0 || from >= n || !change.contains("to_branches") || !change["to_branches"].is_array()) continue;
       for (const nlohmann::json& to : change["to_branches"]) {
         if (to.is_number_integer() && to.get<int>() >= 0 && to.get<int>() < n) children[from].push_back(to.get<int>());
       }
@@ -116,9 +127,26 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
   for (int b = 0; b < n; ++b) {
     if (ray_of[b] >= 0) guide.rays_[ray_of[b]].fruitful = fruitful[b];
   }
-  // The rays the saved study pruned itself (it was guided too): they led to no family.
-  if (summary.is_object() && summary.contains("guided") && summary["guided"].contains("pruned")) {
-    for (const nlohmann::json& p : summary["guided"]["pruned"]) {
+  // The rays the saved study pruned itself (it was guided too): they led to none of the families it continued
+  // (all, or those it names), so to none of ours if ours are among them.
+  const nlohmann::json* guided = summary.is_object() && summary.contains("guided") && summary["guided"].is_object() &&
+                                         summary["guided"].contains("pruned") && summary["guided"]["pruned"].is_array()
+                                     ? &summary["guided"]
+                                     : nullptr;
+  if (guided != nullptr && guided->contains("families") && (*guided)["families"].is_array() &&
+      !(*guided)["families"].empty()) {
+    std::vector<std::string> theirs;
+    for (const nlohmann::json& f : (*guided)["families"]) {
+      if (f.is_string()) theirs.push_back(f.get<std::string>());
+    }
+    const bool covered = !families.empty() && std::all_of(families.begin(), families.end(), [&](const std::string& f) {
+      return std::find(theirs.begin(), theirs.end(), f) != theirs.end();
+    });
+    if (!covered) guided = nullptr;  // its pruned rays may have led to families we continue
+  }
+  guide.families_ = families;
+  if (guided != nullptr) {
+    for (const nlohmann::json& p : (*guided)["pruned"]) {
       if (!p.contains("u") || !p.contains("v") || !p["u"].is_array() || !p["v"].is_array()) continue;
       Ray ray;
       try {
@@ -175,7 +203,12 @@ bool FamilyGuide::Prune(const Vector& u, const Vector& v, const Vector& scales) 
     best = std::max(best, c);
   }
   if (!(best >= kSameDirectionCosine)) return false;
-  pruned_.push_back({u, v, false});
+  // Recorded once (a speculative switch of a threaded exploration may ask again for the same ray).
+  const bool known = std::any_of(pruned_.begin(), pruned_.end(), [&](const Ray& r) {
+    return r.u.size() == u.size() && (r.u - u).lpNorm<Eigen::Infinity>() <= 1e-12 * (1 + u.lpNorm<Eigen::Infinity>()) &&
+           (r.v.normalized() - v.normalized()).lpNorm<Eigen::Infinity>() <= 1e-9;
+  });
+  if (!known) pruned_.push_back({u, v, false});
   return true;
 }
 
@@ -183,13 +216,23 @@ int FamilyGuide::num_fruitful() const {
   return static_cast<int>(std::count_if(rays_.begin(), rays_.end(), [](const Ray& r) { return r.fruitful; }));
 }
 
-nlohmann::json FamilyGuide::Json() const {
+nlohmann::json FamilyGuide::Json(const std::vector<Vector>& switch_points) const {
   nlohmann::json pruned = nlohmann::json::array();
-  for (const Ray& r : pruned_) pruned.push_back({{"u", ToJson(r.u)}, {"v", ToJson(r.v)}});
+  for (const Ray& r : pruned_) {
+    // Only rays at the study's own switch points: a threaded exploration also asks at points it later finds
+    // to be duplicates, whose groups it drops.
+    const bool switched = std::any_of(switch_points.begin(), switch_points.end(), [&](const Vector& p) {
+      return p.size() == r.u.size() && (p - r.u).lpNorm<Eigen::Infinity>() <= 1e-9 * (1 + r.u.lpNorm<Eigen::Infinity>());
+    });
+    if (switched) pruned.push_back({{"u", ToJson(r.u)}, {"v", ToJson(r.v)}});
+  }
+  nlohmann::json families = nlohmann::json::array();
+  for (const std::string& f : families_) families.push_back(f);
   return {{"from", dir_},
+          {"families", families},
           {"rays", rays_.size()},
           {"rays_to_families", num_fruitful()},
-          {"pruned_half_branches", pruned_.size()},
+          {"pruned_half_branches", pruned.size()},
           {"pruned", pruned}};
 }
 

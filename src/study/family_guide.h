@@ -17,7 +17,10 @@
 //     from it with cos ≥ kCloseDirectionCosine led to no family.
 // Anything else is traced: a new switch point, an ambiguous one, a direction the saved study did not take.
 // The saved study's own pruned rays (a guided study guiding the next one) are saved half-branches that led to
-// no family.
+// no family (to none of its `families`, if it continued only those: then they guide only a study continuing
+// some of them). The saved study must be complete (a study stopped at max_branches never followed some of its
+// branches), and should have been run with the same options (until, bounds, max_branches, symmetries): a
+// family it did not reach for other reasons than the parameters would not be continued.
 //
 // What this cannot see: a family born on a branch that had no physical orbit in the saved study and has some
 // here. A sweep explores a grid point whole where a family of its neighbour is not found (sweeps.py), and
@@ -49,17 +52,18 @@ class FamilyGuide {
   static FamilyGuide Load(const std::string& dir, const HybridModel& model, const ShootingLayout& layout,
                           const std::vector<std::string>& families = {});
 
-  // True if the half-branch from u along v (model units, the time-based layout; observables among the
-  // unknowns, if any, are not compared) is to be pruned; `scales` are the exploration's unknown scales.
-  // Records the pruned ray (pruned_json). Called on the exploring thread.
+  // True if the half-branch from u along v (model units, the time-based layout, observables among the unknowns
+  // included) is to be pruned; `scales` are the exploration's unknown scales. Records the pruned ray (Json).
+  // Called on the exploring thread.
   bool Prune(const Vector& u, const Vector& v, const Vector& scales);
 
   const std::string& dir() const { return dir_; }
   int num_rays() const { return static_cast<int>(rays_.size()); }
   int num_fruitful() const;
-  // summary.json's "guided": the folder, the counts, and every pruned ray {u, v} (model units), so that this
-  // study can guide the next one.
-  nlohmann::json Json() const;
+  // summary.json's "guided": the folder, the families continued (empty: all), the counts, and every ray pruned
+  // at one of `switch_points` (the study's special points, model units) as {u, v}, so that this study can guide
+  // the next one. Independent of the order and number of Prune calls (a threaded exploration's speculation).
+  nlohmann::json Json(const std::vector<Vector>& switch_points) const;
 
  private:
   struct Ray {
@@ -69,6 +73,7 @@ class FamilyGuide {
   std::string dir_;
   std::vector<Ray> rays_;
   std::vector<Ray> pruned_;
+  std::vector<std::string> families_;
 };
 
 }  // namespace hybridcont::study

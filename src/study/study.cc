@@ -751,7 +751,9 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
     throw;
   }
   if (p.guide) {
-    const nlohmann::json guided = p.guide->Json();
+    std::vector<Vector> switch_points;
+    for (const SpecialPoint& sp : result.diagram.special_points) switch_points.push_back(sp.u);
+    const nlohmann::json guided = p.guide->Json(switch_points);
     writer.Annotate("guided", guided);
     if (hooks.on_note) {
       hooks.on_note(fmt::format("families of {}: {} half-branches not traced (their counterparts there led to no "

@@ -142,7 +142,9 @@ def test_neighbours_orbits_start_a_grid_point_the_models_own_start_cannot(tmp_pa
                      max_branches=6, set={"k": 17.857}, maps=False)
     walking = table[table.family == "walking"].sort_values("beta")
     assert list(walking.exists) == [True] * 4
-    assert list(walking.strategy) == ["continue from 1", "continue from 2", "continue from 3", "explore"]
+    # Each point from its neighbour's orbits, explored whole: a study stopped at max_branches guides no other.
+    assert list(walking.strategy) == ["explore from %d's orbits (%d did not complete)" % (i, i) for i in (1, 2, 3)] + \
+        ["explore"]
     assert walking.iloc[0].stable  # walking at beta = 0.30 has a stable stretch
 
 
@@ -263,3 +265,19 @@ def test_curves_over_a_line_of_the_grid_pass_through_its_grid_points_ranges(tmp_
         assert "curves continued from grid point 1" in browser.evaluate("document.getElementById('plane-title').textContent")
     finally:
         browser.close()
+
+
+def test_a_script_that_sweeps_at_its_top_level_or_from_standard_input_runs(tmp_path):
+    """A local cluster's workers are started without the user's script (multiprocessing's spawn would run it
+    again in each worker: a sweep at the top level then never started, one read from standard input failed)."""
+    out = tmp_path / "top"
+    script = tmp_path / "top_level.py"
+    script.write_text("import hybridcont as hc\n"
+                      "t = hc.sweep('slip', {'k': (30, 50, 3)}, %r, workers=2, progress=False, maps=False, "
+                      "overwrite=True, until={'H': 1.6})\n"
+                      "print('rows', len(t))\n" % str(out))
+    for how in ("file", "stdin"):
+        args = [sys.executable, str(script)] if how == "file" else [sys.executable, "-"]
+        proc = subprocess.run(args, input=None if how == "file" else script.read_text(), capture_output=True,
+                              text=True, timeout=300, env=dict(os.environ))
+        assert proc.returncode == 0 and "rows 9" in proc.stdout, (how, proc.stdout, proc.stderr[-2000:])
