@@ -30,7 +30,7 @@ nlohmann::json ToJson(const Vector& v) {
 }  // namespace
 
 FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, const ShootingLayout& layout,
-                              const std::vector<std::string>& families) {
+                              const std::vector<std::string>& families, const nlohmann::json& options) {
   StudyResult saved;
   try {
     saved = LoadStudy(dir);
@@ -50,6 +50,18 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
                     (folder_status != "complete" ? "its folder is " + (folder_status.empty() ? std::string("not marked") : folder_status)
                                                  : "its exploration: " + ToString(saved.status)) +
                     "): the branches it did not follow cannot guide");
+  }
+  // What limits the branches the exploration follows must be the same: a branch the guide ended at a nearer
+  // bound or target (until), or a switch it did not make (max_depth), may lead to a family beyond.
+  if (summary.is_object() && summary.contains("options") && summary["options"].is_object()) {
+    for (const char* key : {"bounds", "targets", "max_depth"}) {
+      const nlohmann::json& theirs = summary["options"].contains(key) ? summary["options"][key] : nlohmann::json();
+      if (options.contains(key) && theirs != options[key]) {
+        Refuse(dir, std::string("the saved study was run with other ") +
+                        (std::string(key) == "targets" ? "targets (until)" : key) + " (" + theirs.dump() + ", this study " +
+                        options[key].dump() + "): a branch it ended sooner may lead to a family beyond");
+      }
+    }
   }
   if (saved.unknown_names != layout.unknown_names()) {
     Refuse(dir, "the saved study's unknowns are not the model's own layout (a study in a free parameter, or "

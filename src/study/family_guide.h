@@ -19,8 +19,8 @@
 // The saved study's own pruned rays (a guided study guiding the next one) are saved half-branches that led to
 // no family (to none of its `families`, if it continued only those: then they guide only a study continuing
 // some of them). The saved study must be complete (a study stopped at max_branches never followed some of its
-// branches), and should have been run with the same options (until, bounds, max_branches, symmetries): a
-// family it did not reach for other reasons than the parameters would not be continued.
+// branches) and have this study's bounds, targets (until) and max_depth: a branch it ended sooner may lead to
+// a family beyond.
 //
 // What this cannot see: a family born on a branch that had no physical orbit in the saved study and has some
 // here. A sweep explores a grid point whole where a family of its neighbour is not found (sweeps.py), and
@@ -49,8 +49,11 @@ class FamilyGuide {
   // (`layout`). Throws StudyOptionError("families_of", ...) otherwise, naming the folder. `families`: the
   // families to continue (names; empty: all), each the model's or the saved study's (StudyOptionError
   // "families[i]" otherwise); a half-branch that led only to others is pruned like one that led to none.
+  // `options`: this study's effective options (summary.json's "options"); the guide's bounds, targets and
+  // max_depth must be these.
   static FamilyGuide Load(const std::string& dir, const HybridModel& model, const ShootingLayout& layout,
-                          const std::vector<std::string>& families = {});
+                          const std::vector<std::string>& families = {},
+                          const nlohmann::json& options = nlohmann::json::object());
 
   // True if the half-branch from u along v (model units, the time-based layout, observables among the unknowns
   // included) is to be pruned; `scales` are the exploration's unknown scales. Records the pruned ray (Json).

@@ -617,7 +617,8 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
     if (!options.free.empty()) refuse("not with a free parameter (free '" + options.free + "')");
     if (options.formulation != Formulation::kTimeBased) refuse("needs the time-based formulation");
     p.guide = std::make_unique<FamilyGuide>(
-        FamilyGuide::Load(options.families_of, model, p.exploration->shooting().layout(), options.families));
+        FamilyGuide::Load(options.families_of, model, p.exploration->shooting().layout(), options.families,
+                          OptionsJson(options, p.setup)));
     p.exploration->set_ray_filter([guide = p.guide.get(), exploration = p.exploration.get()](const Vector& u,
                                                                                            const Vector& v) {
       return guide->Prune(u, v, exploration->unknown_scales());
