@@ -519,9 +519,9 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     for i, name in enumerate(families or []):
         # A family is named by the model's rules, or (an automaton's family of another word) by its word.
         if name not in m.families and " > " not in name:
-            raise ValueError("families[%d] '%s': not a family of model '%s' (families: %s; an automaton's family of "
+            raise ValueError("family '%s': not a family of model '%s' (families: %s; an automaton's family of "
                              "another word is named by its word, 'stance > flight > ...')"
-                             % (i, name, m.name, ", ".join(m.families) or "none named"))
+                             % (name, m.name, ", ".join(m.families) or "none named"))
     if curves is not None and curves not in values:
         raise ValueError("curves '%s': not a parameter of the grid (%s)" % (curves, ", ".join(values)))
     if strategy not in ("continue", "explore"):

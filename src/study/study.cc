@@ -606,8 +606,8 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
     }
   }
   if (!options.families.empty() && options.families_of.empty()) {
-    throw StudyOptionError("families", 0, "'" + options.families[0] + "': needs families_of (a saved study whose "
-                           "families are continued)");
+    throw StudyOptionError("families", 0, "'" + options.families[0] + "': needs the saved study whose families are "
+                           "continued (families_of, --families-of)");
   }
   if (!options.families_of.empty()) {
     const auto refuse = [&](const std::string& why) {
