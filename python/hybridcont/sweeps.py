@@ -526,6 +526,12 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
         raise ValueError("curves '%s': not a parameter of the grid (%s)" % (curves, ", ".join(values)))
     if strategy not in ("continue", "explore"):
         raise ValueError("sweep: strategy '%s': expected 'continue' or 'explore'" % strategy)
+    if strategy == "continue" and (options.get("free") or options.get("formulation", "time") != "time"):
+        # A guide continues families in H, in the time-based formulation (StudyOptions::families_of).
+        import warnings
+        warnings.warn("sweep: strategy 'continue' needs families in H in the time-based formulation: every grid "
+                      "point is explored whole", RuntimeWarning, stacklevel=2)
+        strategy = "explore"
     guided = strategy == "continue"
     definition = _definition(model_name, values, options, strategy + (" (starts from the neighbours' orbits)"
                                                                        if document is not None else ""))
@@ -917,10 +923,23 @@ def main(argv=None):
                         "traces only what led to it")
     p.add_argument("--curves", help="a grid parameter P: on every grid line along P, one grid point continues its "
                                     "families' special points in (H, P); the report draws them over the ranges")
+    p.add_argument("--monitor", action="append", default=[], type=lambda t: _parse_pair(t, "--monitor"),
+                   help="NAME=VALUE: locate where an observable takes the value (repeatable)")
+    p.add_argument("--period-doubling", action="store_true")
+    p.add_argument("--one-word", action="store_true")
+    p.add_argument("--free", help="a parameter continued instead of H (with --fix; every grid point explored whole)")
+    p.add_argument("--fix", type=lambda t: _parse_pair(t, "--fix"), help="NAME=VALUE held while --free varies")
     args = p.parse_args(argv)
-    options = {"set": dict(args.set), "until": dict(args.until), "bound": dict(args.bound), "rtol": args.rtol,
-               "atol": args.atol,
-               "max_branches": args.max_branches, "formulation": args.formulation, "no_symmetry": args.no_symmetry}
+    import warnings  # the command line says the sweep's warnings as notes, without Python's file and line
+    warnings.showwarning = lambda message, *rest, **named: print("note: %s" % message, file=sys.stderr)
+    monitors = {}
+    for name, value in args.monitor:
+        monitors.setdefault(name, []).append(value)
+    options = {"set": dict(args.set), "until": dict(args.until), "bound": dict(args.bound), "monitor": monitors,
+               "rtol": args.rtol, "atol": args.atol, "max_branches": args.max_branches,
+               "formulation": args.formulation, "no_symmetry": args.no_symmetry,
+               "period_doubling": args.period_doubling, "one_word": args.one_word, "free": args.free,
+               "fix": dict([args.fix]) if args.fix else None}
     options = {k: v for k, v in options.items() if not (v is None or v is False or (isinstance(v, dict) and not v))}
     out = args.out or os.path.join("results", os.path.basename(args.model).replace(".toml", "") + "-sweep")
     try:

@@ -130,6 +130,15 @@ def test_the_tool_runs_a_sweep_and_refuses_a_bad_grid(tmp_path):
     assert not os.path.exists(tmp_path / "bad")  # nothing written
     proc = subprocess.run([tool, "sweep", "slip", "--grid", "k=1:2"], capture_output=True, text=True)
     assert proc.returncode == 2 and "NAME=START:STOP:COUNT" in proc.stderr
+    # Families in a free parameter at each grid point: explored whole (a guide continues families in H), said.
+    out = str(tmp_path / "free")
+    proc = subprocess.run([tool, "sweep", "slip", "--grid", "w2=5:6:2", "--free", "k", "--fix", "H=1.5", "--workers",
+                           "1", "--quiet", "--no-maps", "--out", out], capture_output=True, text=True)
+    assert proc.returncode == 0 and "note: sweep: strategy 'continue' needs families in H" in proc.stderr, proc.stderr
+    table = pd.read_csv(os.path.join(out, "table.csv"))
+    assert set(table.strategy) == {"explore"} and table[table.family == "hopping in place"].physical.all()
+    # The range of a family in k at H = 1.5 is in k (the bound of k is the model's, 10 to 160).
+    assert table[table.family == "hopping in place"].physical_to.max() == pytest.approx(160)
 
 
 def test_neighbours_orbits_start_a_grid_point_the_models_own_start_cannot(tmp_path):
