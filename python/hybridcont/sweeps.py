@@ -326,11 +326,43 @@ def run_grid_point(model, model_text, point_id, values, options, out, document=N
     return passed_on(final, document, parent)
 
 
+ROW_KEYS = ("point", "family", "exists", "physical", "stable", "status")
+
+
+def _read_json(path, what):
+    """A sweep file read back (untrusted: a damaged or foreign file is a ValueError naming it)."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        raise ValueError("'%s': not %s (%s)" % (path, what, e))
+
+
+def read_rows(folder):
+    """A finished grid point's rows (<folder>/rows.json), checked: a ValueError names the file and what is
+    wrong, and says how to compute the point again."""
+    path = os.path.join(folder, "rows.json")
+    fix = "; remove %s to compute the grid point again" % folder
+    try:
+        rows = _read_json(path, "a grid point's rows")
+    except ValueError as e:
+        raise ValueError(str(e) + fix)
+    if not isinstance(rows, list) or not rows:
+        raise ValueError("'%s': not a grid point's rows (a non-empty list expected)%s" % (path, fix))
+    for i, row in enumerate(rows):
+        missing = [k for k in ROW_KEYS if not isinstance(row, dict) or k not in row]
+        if missing:
+            raise ValueError("'%s': row %d lacks '%s'%s" % (path, i, missing[0], fix))
+        if row["point"] != os.path.basename(folder) or not isinstance(row["status"], str):
+            raise ValueError("'%s': row %d is of grid point '%s', not '%s'%s"
+                             % (path, i, row["point"], os.path.basename(folder), fix))
+    return rows
+
+
 def passed_on(folder, document, parent):
     """What a finished grid point passes on to its neighbours: {"id", "starts", "families", "completed"} (its
     study completed: it can guide theirs)."""
-    with open(os.path.join(folder, "rows.json")) as f:
-        rows = json.load(f)
+    rows = read_rows(folder)
     return {"id": os.path.basename(folder), "starts": _starts_of_folder(folder, document, parent),
             "families": families_of_rows(rows), "completed": all(r["status"] == "completed" for r in rows)}
 
@@ -340,8 +372,12 @@ def _starts_of_folder(folder, document, parent):
     path = os.path.join(folder, "starts.json")
     if document is None or not os.path.exists(path):
         return dict((parent or {}).get("starts") or {})
-    with open(path) as f:
-        return {int(k): v for k, v in json.load(f).items()}
+    starts = _read_json(path, "the orbits a grid point passes on")
+    try:
+        return {int(k): {str(n): float(x) for n, x in v.items()} for k, v in starts.items()}
+    except (AttributeError, TypeError, ValueError):
+        raise ValueError("'%s': not the orbits a grid point passes on ({start: {unknown: value}} expected); "
+                         "remove %s to compute the grid point again" % (path, folder))
 
 
 def neighbour_tree(values, origin):
@@ -390,31 +426,29 @@ def curve_lines(out):
     """The two-parameter curves of a sweep run with ``curves=p``: {line: {"point", "curves"}}, a line named by
     its grid point ids' indices with p's replaced by "*" ("*_3"), each curve {"id", "type", "label", "family",
     "p", "H"} (the special point it continues, its family, and its points in (p, H))."""
-    with open(os.path.join(out, "sweep.json")) as f:
-        definition = json.load(f)
+    definition = read_definition(out)
     parameter = definition.get("curves")
     if not parameter:
         return {}
     axis = list(definition["grid"]).index(parameter)
     lines = {}
+    from .study import load
     for pid in sorted(os.listdir(os.path.join(out, "points"))):
         folder = os.path.join(out, "points", pid)
-        summary_path = os.path.join(folder, "summary.json")
-        if pid.startswith(".") or not os.path.exists(summary_path):
+        if pid.startswith(".") or not os.path.exists(os.path.join(folder, "summary.json")):
             continue
-        with open(summary_path) as f:
-            summary = json.load(f)
-        if not summary.get("curves"):
-            continue
+        head = _read_json(os.path.join(folder, "summary.json"), "a saved study's summary")
+        if not isinstance(head, dict) or not head.get("curves"):
+            continue  # a grid point without curves (all but one per line)
+        study = load(folder)  # the library reads the folder back: a damaged one is a ValueError naming its file
+        summary = study.summary
         special = {sp["id"]: sp for sp in summary.get("special_points") or []}
         families = {b["id"]: b.get("family") or "" for b in summary.get("branches") or []}
+        frames = study.curves
         drawn = []
         for c in summary["curves"]:
-            path = os.path.join(folder, c.get("file", ""))
-            if c.get("status") != "traced" or not os.path.exists(path):
-                continue
-            frame = pd.read_csv(path)
-            if parameter not in frame.columns or "H" not in frame.columns:
+            frame = frames[frames.curve == c["id"]] if len(frames) else frames
+            if c.get("status") != "traced" or frame.empty or parameter not in frame.columns or "H" not in frame.columns:
                 continue
             sp = special.get(c.get("special_point"), {})
             drawn.append({"id": c["id"], "type": c.get("type", ""),
@@ -541,8 +575,7 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
         definition["families"] = families
     definition_file = os.path.join(out, "sweep.json")
     if os.path.exists(definition_file):
-        with open(definition_file) as f:
-            saved = json.load(f)
+        saved = read_definition(out)
         same = {k: v for k, v in saved.items() if k != "strategy"} == \
             {k: v for k, v in json.loads(json.dumps(definition)).items() if k != "strategy"}
         # 0.5.0 wrote "explore" or "neighbour" (every point whole, from its neighbour's orbits): both "explore".
@@ -560,6 +593,13 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
             shutil.rmtree(out)
     elif resume:
         raise ValueError("resume '%s': no sweep there to resume" % out)
+    if resume:  # the finished points' files are read back: checked before anything runs
+        for pid, _ in points:
+            folder = os.path.join(out, "points", pid)
+            if os.path.exists(os.path.join(folder, "rows.json")):
+                read_rows(folder)
+                if document is not None:
+                    _starts_of_folder(folder, document, None)
     os.makedirs(os.path.join(out, "points"), exist_ok=True)
     with open(definition_file + ".tmp", "w") as f:
         json.dump(definition, f, indent=1)
@@ -628,17 +668,29 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     return table
 
 
+def read_definition(out):
+    """<out>/sweep.json, checked (a ValueError names the file)."""
+    path = os.path.join(out, "sweep.json")
+    definition = _read_json(path, "a sweep's definition")
+    grid = definition.get("grid") if isinstance(definition, dict) else None
+    if not isinstance(grid, dict) or not grid or not all(
+            isinstance(v, list) and v and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)
+            for v in grid.values()):
+        raise ValueError("'%s': not a sweep's definition (its grid: {parameter: [values]} expected)" % path)
+    if not isinstance(definition.get("model"), str):
+        raise ValueError("'%s': not a sweep's definition (its model's name expected)" % path)
+    return definition
+
+
 def assemble(out, points=None):
     """The tidy table of a sweep's folder (every complete grid point, once), written to <out>/table.csv."""
     if points is None:
-        with open(os.path.join(out, "sweep.json")) as f:
-            points = grid_points(json.load(f)["grid"])
+        points = grid_points(read_definition(out)["grid"])
     rows = []
     for pid, _ in points:
-        path = os.path.join(out, "points", pid, "rows.json")
-        if os.path.exists(path):
-            with open(path) as f:
-                rows.extend(json.load(f))
+        folder = os.path.join(out, "points", pid)
+        if os.path.exists(os.path.join(folder, "rows.json")):
+            rows.extend(read_rows(folder))
     table = pd.DataFrame(rows)
     table.to_csv(os.path.join(out, "table.csv.tmp"), index=False)
     os.replace(os.path.join(out, "table.csv.tmp"), os.path.join(out, "table.csv"))
@@ -671,8 +723,7 @@ def plot_maps(out, formats=("png",)):
     import matplotlib.pyplot as plt
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
-    with open(os.path.join(out, "sweep.json")) as f:
-        definition = json.load(f)
+    definition = read_definition(out)
     grid = definition["grid"]
     names = list(grid)
     if len(names) > 2:
@@ -792,8 +843,7 @@ def write_report(out):
     if not os.path.exists(plotly):
         warnings.warn("sweep-report.html not written: %s is missing (built without npm)" % plotly, RuntimeWarning)
         return None
-    with open(os.path.join(out, "sweep.json")) as f:
-        definition = json.load(f)
+    definition = read_definition(out)
     table = pd.read_csv(os.path.join(out, "table.csv"), keep_default_na=False, dtype={"point": str})
     families = [f for f in dict.fromkeys(table.family) if f]
     points = []
@@ -950,6 +1000,10 @@ def main(argv=None):
     except ValueError as e:
         print("error: %s" % e, file=sys.stderr)
         return 2
+    except (RuntimeError, OSError) as e:  # a grid point's study stopped or not written (a full disk)
+        print("error: %s\nthe grid points finished are kept in %s; --resume continues the sweep"
+              % (e, os.path.abspath(out)), file=sys.stderr)
+        return 1
     points = table["point"].nunique() if len(table) else 0
     print("%d grid points, %d rows: %s" % (points, len(table), os.path.join(os.path.abspath(out), "table.csv")))
     return 0

@@ -290,3 +290,27 @@ def test_a_script_that_sweeps_at_its_top_level_or_from_standard_input_runs(tmp_p
         proc = subprocess.run(args, input=None if how == "file" else script.read_text(), capture_output=True,
                               text=True, timeout=300, env=dict(os.environ))
         assert proc.returncode == 0 and "rows 9" in proc.stdout, (how, proc.stdout, proc.stderr[-2000:])
+
+
+def test_damaged_sweep_files_are_named_and_a_resume_refuses_them(tmp_path):
+    """A sweep's folder is untrusted input: a damaged definition or grid point's rows is refused on resume
+    (exit 2, naming the file and how to recompute the point), nothing computed or rewritten."""
+    tool = os.environ.get("HYBRIDCONT_BIN", "build/hybridcont")
+    out = tmp_path / "damaged"
+    args = [tool, "sweep", "slip", "--grid", "k=30:40:2", "--until", "H=1.5", "--workers", "1", "--quiet",
+            "--no-maps", "--out", str(out)]
+    assert subprocess.run(args, capture_output=True, text=True).returncode == 0
+    rows = out / "points" / "1" / "rows.json"
+    good = rows.read_text()
+    for damage, expected in (("[{\"point\": \"1\"}]", "row 0 lacks 'family'"), ("{", "not a grid point's rows"),
+                             ("[]", "a non-empty list expected")):
+        rows.write_text(damage)
+        table = (out / "table.csv").read_text()
+        proc = subprocess.run(args + ["--resume"], capture_output=True, text=True)
+        assert proc.returncode == 2 and str(rows) in proc.stderr and expected in proc.stderr, proc.stderr
+        assert "remove %s to compute the grid point again" % (out / "points" / "1") in proc.stderr
+        assert (out / "table.csv").read_text() == table  # nothing rewritten
+    rows.write_text(good)
+    (out / "sweep.json").write_text("{\"grid\": 3}")
+    proc = subprocess.run(args + ["--resume"], capture_output=True, text=True)
+    assert proc.returncode == 2 and "sweep.json" in proc.stderr, proc.stderr
