@@ -574,7 +574,9 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     if families:
         definition["families"] = families
     definition_file = os.path.join(out, "sweep.json")
-    if os.path.exists(definition_file):
+    if os.path.exists(definition_file) and overwrite and not resume:
+        shutil.rmtree(out)  # replaced whole, whatever its files hold
+    elif os.path.exists(definition_file):
         saved = read_definition(out)
         same = {k: v for k, v in saved.items() if k != "strategy"} == \
             {k: v for k, v in json.loads(json.dumps(definition)).items() if k != "strategy"}
@@ -586,11 +588,9 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
         if resume and not same:
             raise ValueError("resume '%s': the sweep there has another definition (model, grid or options); "
                              "resume it with its own" % out)
-        if not resume and not overwrite:
+        if not resume:
             raise ValueError("sweep '%s': a sweep is there (resume=True continues it, overwrite=True replaces it)"
                              % out)
-        if overwrite and not resume:
-            shutil.rmtree(out)
     elif resume:
         raise ValueError("resume '%s': no sweep there to resume" % out)
     if resume:  # the finished points' files are read back: checked before anything runs

@@ -314,3 +314,4 @@ def test_damaged_sweep_files_are_named_and_a_resume_refuses_them(tmp_path):
     (out / "sweep.json").write_text("{\"grid\": 3}")
     proc = subprocess.run(args + ["--resume"], capture_output=True, text=True)
     assert proc.returncode == 2 and "sweep.json" in proc.stderr, proc.stderr
+    assert subprocess.run(args + ["--overwrite"], capture_output=True, text=True).returncode == 0  # replaced whole
