@@ -133,7 +133,8 @@ def test_the_tool_runs_a_sweep_and_refuses_a_bad_grid(tmp_path):
     # Families in a free parameter at each grid point: explored whole (a guide continues families in H), said.
     out = str(tmp_path / "free")
     proc = subprocess.run([tool, "sweep", "slip", "--grid", "w2=5:6:2", "--free", "k", "--fix", "H=1.5", "--workers",
-                           "1", "--quiet", "--no-maps", "--out", out], capture_output=True, text=True)
+                           "1", "--quiet", "--no-maps", "--strategy", "continue", "--out", out], capture_output=True,
+                          text=True)
     assert proc.returncode == 0 and "note: sweep: strategy 'continue' needs families in H" in proc.stderr, proc.stderr
     table = pd.read_csv(os.path.join(out, "table.csv"))
     assert set(table.strategy) == {"explore"} and table[table.family == "hopping in place"].physical.all()
@@ -151,7 +152,11 @@ def test_neighbours_orbits_start_a_grid_point_the_models_own_start_cannot(tmp_pa
                      max_branches=6, set={"k": 17.857}, maps=False)
     walking = table[table.family == "walking"].sort_values("beta")
     assert list(walking.exists) == [True] * 4
-    # Each point from its neighbour's orbits, explored whole: a study stopped at max_branches guides no other.
+    assert list(walking.strategy) == ["explore from %d's orbits" % i for i in (1, 2, 3)] + ["explore"]
+    # Continuing: a study stopped at max_branches guides no other, so each point is explored whole, and says why.
+    table = hc.sweep("bipedal-slip", {"beta": (0.30, 0.3665, 4)}, str(tmp_path / "walk2"), progress=False,
+                     max_branches=6, set={"k": 17.857}, maps=False, strategy="continue")
+    walking = table[table.family == "walking"].sort_values("beta")
     assert list(walking.strategy) == ["explore from %d's orbits (%d did not complete)" % (i, i) for i in (1, 2, 3)] + \
         ["explore"]
     assert walking.iloc[0].stable  # walking at beta = 0.30 has a stable stretch
@@ -238,7 +243,7 @@ def test_curves_over_a_line_of_the_grid_pass_through_its_grid_points_ranges(tmp_
     located, and the report draws the plane."""
     out = str(tmp_path / "line")
     table = hc.sweep("slip", {"k": (20, 80, 5)}, out, workers=2, progress=False, maps=False, curves="k",
-                     until={"H": 2})
+                     until={"H": 2}, strategy="continue")
     lines = sweeps.curve_lines(out)
     assert list(lines) == ["*"] and lines["*"]["point"] == "1"  # k = 35, nearest the model's k = 40
     pd_curves = [c for c in lines["*"]["curves"] if c["type"] == "period-doubling" and c["family"] == "hopping in place"]
