@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "hybridcont/setup_evaluation.h"
+#include "json_fields.h"
 #include "hybridcont/study.h"
 
 namespace hybridcont::study {
@@ -13,18 +14,6 @@ namespace {
 
 [[noreturn]] void Refuse(const std::string& dir, const std::string& why) {
   throw StudyOptionError("families_of", -1, "'" + dir + "': " + why);
-}
-
-Vector FromJson(const nlohmann::json& a) {
-  Vector v(static_cast<Eigen::Index>(a.size()));
-  for (std::size_t i = 0; i < a.size(); ++i) v(static_cast<Eigen::Index>(i)) = a[i].get<double>();
-  return v;
-}
-
-nlohmann::json ToJson(const Vector& v) {
-  nlohmann::json a = nlohmann::json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v(i));
-  return a;
 }
 
 }  // namespace
@@ -145,12 +134,15 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
                                          summary["guided"].contains("pruned") && summary["guided"]["pruned"].is_array()
                                      ? &summary["guided"]
                                      : nullptr;
-  if (guided != nullptr && guided->contains("families") && (*guided)["families"].is_array() &&
-      !(*guided)["families"].empty()) {
-    std::vector<std::string> theirs;
-    for (const nlohmann::json& f : (*guided)["families"]) {
-      if (f.is_string()) theirs.push_back(f.get<std::string>());
+  std::vector<std::string> theirs;
+  if (guided != nullptr) {
+    try {
+      theirs = JsonTexts(*guided, "families", "summary.json: guided");
+    } catch (const std::invalid_argument& e) {
+      Refuse(dir, e.what());
     }
+  }
+  if (guided != nullptr && !theirs.empty()) {
     const bool covered = !families.empty() && std::all_of(families.begin(), families.end(), [&](const std::string& f) {
       return std::find(theirs.begin(), theirs.end(), f) != theirs.end();
     });
@@ -158,14 +150,15 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
   }
   guide.families_ = families;
   if (guided != nullptr) {
-    for (const nlohmann::json& p : (*guided)["pruned"]) {
-      if (!p.contains("u") || !p.contains("v") || !p["u"].is_array() || !p["v"].is_array()) continue;
+    for (std::size_t i = 0; i < (*guided)["pruned"].size(); ++i) {
+      const nlohmann::json& p = (*guided)["pruned"][i];
+      const std::string where = "summary.json: guided.pruned[" + std::to_string(i) + "]";
       Ray ray;
       try {
-        ray.u = FromJson(p["u"]);
-        ray.v = FromJson(p["v"]);
-      } catch (const nlohmann::json::exception& e) {
-        Refuse(dir, std::string("summary.json: guided.pruned: ") + e.what());
+        ray.u = VectorFrom(JsonField(p, "u", where), where + ".u");
+        ray.v = VectorFrom(JsonField(p, "v", where), where + ".v");
+      } catch (const std::invalid_argument& e) {
+        Refuse(dir, e.what());
       }
       if (ray.u.size() != static_cast<Eigen::Index>(layout.num_unknowns()) || ray.v.size() != ray.u.size() ||
           !ray.u.allFinite() || !ray.v.allFinite()) {
@@ -178,39 +171,37 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
 }
 
 bool FamilyGuide::Prune(const Vector& u, const Vector& v, const Vector& scales) {
-  // The orbit's own unknowns (observables joined to the unknowns come last and are left out).
+  // Every unknown is compared (Load checked that the saved study has this layout); in scaled units.
   Eigen::Index m = std::min(u.size(), std::min(v.size(), scales.size()));
   for (const Ray& r : rays_) m = std::min(m, r.u.size());
   if (m == 0 || rays_.empty()) return false;
-  const Vector us = u.head(m).cwiseQuotient(scales.head(m));
-  const double norm = 1 + us.lpNorm<Eigen::Infinity>();
-  const auto distance = [&](const Vector& w) {
-    return (us - w.head(m).cwiseQuotient(scales.head(m))).lpNorm<Eigen::Infinity>() / norm;
-  };
+  const auto scaled = [&](const Vector& w) -> Vector { return w.head(m).cwiseQuotient(scales.head(m)); };
+  const Vector us = scaled(u);
+  std::vector<Vector> points(rays_.size());
   std::vector<double> d(rays_.size());
   std::size_t nearest = 0;
   for (std::size_t i = 0; i < rays_.size(); ++i) {
-    d[i] = distance(rays_[i].u);
+    points[i] = scaled(rays_[i].u);
+    d[i] = (us - points[i]).lpNorm<Eigen::Infinity>() / (1 + us.lpNorm<Eigen::Infinity>());
     if (d[i] < d[nearest]) nearest = i;
   }
   if (!(d[nearest] <= kMaxPointDistance)) return false;
   // The nearest saved switch point (with the rays of points located there twice), clearly nearer than any other.
-  const Vector& at = rays_[nearest].u;
-  const Vector at_scaled = at.head(m).cwiseQuotient(scales.head(m));
+  const Vector& at_scaled = points[nearest];
   const double same = 1e-6 * (1 + at_scaled.lpNorm<Eigen::Infinity>());
   std::vector<std::size_t> here;
   for (std::size_t i = 0; i < rays_.size(); ++i) {
-    const double apart = (rays_[i].u.head(m).cwiseQuotient(scales.head(m)) - at_scaled).lpNorm<Eigen::Infinity>();
+    const double apart = (points[i] - at_scaled).lpNorm<Eigen::Infinity>();
     if (apart <= same) {
       here.push_back(i);
     } else if (d[i] < 2 * d[nearest]) {
       return false;  // two saved switch points about as near: no clear counterpart
     }
   }
-  const Vector vs = v.head(m).cwiseQuotient(scales.head(m)).normalized();
+  const Vector vs = scaled(v).normalized();
   double best = -1;
   for (const std::size_t i : here) {
-    const double c = vs.dot(rays_[i].v.head(m).cwiseQuotient(scales.head(m)).normalized());
+    const double c = vs.dot(scaled(rays_[i].v).normalized());
     if (c >= kCloseDirectionCosine && rays_[i].fruitful) return false;
     best = std::max(best, c);
   }
@@ -236,7 +227,7 @@ nlohmann::json FamilyGuide::Json(const std::vector<Vector>& switch_points) const
     const bool switched = std::any_of(switch_points.begin(), switch_points.end(), [&](const Vector& p) {
       return p.size() == r.u.size() && (p - r.u).lpNorm<Eigen::Infinity>() <= 1e-9 * (1 + r.u.lpNorm<Eigen::Infinity>());
     });
-    if (switched) pruned.push_back({{"u", ToJson(r.u)}, {"v", ToJson(r.v)}});
+    if (switched) pruned.push_back({{"u", VectorJson(r.u)}, {"v", VectorJson(r.v)}});
   }
   nlohmann::json families = nlohmann::json::array();
   for (const std::string& f : families_) families.push_back(f);

@@ -1,5 +1,6 @@
 #include "json_fields.h"
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 
@@ -77,6 +78,27 @@ std::vector<std::string> JsonTexts(const nlohmann::json& object, const std::stri
     list.push_back((*v)[i].get<std::string>());
   }
   return list;
+}
+
+nlohmann::json NumberJson(double x) {
+  if (std::isnan(x)) return "nan";
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  return x;
+}
+
+nlohmann::json VectorJson(const Vector& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(NumberJson(v(i)));
+  return a;
+}
+
+Vector VectorFrom(const nlohmann::json& list, const std::string& where) {
+  if (!list.is_array()) throw std::invalid_argument(where + ": expected a list of numbers");
+  Vector v(static_cast<Eigen::Index>(list.size()));
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    v(static_cast<Eigen::Index>(i)) = JsonNumberValue(list[i], where + "[" + std::to_string(i) + "]");
+  }
+  return v;
 }
 
 }  // namespace hybridcont::study

@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "hybridcont/types.h"
+
 namespace hybridcont::study {
 
 [[noreturn]] void Malformed(const std::string& where, const std::string& what);
@@ -29,6 +31,12 @@ std::string JsonText(const nlohmann::json& object, const std::string& key, const
                      std::optional<std::string> fallback = {});
 // A list of strings; a missing one is empty.
 std::vector<std::string> JsonTexts(const nlohmann::json& object, const std::string& key, const std::string& where);
+
+// Writing side of the same convention: a number (NaN and infinities as "nan", "inf", "-inf") and a vector of them.
+nlohmann::json NumberJson(double x);
+nlohmann::json VectorJson(const Vector& v);
+// A list of numbers as a vector.
+Vector VectorFrom(const nlohmann::json& list, const std::string& where);
 
 }  // namespace hybridcont::study
 

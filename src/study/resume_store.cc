@@ -17,25 +17,6 @@ namespace {
 
 constexpr int kFormat = 1;
 
-nlohmann::json NumberJson(double x) {
-  if (std::isnan(x)) return "nan";
-  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-  return x;
-}
-
-nlohmann::json VectorJson(const Vector& v) {
-  nlohmann::json a = nlohmann::json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(NumberJson(v(i)));
-  return a;
-}
-
-Vector VectorFrom(const nlohmann::json& j, const std::string& where) {
-  if (!j.is_array()) throw std::invalid_argument(where + ": expected a list of numbers");
-  Vector v(static_cast<Eigen::Index>(j.size()));
-  for (std::size_t i = 0; i < j.size(); ++i) v(static_cast<Eigen::Index>(i)) = JsonNumberValue(j[i], where + "[" + std::to_string(i) + "]");
-  return v;
-}
-
 template <typename Enum>
 Enum EnumFrom(const nlohmann::json& j, const char* key, const std::string& where, Enum last) {
   const int v = JsonInt(j, key, where);
