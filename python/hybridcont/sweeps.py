@@ -256,9 +256,9 @@ def _study_at(m, point_id, values, options, out, document, starts, families_of, 
         if document is not None:
             starts = orbits_near_starts(study, document, starts)
     except ValueError as e:
-        # The options were checked before the sweep began: what fails here is this grid point's (a model file's
-        # start guess that does not converge at its parameters, a value outside a parameter's range): its rows
-        # say so. (A start the exploration cannot correct is the study's status start-failed, not an error.)
+        # The options and the grid's values were checked before the sweep began: what fails here is this grid
+        # point's (a model whose setup is refused at these parameters, a guided study whose guide is refused):
+        # its rows say so. (A start that does not converge is the study's status start-failed, not an error.)
         os.makedirs(partial, exist_ok=True)
         with open(os.path.join(partial, "error.txt"), "w") as f:
             f.write(str(e) + "\n")
@@ -536,6 +536,13 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     if unknown:
         raise ValueError("grid %s: model '%s' has no parameter '%s' (parameters: %s)"
                          % (unknown[0], m.name, unknown[0], ", ".join(m.parameters)))
+    probe = m.with_parameters()  # each grid value within its parameter's range (bad input, not a failed point)
+    for name, vals in values.items():
+        for v in vals:
+            try:
+                probe.set_parameter(name, v)
+            except ValueError as e:
+                raise ValueError("grid %s: the value %.12g: %s" % (name, v, e))
     model_text = None
     if isinstance(model, Model):
         # Workers get the model as data (its text, or its name or path): a Model object holds the library's

@@ -128,6 +128,10 @@ def test_the_tool_runs_a_sweep_and_refuses_a_bad_grid(tmp_path):
                           capture_output=True, text=True)
     assert proc.returncode == 2 and "grid kk: model 'slip' has no parameter 'kk'" in proc.stderr
     assert not os.path.exists(tmp_path / "bad")  # nothing written
+    proc = subprocess.run([tool, "sweep", "slip", "--grid", "k=-10:20:2", "--out", str(tmp_path / "range")],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2 and "grid k: the value -10:" in proc.stderr and "range" in proc.stderr, proc.stderr
+    assert not os.path.exists(tmp_path / "range")
     proc = subprocess.run([tool, "sweep", "slip", "--grid", "k=1:2"], capture_output=True, text=True)
     assert proc.returncode == 2 and "NAME=START:STOP:COUNT" in proc.stderr
     # Families in a free parameter at each grid point: explored whole (a guide continues families in H), said.
