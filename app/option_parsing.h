@@ -8,22 +8,10 @@
 #include <utility>
 #include <vector>
 
+#include "hybridcont/option_text.h"
 #include "hybridcont/study.h"
 
 namespace hybridcont::app {
-
-// "NAME=VALUE" (VALUE a finite real number).
-std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text);
-
-// "NAME=LOWER:UPPER" (either end may be empty for an unbounded side).
-struct BoundAssignment {
-  std::string name;
-  double lower, upper;
-};
-BoundAssignment ParseBound(const std::string& option, const std::string& text);
-
-// A real number that must be finite (decimal notation only).
-double ParseFinite(const std::string& option, const std::string& text);
 
 // The model named on the command line (a built-in or a model file, also looked up in the installation's
 // models folder) with `--set NAME=VALUE` assignments.

@@ -127,20 +127,10 @@ StudyOptions StudyOptionsOf(const RunArguments& args) {
     o.until.push_back({name, value});
   }
   for (const std::string& a : args.bounds) {
-    const BoundAssignment b = ParseBound("--bound", a);
-    o.bounds.push_back({b.name, b.lower, b.upper});
+    o.bounds.push_back(ParseBound("--bound", a));
   }
-  for (const std::string& a : args.monitors) {
-    // Several values of one observable: NAME=V1,V2,... (each checked as NAME=Vi).
-    const std::size_t eq = a.find('=');
-    if (eq == std::string::npos) ParseAssignment("--monitor", a);  // refused: expected NAME=VALUE
-    for (std::size_t begin = eq + 1;;) {
-      const std::size_t comma = std::min(a.find(',', begin), a.size());
-      const auto [name, value] = ParseAssignment("--monitor", a.substr(0, eq + 1) + a.substr(begin, comma - begin));
-      o.monitors.push_back({name, value});
-      if (comma == a.size()) break;
-      begin = comma + 1;
-    }
+  for (const std::string& a : args.monitors) {  // several values of one observable: NAME=V1,V2,...
+    for (const NamedValue& v : ParseAssignments("--monitor", a)) o.monitors.push_back(v);
   }
   o.rtol = args.rtol;
   o.atol = args.atol;
@@ -239,8 +229,8 @@ StudyHooks PrintingHooks(const RunArguments& args, bool terminal, std::ostream& 
   return hooks;
 }
 
-// report.html in `dir` (study_report.h), written whole (a temporary file renamed); false, with a note, when the
-// tool lacks its assets or the file cannot be written.
+// report.html in `dir` (study_report.h, SaveStudyReport); false, with a note, when the tool lacks its assets or
+// the file cannot be written.
 bool WriteReport(const StudyResult& study, const std::string& dir, const HybridModel* model, std::ostream& err) {
   const ReportAssets assets = ReportAssetsOfTool();
   if (const std::string missing = assets.Missing(); !missing.empty()) {
@@ -248,22 +238,20 @@ bool WriteReport(const StudyResult& study, const std::string& dir, const HybridM
         << " (the plotting library is installed from npm when the tool is built)\n";
     return false;
   }
-  const fs::path target = fs::path(dir) / "report.html", temporary = fs::path(dir) / ".report.html.tmp";
+  const std::string why = SaveStudyReport(study, dir, assets, model);
+  if (!why.empty()) err << "note: no report.html: " << why << "\n";
+  return why.empty();
+}
+
+// The model the study was computed on, for the report's animations; null, with the reason said, where it
+// cannot be rebuilt (its model file has gone or changed since).
+std::unique_ptr<HybridModel> ModelForReport(const StudyResult& study, std::ostream& err) {
   try {
-    const std::string html = StudyReportHtml(study, assets, model);
-    {
-      std::ofstream out(temporary, std::ios::binary);
-      out << html;
-      if (!out.flush()) throw std::runtime_error("cannot write " + temporary.string());
-    }
-    fs::rename(temporary, target);
-  } catch (const std::exception& e) {
-    std::error_code ec;
-    fs::remove(temporary, ec);
-    err << "note: no report.html: " << e.what() << "\n";
-    return false;
+    return std::make_unique<HybridModel>(ModelOfStudy(study, ModelsDirectory().string()));
+  } catch (const std::invalid_argument& e) {
+    err << "note: report.html without the orbits' animations: " << e.what() << "\n";
+    return nullptr;
   }
-  return true;
 }
 
 }  // namespace
@@ -291,8 +279,7 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
     return 1;
   }
   // The model again (compiled code cached) for the orbits' drawings; without it the report has no animations.
-  const std::unique_ptr<HybridModel> model =
-      MakeStudyModelIfKnown(options.model, options.parameters, options.models_directory);
+  const std::unique_ptr<HybridModel> model = ModelForReport(study, err);
   const bool report = WriteReport(study, dir, model.get(), err);
   out << fmt::format("results written to {}/ (summary.json, branch-*.csv, orbit-*.csv{})\n", dir,
                      report ? ", report.html: open it in a browser" : "");
@@ -324,9 +311,8 @@ int PlotCommand(const std::string& dir, const FigureOptions& figures, std::ostre
   if (rc == 0) {
     out << "figures written to " << dir << "/\n";
     const StudyResult study = LoadStudy(dir);
-    // a built-in model or a shipped model file by its name: the orbits drawn; otherwise none
-    const std::unique_ptr<HybridModel> model =
-        MakeStudyModelIfKnown(study.model, study.parameters, ModelsDirectory().string());
+    // the study's own model (its record: never another of the same name) draws the orbits
+    const std::unique_ptr<HybridModel> model = ModelForReport(study, err);
     if (WriteReport(study, dir, model.get(), err)) out << "report written to " << dir << "/report.html\n";
   }
   return rc == 0 ? 0 : rc == 2 ? 2 : 1;  // 2: the script found the results malformed (bad input)

@@ -952,7 +952,24 @@ def save(fig, res, name, svg, written):
         path = os.path.join(res.dir, name + "." + ext)
         fig.savefig(path, dpi=200 if ext == "png" else None, bbox_inches="tight")
         written.append(path)
+        record_figure(res.dir, path)
     plt.close(fig)
+
+
+def record_figure(folder, path):
+    """figures.txt lists every figure drawn into a results folder (one file name a line), so that the next study
+    written there removes them all (docs/results-format.md): none is left beside a study it does not show."""
+    manifest = os.path.join(folder, "figures.txt")
+    names = []
+    if os.path.exists(manifest):
+        with open(manifest, encoding="utf-8") as f:
+            names = [line for line in f.read().splitlines() if line]
+    name = os.path.basename(path)
+    if name in names:
+        return
+    with open(manifest + ".tmp", "w", encoding="utf-8") as f:
+        f.write("".join(n + "\n" for n in names + [name]))
+    os.replace(manifest + ".tmp", manifest)
 
 
 def physical_values(res, name, of=None):

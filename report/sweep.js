@@ -25,10 +25,15 @@
     const nx = data.grid[names[0]].length, ny = names.length > 1 ? data.grid[names[1]].length : 1;
     return Math.max(4, Math.min((el.clientWidth - 160) / nx, (el.clientHeight - 90) / ny) * 0.92);
   }
+  // "physical 1.2 .. 1.4, 1.6 .. 1.9": every disjoint interval of the table's "a..b;c..d".
+  function ranges(kind, text) {
+    if (!text) return '';
+    return '<br>' + kind + ' ' + text.split(';').map((r) => r.split('..').map((v) => fmt(Number(v))).join(' .. ')).join(', ');
+  }
   function describe(p, family) {
     const f = p.families[family] || {};
     return names.map((n) => n + ' = ' + fmt(p.values[n])).join(', ') + '<br>' + family + ': ' + CLASSES[f.class] +
-           (f.stable_from !== undefined && f.stable_from !== null ? '<br>stable ' + fmt(f.stable_from) + ' .. ' + fmt(f.stable_to) : '') +
+           ranges('physical', f.physical_ranges) + ranges('stable', f.stable_ranges) +
            '<br>' + p.status + ' · ' + p.strategy;
   }
   function draw() {

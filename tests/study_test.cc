@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "hybridcont/study.h"
+#include "hybridcont/study_answer.h"
 #include "hybridcont/study_report.h"
 #include "hybridcont/timebased_shooting.h"
 
@@ -103,6 +104,13 @@ TEST(Study, RunsWithoutAFolderAndItsFolderReadsBackAsTheSameStudy) {
       EXPECT_EQ(other->special_points[i].status, memory.special_points[i].status);
     }
   }
+  // The families, folded once, are the same in memory, as written and as read back (to the last bit).
+  for (const StudyResult* other : {&written, &loaded}) {
+    EXPECT_EQ(other->families, memory.families);
+    EXPECT_EQ(other->model_source.name, "slip");
+  }
+  EXPECT_EQ(written.model_source.kind, StudyModelSource::Kind::kBuiltin);
+  EXPECT_EQ(loaded.model_source.kind, StudyModelSource::Kind::kBuiltin);
   // The typed ranges say what the report says: hopping in place is stable from its PD to its BP.
   const StudyBranch& hopping = memory.branch(2);
   EXPECT_EQ(hopping.family, "hopping in place");
@@ -297,6 +305,109 @@ TEST(Study, OptionsArePlainData) {
   EXPECT_EQ(StudyOptions().threads, 1);  // a library caller's study takes one core
 }
 
+// A study records which model it ran (study.h, StudyModelSource): a model file named like a built-in model is
+// rebuilt from that file, never from the built-in of its name; a file that has changed or gone since is
+// refused with the reason; model text is rebuilt from the text the folder keeps.
+TEST(Study, AFolderRebuildsItsOwnModelOrSaysWhyNot) {
+  const fs::path dir = Scratch("identity"), elsewhere = Scratch("identity_model");
+  fs::create_directories(elsewhere);
+  std::string text = Contents(fs::path(HYBRIDCONT_SOURCE_DIR) / "models" / "slip.toml");
+  const std::string description = "description = \"spring-loaded inverted pendulum hopper with swing leg (paper §4.4), as a model file\"";
+  ASSERT_NE(text.find(description), std::string::npos);
+  text.replace(text.find(description), description.size(), "description = \"a SLIP of the user's own\"");
+  const fs::path file = elsewhere / "slip.toml";
+  std::ofstream(file) << text;
+  StudyOptions o;
+  o.model = file.string();
+  o.max_branches = 2;
+  o.out_dir = dir.string();
+  const StudyResult study = RunStudy(o);
+  EXPECT_EQ(study.model, "slip");
+  const StudyResult loaded = LoadStudy(dir.string());
+  EXPECT_EQ(loaded.model_source.kind, StudyModelSource::Kind::kFile);
+  EXPECT_EQ(loaded.model_source.path, fs::absolute(file).lexically_normal().string());
+  EXPECT_EQ(loaded.model_source.sha256.size(), 64u);
+  EXPECT_EQ(ModelOfStudy(loaded).description(), "a SLIP of the user's own");  // not the built-in's
+  EXPECT_NE(MakeStudyModel("slip").description(), "a SLIP of the user's own");
+  std::ofstream(file, std::ios::app) << "# edited\n";
+  try {
+    ModelOfStudy(loaded);
+    ADD_FAILURE() << "a changed model file is used";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("has changed since the study"), std::string::npos) << e.what();
+  }
+  fs::remove(file);
+  try {
+    ModelOfStudy(loaded);
+    ADD_FAILURE() << "a model file that has gone is replaced";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("is gone"), std::string::npos) << e.what();
+  }
+  // Model text: rebuilt from the folder alone.
+  o.model = "mine";
+  o.model_text = text;
+  o.overwrite = true;
+  RunStudy(o);
+  const StudyResult from_text = LoadStudy(dir.string());
+  EXPECT_EQ(from_text.model_source.kind, StudyModelSource::Kind::kText);
+  EXPECT_EQ(ModelOfStudy(from_text).description(), "a SLIP of the user's own");
+  // A model the caller built without text cannot be rebuilt: said, not guessed.
+  StudyOptions caller;
+  caller.max_branches = 2;
+  caller.out_dir = dir.string();
+  caller.overwrite = true;
+  RunStudy(MakeStudyModel("slip"), caller);
+  EXPECT_THROW(ModelOfStudy(LoadStudy(dir.string())), std::invalid_argument);
+  fs::remove_all(dir);
+  fs::remove_all(elsewhere);
+}
+
+// The fold of the branches' ranges into families: overlapping stretches of one family (two directions from a
+// start, a branch and its image) join, disjoint ones stay apart, each end as the answer says it.
+TEST(Study, FamiliesJoinOverlappingStretchesAndKeepDisjointOnesApart) {
+  const auto range = [](double from, double to, const std::string& family, int first, int last, int special_from = -1) {
+    Range r;
+    r.from.value = from, r.from.how = "start of the branch", r.from.special_point = special_from, r.from.located = true;
+    r.to.value = to, r.to.how = "end of the branch, bound-reached";
+    r.first_point = first, r.last_point = last, r.family = family;
+    return r;
+  };
+  std::vector<StudyBranch> branches(3);
+  for (int i = 0; i < 3; ++i) branches[i].id = i, branches[i].continued = "H";
+  branches[0].family = "A";
+  branches[0].ranges.physical = {range(1.0, 1.2, "A", 0, 4, 0), range(1.5, 1.8, "A", 8, 12)};
+  branches[0].ranges.stable = {range(1.05, 1.1, "A", 1, 2)};
+  branches[1].family = "A";
+  branches[1].ranges.physical = {range(1.3, 1.1, "A", 0, 5), range(2.5, 3.0, "B", 7, 9)};
+  branches[2].family = "B";
+  branches[2].ranges.physical = {range(2.0, 2.6, "B", 0, 6)};
+  std::vector<StudySpecialPoint> special(2);
+  special[0].id = 0, special[0].code = "PD", special[0].branch = 0, special[0].index = 3, special[0].status = "located";
+  special[1].id = 1, special[1].code = "BP", special[1].branch = 1, special[1].index = 20, special[1].status = "located";
+  const std::vector<StudyFamily> families = FoldFamilies(branches, special);
+  ASSERT_EQ(families.size(), 2u);
+  const StudyFamily& a = families[0];
+  EXPECT_EQ(a.name, "A");
+  EXPECT_EQ(a.continued, "H");
+  EXPECT_EQ(a.branches, (std::vector<int>{0, 1}));
+  ASSERT_EQ(a.physical.size(), 2u);  // [1.0, 1.3] and [1.5, 1.8]: the gap between stays a gap
+  EXPECT_EQ(a.physical[0].from, 1.0);
+  EXPECT_EQ(a.physical[0].to, 1.3);
+  EXPECT_EQ(a.physical[0].from_end, "PD0");
+  EXPECT_EQ(a.physical[0].to_end, "start of the branch");  // branch 1 runs down from 1.3
+  EXPECT_EQ(a.physical[1].from, 1.5);
+  EXPECT_EQ(a.physical[1].to, 1.8);
+  ASSERT_EQ(a.stable.size(), 1u);
+  EXPECT_EQ(a.special_points, (std::vector<std::string>{"PD0"}));  // BP1 lies on no physical stretch
+  const StudyFamily& b = families[1];
+  EXPECT_EQ(b.name, "B");
+  EXPECT_EQ(b.branches, (std::vector<int>{1, 2}));
+  ASSERT_EQ(b.physical.size(), 1u);
+  EXPECT_EQ(b.physical[0].from, 2.0);
+  EXPECT_EQ(b.physical[0].to, 3.0);
+  EXPECT_TRUE(b.stable.empty());
+}
+
 // The period-doubled family restarted from PD4 of a saved study is the family a run with period doubling
 // traces from it: the same rows, without recomputing the rest of the diagram.
 TEST(Study, RestartFromAPdPointGivesThePeriodDoubledFamilyOfTheFullRun) {
@@ -324,7 +435,47 @@ TEST(Study, RestartFromAPdPointGivesThePeriodDoubledFamilyOfTheFullRun) {
               Rows(full / ("branch-" + std::to_string(b.id) + ".csv")));
   }
   EXPECT_EQ(matched, 2);
+  // Its family, from the one place families are decided (families.h): named, physical and stable over the
+  // same ranges as in the whole run, in the result, the answer and the folder alike.
+  const auto family_of = [](const StudyResult& study) -> const StudyFamily* {
+    for (const StudyFamily& f : study.families) {
+      if (f.name == "period-doubled backward hopping / forward hopping") return &f;
+    }
+    return nullptr;
+  };
+  const StudyFamily* doubled = family_of(r);
+  const StudyFamily* in_whole = family_of(whole);
+  ASSERT_NE(doubled, nullptr);
+  ASSERT_NE(in_whole, nullptr);
+  ASSERT_FALSE(doubled->physical.empty());
+  ASSERT_EQ(doubled->physical.size(), in_whole->physical.size());
+  ASSERT_EQ(doubled->stable.size(), in_whole->stable.size());
+  for (std::size_t i = 0; i < doubled->physical.size(); ++i) {
+    EXPECT_DOUBLE_EQ(doubled->physical[i].from, in_whole->physical[i].from);
+    EXPECT_DOUBLE_EQ(doubled->physical[i].to, in_whole->physical[i].to);
+  }
+  for (const StudyBranch& b : r.branches) {
+    EXPECT_EQ(b.family, "period-doubled backward hopping / forward hopping");
+    EXPECT_FALSE(b.ranges.physical.empty());
+    int physical = 0;
+    for (const StudyPoint& p : b.points) physical += p.analysis.classification.physical;
+    EXPECT_GT(physical, 0);
+  }
+  // It leaves PD4 (H = 1.2828...) down to its fold (TP, H = 1.2827) and turns up to where an event grazes (GR):
+  // one stretch of H over its two halves, stable only between the fold and PD4.
+  ASSERT_EQ(doubled->physical.size(), 1u);
+  EXPECT_NEAR(doubled->physical.front().from, 1.282699643, 1e-7);
+  EXPECT_NEAR(doubled->physical.front().to, 1.427197748, 1e-8);
+  ASSERT_EQ(doubled->stable.size(), 1u);
+  EXPECT_NEAR(doubled->stable.front().to, 1.282809323809, 1e-8);
+  const std::string answer = OneScreenAnswer(r, 0);
+  EXPECT_NE(answer.find("2 branches with physical orbits of 2"), std::string::npos) << answer;
+  EXPECT_NE(answer.find("  period-doubled backward hopping / forward hopping: physical H "), std::string::npos) << answer;
+  EXPECT_EQ(LoadStudy(restarted.string()).families.size(), r.families.size());
   const nlohmann::json summary = nlohmann::json::parse(Contents(restarted / "summary.json"));
+  ASSERT_TRUE(summary["families"].is_array());
+  EXPECT_EQ(summary["families"][0]["name"], "period-doubled backward hopping / forward hopping");
+  EXPECT_EQ(summary["families"][0]["physical"][0]["from"].get<double>(), doubled->physical.front().from);
   EXPECT_EQ(summary["restarted_from"]["label"], "PD4");
   EXPECT_EQ(summary["restarted_from"]["kind"], "period-doubled");
   for (const fs::path& d : {full, saved, restarted}) fs::remove_all(d);
@@ -552,6 +703,27 @@ TEST(StudyReport, DataIsTheStudyAndScriptsStayClosed) {
   EXPECT_NE(page.find("var p = 1 </ 2;"), std::string::npos);  // not a script end: left alone
   EXPECT_EQ(page.find("/*HYBRIDCONT_"), std::string::npos);
   EXPECT_EQ(page.find("</SCRIPT>"), std::string::npos);
+  // A family's name that holds a marker of the template, or opens an HTML comment in the script, changes
+  // nothing of the page: the viewer is inserted once, where the template has it, and no "<" of the data is
+  // left for the HTML parser.
+  StudyResult hostile = study;
+  hostile.branches[2].family = "/*HYBRIDCONT_VIEWER*/<!--<script>";
+  const std::string hostile_page = StudyReportHtml(hostile, assets);
+  const std::size_t viewer = hostile_page.find("const s = ");
+  ASSERT_NE(viewer, std::string::npos);
+  EXPECT_EQ(hostile_page.find("const s = ", viewer + 1), std::string::npos);
+  EXPECT_EQ(hostile_page.find("<!--"), std::string::npos);
+  EXPECT_NE(hostile_page.find("/*HYBRIDCONT_VIEWER*/\\u003c!--\\u003cscript>"), std::string::npos);
+  // Saved whole: no temporary file left, in a folder that cannot be written the reason and nothing else.
+  const fs::path out = Scratch("report_save");
+  fs::create_directories(out);
+  EXPECT_EQ(SaveStudyReport(study, out, assets), "");
+  EXPECT_EQ(Contents(out / "report.html"), page);
+  int files = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(out)) ++files;
+  EXPECT_EQ(files, 1);
+  EXPECT_NE(SaveStudyReport(study, out / "absent", assets), "");
+  fs::remove_all(out);
   assets.plotly_js = dir / "absent.js";
   EXPECT_NE(assets.Missing().find("absent.js"), std::string::npos);
   EXPECT_THROW(StudyReportHtml(study, assets), std::runtime_error);

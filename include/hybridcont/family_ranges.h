@@ -34,6 +34,9 @@ struct RangeEnd {
 struct Range {
   RangeEnd from, to;       // in the order of the branch's points
   int first_point = 0, last_point = 0;
+  // The family the stretch belongs to, named by the model's family rules at its middle point (a stretch's ends
+  // may be shared with another family's). Set by a study; empty from RangesOnBranch.
+  std::string family;
 };
 
 struct BranchRanges {

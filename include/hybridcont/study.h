@@ -81,6 +81,25 @@ struct RestartSpec {
 };
 std::string ToString(RestartSpec::Kind kind);
 
+// Which model a study was computed on, recorded in its result and its folder ("model_source") so that a
+// study read back later draws and evaluates exactly that model, or says why it cannot (ModelOfStudy).
+struct StudyModelSource {
+  enum class Kind {
+    kBuiltin,  // a built-in model, by name
+    kFile,     // a model file: its absolute path and the SHA-256 of its text
+    kText,     // model-file text (Python's hc.model(text=...), ModelBuilder): the text and its SHA-256
+    kCaller,   // a model the caller built in C++ (RunStudy(model, ...)) without text: not rebuildable
+    kName,     // a folder written before the record existed: rebuilt by its name, as then
+  };
+  Kind kind = Kind::kBuiltin;
+  std::string name;    // the model's name (HybridModel::name)
+  std::string path;    // kFile
+  std::string sha256;  // kFile, kText: hex
+  std::string text;    // kText
+};
+std::string ToString(StudyModelSource::Kind kind);
+bool FromString(const std::string& text, StudyModelSource::Kind* kind);
+
 // Everything `hybridcont run` accepts, as plain data (no callbacks): copyable, comparable field by field,
 // and written into summary.json as the study's effective options.
 struct StudyOptions {
@@ -88,6 +107,10 @@ struct StudyOptions {
   // models_directory.
   std::string model;
   std::string models_directory;
+  // Model-file text: the study's model is made of it (`model` then only names it), or, with a caller's model
+  // (RunStudy(model, options)), the text that model was made of. Recorded in the result (StudyModelSource
+  // kText) so that its folder rebuilds the model, and part of the resume key.
+  std::string model_text;
   std::vector<NamedValue> parameters;  // model parameters set before the study (each name once)
   std::vector<NamedValue> until;       // each branch ends exactly where an unknown or observable reaches the value
   std::vector<NamedInterval> bounds;   // replace the model's bound on an unknown ("period": sum of durations)
@@ -177,6 +200,9 @@ struct StudyBranch {
   BranchRanges ranges;                     // where its orbits are physical and stable (family_ranges.h)
   int period_doubled_from = -1;            // the PD point a period-doubled family is born at
   int handed_over_from = -1;               // the word change it begins at (StudyResult::word_changes)
+
+  // Whether a special point after point `index` lies on (or at an end of) one of its physical stretches.
+  bool OnPhysicalStretch(int index) const;
 };
 
 // A located (or bracketed) special point of the study, in the layout of its branch.
@@ -226,6 +252,33 @@ struct StudyCurve {
   std::vector<Vector> points;        // in curve order, each in `columns` order
 };
 
+// A stretch of the continued coordinate: from <= to, each end said as the answer says it — a special point's
+// label ("PD4"; ", not located" where it was only bracketed) or how the end is known ("end of the branch,
+// bound-reached").
+struct FamilyInterval {
+  double from = 0, to = 0;
+  std::string from_end, to_end;
+  bool operator==(const FamilyInterval&) const = default;
+};
+
+// One family of the study, over every branch that holds its orbits (both directions from a start, the images
+// under symmetries, families reached by switching, restarts, period doubling, other words): where its orbits
+// are physical and where stable, as the union of its branches' ranges. Disjoint stretches stay disjoint.
+struct StudyFamily {
+  std::string name;                      // as the model's family rules name it (StudyBranch::family)
+  std::string continued;                 // the coordinate of its intervals (H or a free parameter)
+  std::vector<int> branches;             // the branches with a stretch of it, ascending
+  std::vector<FamilyInterval> physical;  // ascending, disjoint
+  std::vector<FamilyInterval> stable;    // ascending, disjoint
+  std::vector<std::string> special_points;  // labels of the located special points on its physical stretches
+  bool operator==(const StudyFamily&) const = default;  // exact: a study and the same study read back agree
+};
+
+// The families of a study's branches, in the order they are first met (StudyBranch::ranges, each range's
+// family). The one fold of ranges that every front end shows.
+std::vector<StudyFamily> FoldFamilies(const std::vector<StudyBranch>& branches,
+                                      const std::vector<StudySpecialPoint>& special_points);
+
 struct StudyWork {
   long rhs_evaluations = 0;          // the continuation's
   long map_evaluations = 0;
@@ -240,10 +293,12 @@ struct StudyWork {
 struct StudyResult {
   std::string version;               // of the library that computed (or wrote) it
   std::string model;
+  StudyModelSource model_source;       // which model it is (ModelOfStudy rebuilds it)
   std::vector<NamedValue> parameters;  // the model's parameter values
   std::vector<std::string> unknown_names;
   std::vector<StudyBranch> branches;   // id == index
   std::vector<StudySpecialPoint> special_points;  // id == index
+  std::vector<StudyFamily> families;   // FoldFamilies(branches, special_points)
   ExplorationStatus status = ExplorationStatus::kCompleted;
   std::string message;               // why it did not complete
   std::string report;                // the study's report in words
@@ -301,10 +356,15 @@ struct StudyHooks {
 HybridModel MakeStudyModel(const std::string& model, const std::vector<NamedValue>& parameters = {},
                            const std::string& models_directory = "", std::ostream* log = nullptr,
                            bool compile = true);
-// The same, or null where the library cannot make it (a model the caller built, a file that has gone): for
-// what only draws with the model (a report's animations).
-std::unique_ptr<HybridModel> MakeStudyModelIfKnown(const std::string& model, const std::vector<NamedValue>& parameters,
-                                                   const std::string& models_directory);
+// Where MakeStudyModel finds `model`: a built-in model, or a model file (its absolute path and digest).
+StudyModelSource FindStudyModel(const std::string& model, const std::string& models_directory = "");
+
+// The model a study was computed on, rebuilt from its record (StudyResult::model_source) at the study's
+// parameter values: the built-in model; the model file, if it is still there with the same text; the model
+// text. Throws std::invalid_argument saying why it cannot (the file is gone or has changed since; a model the
+// caller built) — never another model of the same name. `models_directory` serves folders written before the
+// record existed (rebuilt by name).
+HybridModel ModelOfStudy(const StudyResult& study, const std::string& models_directory = "", std::ostream* log = nullptr);
 
 // Validates the options (throws StudyOptionError / ModelInputError), prepares out_dir, runs the study.
 StudyResult RunStudy(const StudyOptions& options, const StudyHooks& hooks = {});

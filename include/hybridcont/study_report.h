@@ -37,6 +37,12 @@ inline constexpr int kAnimationFrames = 40;
 // report.html of the study. Throws std::runtime_error naming the asset that cannot be read.
 std::string StudyReportHtml(const StudyResult& study, const ReportAssets& assets, const HybridModel* model = nullptr);
 
+// Writes StudyReportHtml into dir/report.html whole: a temporary file of its own (unique to the call, so that
+// two writers of one folder never share one) renamed over it, removed when anything fails. Returns the reason
+// it was not written, empty when it was.
+std::string SaveStudyReport(const StudyResult& study, const std::filesystem::path& dir, const ReportAssets& assets,
+                            const HybridModel* model = nullptr);
+
 }  // namespace hybridcont
 
 #endif  // HYBRIDCONT_STUDY_REPORT_H_

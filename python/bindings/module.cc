@@ -33,6 +33,7 @@
 #include "hybridcont/orbit_trace.h"
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/shooting_layout.h"
+#include "hybridcont/option_text.h"
 #include "hybridcont/study.h"
 #include "hybridcont/study_answer.h"
 #include "hybridcont/study_report.h"
@@ -44,9 +45,12 @@ namespace hybridcont::python {
 
 namespace {
 
-// ---- Ctrl-C: a flag the study's stop request reads, set by a SIGINT handler installed for one call.
-std::atomic<bool> interrupted{false};
-extern "C" void OnInterrupt(int) { interrupted = true; }
+// ---- Ctrl-C: a count of SIGINTs, raised by a handler installed while studies run. Each study remembers the
+// count it began with, so that a Ctrl-C stops every study running then and no later study forgets it (a
+// lock-free atomic: safe in a signal handler).
+std::atomic<long> interrupts{0};
+static_assert(std::atomic<long>::is_always_lock_free);
+extern "C" void OnInterrupt(int) { interrupts.fetch_add(1); }
 
 // Studies may run on several Python threads at once: the handler is installed by the first and the previous
 // one restored by the last (a count under a mutex), and a Ctrl-C stops them all. A SIGINT the process ignores
@@ -56,7 +60,6 @@ class InterruptGuard {
   InterruptGuard() {
     std::lock_guard<std::mutex> lock(mutex_);
     if (depth_++ > 0) return;
-    interrupted = false;
     struct sigaction action {};
     action.sa_handler = OnInterrupt;
     sigemptyset(&action.sa_mask);
@@ -98,6 +101,7 @@ StudyOptions OptionsOf(const py::dict& d) {
   StudyOptions o;
   o.model = Get<std::string>(d, "model", "");
   o.models_directory = Get<std::string>(d, "models_directory", "");
+  o.model_text = Get<std::string>(d, "model_text", "");
   o.parameters = NamedValues(d, "parameters");
   o.until = NamedValues(d, "until");
   o.monitors = NamedValues(d, "monitors");
@@ -283,24 +287,39 @@ ReportAssets AssetsOf(const py::dict& assets) {
                       assets["viewer_css"].cast<std::string>(), assets["plotly_js"].cast<std::string>()};
 }
 
-// Writes report.html into the study's folder (as the command line does, atomically); the reason it could not,
-// empty when written.
-std::string WriteReport(const StudyResult& study, const std::string& dir, const ReportAssets& assets,
-                        const HybridModel* model, const std::string& models_directory) {
-  if (const std::string missing = assets.Missing(); !missing.empty()) return "the report's files are missing: " + missing;
-  const std::unique_ptr<HybridModel> built = model ? nullptr : MakeStudyModelIfKnown(study.model, study.parameters, models_directory);
+// The study's own model (its record, ModelOfStudy) for a report's animations; null, with the reason, where it
+// cannot be rebuilt.
+std::unique_ptr<HybridModel> ModelForReport(const StudyResult& study, const std::string& models_directory,
+                                            std::string* why) {
   try {
-    const std::filesystem::path path = std::filesystem::path(dir) / "report.html";
-    {
-      std::ofstream f(path.string() + ".tmp", std::ios::binary);
-      f << StudyReportHtml(study, assets, model ? model : built.get());
-      if (!f.flush()) return "cannot write " + path.string() + ".tmp";
-    }
-    std::filesystem::rename(path.string() + ".tmp", path);
-  } catch (const std::exception& e) {
-    return e.what();
+    return std::make_unique<HybridModel>(ModelOfStudy(study, models_directory));
+  } catch (const std::invalid_argument& e) {
+    *why = e.what();
+    return nullptr;
   }
-  return "";
+}
+
+// The study's families (FoldFamilies): one dict per family and kind of stretch, one entry per interval.
+py::list FamiliesOf(const StudyResult& study) {
+  py::list out;
+  for (const StudyFamily& f : study.families) {
+    for (const bool physical : {true, false}) {
+      for (const FamilyInterval& i : physical ? f.physical : f.stable) {
+        py::dict row;
+        row["family"] = f.name;
+        row["kind"] = physical ? "physical" : "stable";
+        row["continued"] = f.continued;
+        row["from"] = i.from;
+        row["to"] = i.to;
+        row["from_end"] = i.from_end;
+        row["to_end"] = i.to_end;
+        row["branches"] = f.branches;
+        row["special_points"] = f.special_points;
+        out.append(row);
+      }
+    }
+  }
+  return out;
 }
 
 py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& model, const py::object& on_progress,
@@ -313,14 +332,18 @@ py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& mod
   // exception in a callback ends the study like Ctrl-C and is raised again afterwards.
   std::string callback_error;
   std::atomic<bool> stop_this{false};  // this call's own stop (a callback that failed), beside Ctrl-C's
+  // Interrupted: a Ctrl-C since this call began, or a KeyboardInterrupt raised in one of its callbacks.
+  const long interrupts_before = interrupts.load();
+  std::atomic<bool> interrupted_here{false};
+  const auto interrupted = [&] { return interrupted_here.load() || interrupts.load() != interrupts_before; };
   const auto call = [&](const py::object& f, auto&&... args) {
-    if (f.is_none() || interrupted || stop_this) return;
+    if (f.is_none() || interrupted() || stop_this) return;
     py::gil_scoped_acquire acquire;
     try {
       f(std::forward<decltype(args)>(args)...);
     } catch (py::error_already_set& e) {
       if (e.matches(PyExc_KeyboardInterrupt)) {
-        interrupted = true;
+        interrupted_here = true;
       } else {
         callback_error = e.what();
         stop_this = true;
@@ -336,7 +359,7 @@ py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& mod
     };
   }
   if (!on_note.is_none()) hooks.on_note = [&](const std::string& line) { call(on_note, line); };
-  hooks.stop_requested = [&stop_this] { return interrupted.load() || stop_this.load(); };
+  hooks.stop_requested = [&] { return interrupted() || stop_this.load(); };
   StudyResult result;
   std::string report_error;
   {
@@ -344,7 +367,10 @@ py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& mod
     py::gil_scoped_release release;
     result = model ? RunStudy(*model, options, hooks) : RunStudy(options, hooks);
     if (assets && !options.out_dir.empty()) {
-      report_error = WriteReport(result, options.out_dir, *assets, model.get(), options.models_directory);
+      std::string why;
+      const std::unique_ptr<HybridModel> built = model ? nullptr : ModelForReport(result, options.models_directory, &why);
+      report_error = SaveStudyReport(result, options.out_dir, *assets, model ? model.get() : built.get());
+      if (report_error.empty() && !why.empty()) report_error = "written without the orbits' animations: " + why;
     }
   }
   if (!callback_error.empty()) throw std::runtime_error("a callback of the study failed: " + callback_error);
@@ -354,11 +380,12 @@ py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& mod
   out["version"] = result.version;
   out["status"] = ToString(result.status);
   out["message"] = result.message;
-  out["interrupted"] = interrupted.load();
+  out["interrupted"] = interrupted();
   out["write_error"] = result.write_error;
   out["wall_seconds"] = result.work.wall_seconds;
   out["answer"] = OneScreenAnswer(result, result.work.wall_seconds);
   out["report"] = result.report;
+  out["families"] = FamiliesOf(result);
   return out;
 }
 
@@ -376,6 +403,7 @@ py::dict LoadStudyFromPython(const std::string& dir) {
   out["model"] = study.model;
   out["version"] = study.version;
   out["answer"] = OneScreenAnswer(study, study.work.wall_seconds);
+  out["families"] = FamiliesOf(study);
   return out;
 }
 
@@ -387,7 +415,8 @@ std::string ReportHtml(const std::string& dir, const py::dict& assets, const Mod
   }
   py::gil_scoped_release release;  // reading the folder, building the model (compiled on first use), drawing
   const StudyResult study = LoadStudy(dir);
-  const std::unique_ptr<HybridModel> built = model ? nullptr : MakeStudyModelIfKnown(study.model, study.parameters, models_directory);
+  std::string why;  // without the model: no animations (Study.report_html's page says nothing of them then)
+  const std::unique_ptr<HybridModel> built = model ? nullptr : ModelForReport(study, models_directory, &why);
   return StudyReportHtml(study, a, model ? model.get() : built.get());
 }
 
@@ -529,6 +558,34 @@ PYBIND11_MODULE(_hybridcont, m) {
         py::arg("on_progress") = py::none(), py::arg("on_point") = py::none(), py::arg("on_note") = py::none(),
         py::arg("report_assets") = py::none());
   m.def("load_study", &LoadStudyFromPython, py::arg("dir"));
+  m.def(
+      "parse_assignments",
+      [](const std::string& option, const std::string& text) {
+        std::vector<std::pair<std::string, double>> out;
+        for (const NamedValue& v : ParseAssignments(option, text)) out.emplace_back(v.name, v.value);
+        return out;
+      },
+      py::arg("option"), py::arg("text"),
+      "NAME=VALUE or NAME=V1,V2,... as [(name, value)], checked as the command line checks it (ValueError naming "
+      "the option and the text: an empty name, a value that is not a finite decimal number).");
+  m.def(
+      "parse_bound",
+      [](const std::string& option, const std::string& text) {
+        const NamedInterval b = ParseBound(option, text);
+        return std::make_tuple(b.name, b.lower, b.upper);
+      },
+      py::arg("option"), py::arg("text"), "NAME=LOWER:UPPER as (name, lower, upper), checked as the command line checks it.");
+  m.def(
+      "model_of_study",
+      [](const std::string& dir, const std::string& models_directory) {
+        py::gil_scoped_release release;  // reading the folder, building (compiling) the model
+        const StudyResult study = LoadStudy(dir);
+        return Share(ModelOfStudy(study, models_directory));
+      },
+      py::arg("dir"), py::arg("models_directory") = "",
+      "The model a saved study was computed on, at its parameter values, rebuilt from its record "
+      "(ValueError saying why it cannot: its model file is gone or has changed, or the model was built by the "
+      "caller).");
   m.def(
       "check_options",
       [](const py::dict& options) {

@@ -26,7 +26,7 @@ import pandas as pd
 
 from . import _hybridcont as native
 from . import _paths
-from .models import Model, model as make_model
+from .models import Model
 
 _TEMPORARY = []
 
@@ -149,6 +149,8 @@ def run(model, out=None, progress=True, report=True, **options):
         _TEMPORARY.append(out)
         options["overwrite"] = True
     opts = _options(name, os.fspath(out), **options)
+    if isinstance(model, Model) and model.text is not None:
+        opts["model_text"] = model.text  # recorded: the folder rebuilds this model, and resume sees an edit
     on_progress, close = _progress(progress)
     try:
         # report.html written as the command line writes it, from the study in memory
@@ -209,6 +211,7 @@ class Study:
         self.model_name = info["model"]
         self.version = info["version"]
         self._answer = info["answer"]
+        self._families = list(info["families"])
         self.interrupted = bool(result and result["interrupted"])
         self.write_error = result["write_error"] if result else ""
         self.wall_seconds = result["wall_seconds"] if result else None
@@ -291,18 +294,14 @@ class Study:
 
     @property
     def families(self):
-        """Where each family is physical and where stable: one row per range (family, branch, kind, from, to,
-        how each end is known, the special points at the ends, first and last point)."""
-        def make():
-            rows = []
-            for b in self.summary.get("branches") or []:
-                for kind in ("physical", "stable"):
-                    for r in b.get(kind + "_ranges") or []:
-                        row = {"family": r.get("family") or b.get("family"), "branch": b["id"], "kind": kind}
-                        row.update({k: v for k, v in r.items() if k != "family"})
-                        rows.append(row)
-            return pd.DataFrame(rows)
-        return self._table("families", make)
+        """Where each family is physical and where stable, over all its branches (the library's one fold of
+        the branches' ranges, as the one-screen answer and a sweep's table say it): one row per interval —
+        family, kind ("physical" or "stable"), continued (the coordinate: H or the free parameter), from, to
+        (from <= to), from_end and to_end (the special point's label at the end, or how the end is known),
+        branches and special_points (the labels of the located special points on its physical stretches).
+        Disjoint intervals are separate rows."""
+        columns = ["family", "kind", "continued", "from", "to", "from_end", "to_end", "branches", "special_points"]
+        return self._table("families", lambda: pd.DataFrame(self._families, columns=columns))
 
     @property
     def word_changes(self):
@@ -352,23 +351,30 @@ class Study:
         return row.iloc[0][self.unknowns].to_numpy(dtype=float)
 
     def _model(self):
+        """The study's own model at its parameter values: the one given, else rebuilt from the folder's record of
+        it (ValueError where it cannot be: never another model of the same name)."""
         if self.model is None:
-            self.model = make_model(self.model_name)
-            for name, value in (self.summary.get("parameters") or {}).items():
-                self.model.set_parameter(name, value)
+            source = self.summary.get("model_source") or {}
+            self.model = Model(native.model_of_study(self.path, _paths.MODELS),
+                               source=source.get("path") or source.get("name"), text=source.get("text"))
         return self.model
 
     def _map(self):
         o = self.summary.get("options") or {}
         return {"free": o.get("free") or [], "fix": o.get("fixed") or {}}
 
+    def _tolerances(self):
+        """The study's integrator tolerances (its effective options): a point is evaluated as it was computed."""
+        integrator = (self.summary.get("options") or {}).get("integrator") or {}
+        return {"rtol": integrator.get("rtol"), "atol": integrator.get("atol")}
+
     def evaluate(self, branch, index, jacobian=True):
         """r and dr of the time-based map at a point of the study (Model.evaluate)."""
-        return self._model().evaluate(self.u(branch, index), jacobian=jacobian, **self._map())
+        return self._model().evaluate(self.u(branch, index), jacobian=jacobian, **self._map(), **self._tolerances())
 
     def floquet(self, branch, index):
         """The monodromy matrix and Floquet multipliers at a point of the study (Model.floquet)."""
-        return self._model().floquet(self.u(branch, index), **self._map())
+        return self._model().floquet(self.u(branch, index), **self._map(), **self._tolerances())
 
     def monodromy(self, branch, index):
         """Φ_T at a point of the study."""
@@ -382,7 +388,7 @@ class Study:
         if free:
             m = m.with_parameters(**{p: u[self.unknowns.index(p)] for p in free})
             u = u[: len(u) - len(free)]
-        return m.orbit(u, samples)
+        return m.orbit(u, samples, **self._tolerances())
 
     # ---- restart, save ----------------------------------------------------------------------------------
     def continue_from(self, label, as_="auto", out=None, progress=True, **options):
@@ -442,7 +448,7 @@ class Study:
         return self._answer
 
     def __repr__(self):
-        n_families = len({f for f in (b.get("family") for b in self.summary.get("branches") or []) if f})
+        n_families = len({row["family"] for row in self._families})
         return "<hybridcont.Study %s: %d branches, %d families, %d special points, %s; %s>" % (
             self.model_name, len(self.summary.get("branches") or []), n_families,
             len(self.summary.get("special_points") or []), self.status, self.path)

@@ -90,48 +90,50 @@ def grid_points(values):
     return points
 
 
+def _intervals_text(intervals):
+    """"1.2..1.4;1.6..1.9": a family's disjoint intervals, in full precision."""
+    return ";".join("%.17g..%.17g" % (a, b) for a, b in intervals)
+
+
 def family_rows(study, point_id, values, families=None):
-    """The tidy rows of one grid point: one per family of its study (of `families` only, when given)."""
-    summary = study.summary
-    names = [f for f in (summary.get("presentation") or {}).get("families") or []]
-    special = {sp["id"]: sp for sp in summary.get("special_points") or []}
+    """The tidy rows of one grid point: one per family of its study (of `families` only, when given), from the
+    study's own fold of its branches' ranges (Study.families: the numbers its one-screen answer prints).
+    physical_from/to and stable_from/to are the first start and the last end; physical_ranges and
+    stable_ranges list every disjoint interval, so a gap inside is never called physical or stable."""
+    names = [f for f in (study.summary.get("presentation") or {}).get("families") or []]
+    special = study.special_points.set_index("label") if len(study.special_points) else None
     found = {}
-    for b in summary.get("branches") or []:
-        family = b.get("family")
-        if not family:
-            continue
-        if family not in names:
-            names.append(family)
-        row = found.setdefault(family, {"branches": [], "physical": [], "stable": [], "special_points": set()})
-        row["branches"].append(b["id"])
-        for kind in ("physical", "stable"):
-            for r in b.get(kind + "_ranges") or []:
-                row[kind].append((min(r["from"], r["to"]), max(r["from"], r["to"])))
-        for sp in special.values():
-            if sp["branch"] == b["id"] and sp.get("duplicate_of", -1) < 0 and sp["type"] != "start" \
-                    and sp.get("status") == "located":
-                at = sp.get("H")
-                row["special_points"].add("%s%d" % (sp["type"], sp["id"]) + ("@%.10g" % at if at is not None else ""))
+    for r in study.families.itertuples(index=False):
+        if r.family not in names:
+            names.append(r.family)
+        row = found.setdefault(r.family, {"physical": [], "stable": [], "special_points": list(r.special_points)})
+        row[r.kind].append((r[3], r[4]))  # from, to
     if families:
-        names = [f for f in families]
+        names = list(families)
     rows = []
     for family in names:
         f = found.get(family)
+        labels = []
+        for label in (f["special_points"] if f else []):
+            at = special.loc[label, "H"] if special is not None and label in special.index else None
+            labels.append(label + ("@%.10g" % at if at is not None and not pd.isna(at) else ""))
         row = dict(values)
         row.update({"point": point_id, "family": family, "exists": f is not None,
                     "physical": bool(f and f["physical"]), "stable": bool(f and f["stable"]),
-                    "physical_from": min((a for a, _ in f["physical"]), default=np.nan) if f else np.nan,
-                    "physical_to": max((b for _, b in f["physical"]), default=np.nan) if f else np.nan,
-                    "stable_from": min((a for a, _ in f["stable"]), default=np.nan) if f else np.nan,
-                    "stable_to": max((b for _, b in f["stable"]), default=np.nan) if f else np.nan,
-                    "special_points": ";".join(sorted(f["special_points"])) if f else "",
+                    "physical_from": f["physical"][0][0] if f and f["physical"] else np.nan,
+                    "physical_to": f["physical"][-1][1] if f and f["physical"] else np.nan,
+                    "stable_from": f["stable"][0][0] if f and f["stable"] else np.nan,
+                    "stable_to": f["stable"][-1][1] if f and f["stable"] else np.nan,
+                    "physical_ranges": _intervals_text(f["physical"]) if f else "",
+                    "stable_ranges": _intervals_text(f["stable"]) if f else "",
+                    "special_points": ";".join(sorted(labels)),
                     "status": study.status})
         rows.append(row)
     if not rows:  # no family anywhere: the point is still in the table, once
         row = dict(values)
         row.update({"point": point_id, "family": "", "exists": False, "physical": False, "stable": False,
                     "physical_from": np.nan, "physical_to": np.nan, "stable_from": np.nan, "stable_to": np.nan,
-                    "special_points": "", "status": study.status})
+                    "physical_ranges": "", "stable_ranges": "", "special_points": "", "status": study.status})
         rows.append(row)
     return rows
 
@@ -219,7 +221,7 @@ def _failed_rows(point_id, values, message):
     row = dict(values)
     row.update({"point": point_id, "family": "", "exists": False, "physical": False, "stable": False,
                 "physical_from": np.nan, "physical_to": np.nan, "stable_from": np.nan, "stable_to": np.nan,
-                "special_points": "", "status": "failed: " + (message.splitlines() or ["(no message)"])[0][:300]})
+                "physical_ranges": "", "stable_ranges": "", "special_points": "", "status": "failed: " + (message.splitlines() or ["(no message)"])[0][:300]})
     return [row]
 
 
@@ -550,8 +552,10 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
         options = dict(options, set=dict(m.parameters, **(options.get("set") or {})))
         model_text = model.text
         model = None if model_text is not None else model.source
+    if isinstance(model, os.PathLike):
+        model = os.fspath(model)
     if isinstance(model, str) and model.endswith(".toml") and os.path.exists(model):
-        model = os.path.abspath(model)  # the workers may run elsewhere
+        model = os.path.abspath(model)  # the workers may run elsewhere (a str or a pathlib.Path alike)
     if model_text is None:
         from .study import check
         check(model, **dict(options, curves=curves) if curves is not None else options)
@@ -872,6 +876,8 @@ def write_report(out):
                 r = f.iloc[0]
                 for key in ("physical_from", "physical_to", "stable_from", "stable_to"):
                     item[key] = float(r[key]) if r[key] not in ("", None) and not pd.isna(r[key]) else None
+                for key in ("physical_ranges", "stable_ranges"):  # every disjoint interval
+                    item[key] = str(r[key]) if key in r and not pd.isna(r[key]) else ""
                 item["special_points"] = str(r.special_points)
             entry["families"][family] = item
         points.append(entry)
@@ -932,28 +938,38 @@ def _parse_grid(text):
     if not name or len(parts) != 3:
         raise argparse.ArgumentTypeError("--grid '%s': expected NAME=START:STOP:COUNT" % text)
     try:
-        return name, (float(parts[0]), float(parts[1]), int(parts[2]))
+        start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
     except ValueError:
         raise argparse.ArgumentTypeError("--grid '%s': START and STOP are numbers, COUNT a whole number" % text)
+    if not (np.isfinite(start) and np.isfinite(stop)):
+        raise argparse.ArgumentTypeError("--grid '%s': START and STOP must be finite" % text)
+    return name, (start, stop, count)
 
 
 def _parse_bound(text):
-    name, _, spec = text.partition("=")
-    parts = spec.split(":")
+    """NAME=LO:HI (either side may be empty) as (name, (lo, hi)), None for an open side; checked by the library."""
+    from . import _hybridcont as native
     try:
-        if not name or len(parts) != 2:
-            raise ValueError
-        return name, tuple(float(v) if v.strip() else None for v in parts)
-    except ValueError:
-        raise argparse.ArgumentTypeError("--bound '%s': expected NAME=LO:HI (either side may be empty)" % text)
+        name, lower, upper = native.parse_bound("--bound", text)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e))
+    return name, (None if np.isinf(lower) else lower, None if np.isinf(upper) else upper)
+
+
+def _parse_pairs(text, option):
+    """NAME=VALUE or NAME=V1,V2,... as [(name, value)], checked by the library as `hybridcont run` checks it."""
+    from . import _hybridcont as native
+    try:
+        return native.parse_assignments(option, text)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e))
 
 
 def _parse_pair(text, option):
-    name, _, value = text.partition("=")
-    try:
-        return name, float(value)
-    except ValueError:
-        raise argparse.ArgumentTypeError("%s '%s': expected NAME=VALUE" % (option, text))
+    pairs = _parse_pairs(text, option)
+    if len(pairs) != 1:
+        raise argparse.ArgumentTypeError("%s '%s': expected NAME=VALUE (one value)" % (option, text))
+    return pairs[0]
 
 
 def main(argv=None):
@@ -984,8 +1000,8 @@ def main(argv=None):
                         "traces only what led to it")
     p.add_argument("--curves", help="a grid parameter P: on every grid line along P, one grid point continues its "
                                     "families' special points in (H, P); the report draws them over the ranges")
-    p.add_argument("--monitor", action="append", default=[], type=lambda t: _parse_pair(t, "--monitor"),
-                   help="NAME=VALUE: locate where an observable takes the value (repeatable)")
+    p.add_argument("--monitor", action="append", default=[], type=lambda t: _parse_pairs(t, "--monitor"),
+                   help="NAME=VALUE or NAME=V1,V2,...: locate where an observable takes the values (repeatable)")
     p.add_argument("--period-doubling", action="store_true")
     p.add_argument("--one-word", action="store_true")
     p.add_argument("--free", help="a parameter continued instead of H (with --fix; every grid point explored whole)")
@@ -994,8 +1010,9 @@ def main(argv=None):
     import warnings  # the command line says the sweep's warnings as notes, without Python's file and line
     warnings.showwarning = lambda message, *rest, **named: print("note: %s" % message, file=sys.stderr)
     monitors = {}
-    for name, value in args.monitor:
-        monitors.setdefault(name, []).append(value)
+    for pairs in args.monitor:
+        for name, value in pairs:
+            monitors.setdefault(name, []).append(value)
     options = {"set": dict(args.set), "until": dict(args.until), "bound": dict(args.bound), "monitor": monitors,
                "rtol": args.rtol, "atol": args.atol, "max_branches": args.max_branches,
                "formulation": args.formulation, "no_symmetry": args.no_symmetry,

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -135,7 +136,8 @@ std::string PublishEntry(const fs::path& compiled, const CacheEntry& entry, cons
   if (ec) return "cannot restrict the mode of " + compiled.string();
   const std::string digest = Sha256OfFile(compiled);
   if (digest.empty()) return "cannot read " + compiled.string();
-  const fs::path record = entry.record.string() + "." + std::to_string(getpid());
+  static std::atomic<long> calls{0};  // one name per call: two threads may publish the same model at once
+  const fs::path record = entry.record.string() + "." + std::to_string(getpid()) + "-" + std::to_string(calls.fetch_add(1));
   {
     std::ofstream out(record);
     out << kRecordHeader << "\nkey " << key << "\nlibrary-sha256 " << digest << "\n";

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -416,9 +417,11 @@ std::shared_ptr<const CompiledPrograms> CompileModel(const ExpressionModelSpec& 
     if (options.log) *options.log << "note: the cached model " << entry.library.string() << " is not used (" << why << "); compiling it again\n";
     RemoveEntry(entry);
   }
-  // Compiled under names of this process, loaded from there, then published.
-  const std::string stem = "model-" + key + "." + std::to_string(getpid());
-  const fs::path src = cache / (stem + ".cc"), tmp = cache / (stem + ".so"), log = cache / ("model-" + key + ".log");
+  // Compiled under names of this process and this call (two threads of one process, a Dask worker's, may
+  // compile the same model at once), loaded from there, then published.
+  static std::atomic<long> calls{0};
+  const std::string stem = "model-" + key + "." + std::to_string(getpid()) + "-" + std::to_string(calls.fetch_add(1));
+  const fs::path src = cache / (stem + ".cc"), tmp = cache / (stem + ".so"), log = cache / (stem + ".log");
   {
     std::ofstream f(src);
     f << code;

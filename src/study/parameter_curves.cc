@@ -217,7 +217,7 @@ nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& se
     }
     const int id = static_cast<int>(curves.size());
     const std::string file = "curve_" + std::to_string(id) + ".csv";
-    if (!dir.empty() && !WriteCurve(curve, p, dir / file)) throw std::runtime_error("writing " + (dir / file).string() + " failed");
+    if (!dir.empty() && !WriteCurve(curve, p, dir / file)) throw CurveFileError("writing " + (dir / file).string() + " failed");
     const auto column = [&](const std::string& name) {
       return static_cast<int>(std::find(curve.unknown_names.begin(), curve.unknown_names.end(), name) -
                               curve.unknown_names.begin());
@@ -269,7 +269,7 @@ nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& se
     curve.points = points;
     const int id = static_cast<int>(curves.size());
     const std::string file = "curve_" + std::to_string(id) + ".csv";
-    if (!dir.empty() && !WriteCurve(curve, p, dir / file)) throw std::runtime_error("writing " + (dir / file).string() + " failed");
+    if (!dir.empty() && !WriteCurve(curve, p, dir / file)) throw CurveFileError("writing " + (dir / file).string() + " failed");
     curves.push_back({{"id", id},
                       {"type", "boundary"},
                       {"name", boundary.name + " = 0"},

@@ -24,6 +24,7 @@
 #define HYBRIDCONT_STUDY_PARAMETER_CURVES_H_
 
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -33,6 +34,12 @@
 #include "run_setup.h"
 
 namespace hybridcont::study {
+
+// A curve's file could not be written (a full disk): the study records it as its write error and stops writing.
+class CurveFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 // Traces the curves of diagram's special points (model units, the model's layout) in
 // setup.curve_parameter within setup.curve_bound and the scenario's H bound, writes their files into

@@ -4,12 +4,15 @@
 
 #include <cmath>
 #include <map>
+#include <optional>
+#include <set>
 #include <vector>
 
 #include "hybridcont/family_ranges.h"
 #include "hybridcont/floquet.h"
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/timebased_shooting.h"
+#include "families.h"
 #include "model_exploration.h"
 #include "point_analysis.h"
 #include "scenario.h"
@@ -43,11 +46,6 @@ ExplorationOptions DoubledOptions(const ExplorationOptions& run, const ShootingL
   return o;
 }
 
-// What the family's accepted points said, per branch id of the run.
-struct FamilyLog {
-  std::map<int, std::vector<double>> stable, H;
-};
-
 std::string Multipliers(const FloquetResult& f) {
   std::string text;
   for (const std::complex<double>& mu : f.nontrivial) {
@@ -72,24 +70,24 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
   std::string report = "Period-doubled families (the phase sequence traversed twice, model " + doubled.name() + "):\n";
   int next_branch = static_cast<int>(diagram.branches.size());
   int families = 0;
+  const FamilyNamer name_of = PeriodDoubledNamer(setup.scenario.describe, parent, layout);
+  std::string family_lines;  // where each family's orbits are physical and stable (families.h)
   for (const SpecialPoint& pd : diagram.special_points) {
     const bool located_pd = pd.type == SpecialPointType::kPeriodDoubling && pd.status == LocationStatus::kLocated;
     if (!located_pd || pd.duplicate_of >= 0 || pd.u.size() == 0) continue;
     const Vector& u_pd = pd.u;
     const int pd_id = pd.id;
     const int offset = next_branch;
-    FamilyLog log;
+    std::set<int> begun;  // the family's branch ids with a point so far
     ModelExploration exploration(doubled, scenario, setup.integrator, options, Formulation::kTimeBased, setup.free);
     exploration.set_branch_store(writer.resume_store(), offset);
     BifurcationDiagram d = exploration.RunPeriodDoubled(parent, u_pd, [&](const ProgressInfo& info, const Vector& u) {
       const int id = info.branch_id + offset;
-      if (log.H.find(id) == log.H.end()) writer.SetBranchModel(id, doubled, "period-doubled");
+      if (begun.insert(id).second) writer.SetBranchModel(id, doubled, "period-doubled");
       PointRecord record = RecordOf(info, u);
       SetFreeParameters(layout, u, &at_point);
       const auto known = exploration.KnownBranchPointAnalysis(u);
       AnalyzePoint(at_point, setup.integrator, floquet_map, replay, &record, known ? &*known : nullptr);
-      log.stable[id].push_back(record.extra[1].second);
-      log.H[id].push_back(u(layout.continued_index()));
       writer.AddPoint(id, record);
     });
     const FloquetResult at_pd = ComputeFloquet(parent_map, u_pd);
@@ -109,21 +107,22 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
     }
     for (const Branch& b : d.branches) {
       writer.EndBranch(b);
-      // Where the stability changes: at the special point located between the two points (family_ranges.h),
-      // else between them, not located (the later point's value).
+      // Its family and ranges (families.h), from the typed analysis of its points; where the stability changes:
+      // at the special point located between the two points (family_ranges.h), else between them, not located
+      // (the later point's value).
+      family_lines += AssignBranchFamily(b, layout, name_of, writer);
       nlohmann::json changes = nlohmann::json::array();
-      const std::vector<double>& stable = log.stable[b.id];
-      std::vector<bool> physical(stable.size()), is_stable(stable.size()), boundary(stable.size(), false);
-      for (size_t i = 0; i < stable.size(); ++i) physical[i] = std::isfinite(stable[i]), is_stable[i] = stable[i] == 1;
-      const BranchRanges ranges = physical.size() == b.points.size()
-                                      ? RangesOnBranch(b, physical, is_stable, boundary, layout.continued_index())
-                                      : BranchRanges{};
-      double previous = std::nan("");
-      for (size_t i = 0; i < stable.size(); ++i) {
-        if (!std::isfinite(stable[i])) continue;
-        if (std::isfinite(previous) && stable[i] != previous) {
-          nlohmann::json change = {{"after_point", i - 1}, {layout.continued_name(), log.H[b.id][i]},
-                                   {"stable", stable[i] == 1}, {"located", false}};
+      const auto analysed = writer.points().find(b.id);
+      const std::vector<StudyPoint> none;
+      const std::vector<StudyPoint>& points = analysed == writer.points().end() ? none : analysed->second;
+      const BranchRanges ranges = FamilyOfBranch(b, points, layout.continued_index(), name_of).ranges;
+      std::optional<bool> previous;  // the stability of the last physical point with multipliers
+      for (size_t i = 0; i < points.size(); ++i) {
+        const OrbitAnalysis& a = points[i].analysis;
+        if (!a.classification.physical || !a.floquet) continue;
+        if (previous && a.stable != *previous) {
+          nlohmann::json change = {{"after_point", i - 1}, {layout.continued_name(), points[i].u(layout.continued_index())},
+                                   {"stable", a.stable}, {"located", false}};
           for (const Range& r : ranges.stable) {  // a stable stretch that begins at point i or ends before it
             const RangeEnd* end = r.first_point == static_cast<int>(i)      ? &r.from
                                   : r.last_point + 1 == static_cast<int>(i) ? &r.to
@@ -136,7 +135,7 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
           }
           changes.push_back(change);
         }
-        previous = stable[i];
+        previous = a.stable;
       }
       writer.AnnotateBranch(b.id, {{"period_doubled_from", pd_id},
                                    {"model", doubled.name()},
@@ -160,6 +159,10 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
     next_branch += static_cast<int>(d.branches.size());
   }
   if (families == 0 && report.find("from PD") == std::string::npos) report += "  none (no located PD point)\n";
+  if (!family_lines.empty()) {
+    report += "Physical period-doubled families (where their orbits are physical and where stable, in " +
+              layout.continued_name() + "):\n" + family_lines;
+  }
   return report;
 }
 

@@ -126,9 +126,22 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
   summary_["status"] = "running";
   // Remove the results of an earlier run in the same folder so that the folder describes this run only:
   // summary.json first (while the rest is removed the folder claims nothing), then the CSV files, the
-  // figures (the generic ones and those the old summary declared) and the figure script's log.
+  // figures (the generic ones, those the old summary declared and every one figures.txt lists), the report and
+  // the figure script's log.
   if (!writes_files()) return;
-  std::set<std::string> figures = {"H_T", "H_T_xi", "keyframes", "curves"};
+  std::set<std::string> figures = {"H_T", "H_T_xi", "keyframes", "curves", "words"};
+  // Every figure drawn into the folder, as the figure script lists them (figures.txt: one plain file name a line).
+  std::set<std::string> drawn;
+  {
+    std::ifstream f(dir_ / "figures.txt");
+    for (std::string line; std::getline(f, line);) {
+      const fs::path file = line;
+      const std::string ext = file.extension().string();
+      if (!line.empty() && line[0] != '.' && file == file.filename() && (ext == ".png" || ext == ".svg" || ext == ".pdf")) {
+        drawn.insert(line);
+      }
+    }
+  }
   std::error_code ec;
   {
     std::ifstream f(dir_ / "summary.json");
@@ -149,7 +162,8 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
     const bool ours = ((name.rfind("branch-", 0) == 0 || name.rfind("orbit-", 0) == 0 || name.rfind("curve_", 0) == 0) &&
                        ext == ".csv") ||
                       ((ext == ".png" || ext == ".svg") && figures.count(entry.path().stem().string())) ||
-                      name == "plot.log" || name == "summary.json.tmp";
+                      drawn.count(name) || name == "figures.txt" || name == "report.html" || name == "plot.log" ||
+                      name == "summary.json.tmp";
     if (ours && entry.is_regular_file(ec)) fs::remove(entry.path(), ec);
   }
   WriteSummary();
@@ -175,6 +189,22 @@ int ResultsWriter::next_branch_id() const {
   return next;
 }
 
+void ResultsWriter::SetBranchFamily(int branch_id, const BranchFamily& family) {
+  families_[branch_id] = family;
+  const auto json_of = [](const std::vector<Range>& list) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const Range& r : list) {
+      a.push_back({{"from", r.from.value}, {"to", r.to.value}, {"from_how", r.from.how}, {"to_how", r.to.how},
+                   {"from_special_point", r.from.special_point}, {"to_special_point", r.to.special_point},
+                   {"first_point", r.first_point}, {"last_point", r.last_point}, {"family", r.family}});
+    }
+    return a;
+  };
+  AnnotateBranch(branch_id, {{"family", family.family},
+                             {"physical_ranges", json_of(family.ranges.physical)},
+                             {"stable_ranges", json_of(family.ranges.stable)}});
+}
+
 void ResultsWriter::AnnotateBranch(int branch_id, const nlohmann::json& fields) {
   for (nlohmann::json& b : summary_["branches"]) {
     if (b["id"] == branch_id) b.update(fields);
@@ -189,8 +219,7 @@ const std::vector<ResultsWriter::ClassifiedPoint>& ResultsWriter::ClassifiedPoin
 }
 
 void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
-  const bool stable = p.classification.physical && p.extra.size() > 1 && p.extra[1].first == "stable" &&
-                      p.extra[1].second == 1;
+  const bool stable = p.analysis.classification.physical && p.analysis.floquet && p.analysis.stable;
   classified_[branch_id].push_back({p.index, p.u, p.classification, stable});
   const auto other = branch_models_.find(branch_id);
   const ShootingLayout& layout = other == branch_models_.end() ? layout_ : other->second.layout;
@@ -327,6 +356,11 @@ StudyBranch ResultsWriter::BranchOf(int branch_id, bool with_points) const {
   if (other != branch_models_.end()) b.model = other->second.model_name, b.origin = other->second.origin;
   else b.model = model_.name();
   if (with_points && points != points_.end()) b.points = points->second;
+  if (const auto f = families_.find(branch_id); f != families_.end()) {
+    b.family = f->second.family;
+    b.ranges = f->second.ranges;
+    b.ranges.branch = branch_id;
+  }
   return b;
 }
 

@@ -43,6 +43,7 @@
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/study.h"
+#include "families.h"
 #include "resume_store.h"
 
 namespace hybridcont::study {
@@ -126,6 +127,9 @@ class ResultsWriter {
     bool stable = false;  // a physical orbit whose Floquet class is stable (asymptotically or neutrally)
   };
   const std::vector<ClassifiedPoint>& ClassifiedPoints(int branch_id) const;
+  // The family and ranges of branch `branch_id` (families.h), after EndBranch: in the branch's record and its
+  // summary entry ("family", "physical_ranges", "stable_ranges").
+  void SetBranchFamily(int branch_id, const BranchFamily& family);
   // Adds `fields` to the summary entry of branch `branch_id` (after EndBranch) and rewrites summary.json.
   void AnnotateBranch(int branch_id, const nlohmann::json& fields);
   // Records the finished branch's metadata and rewrites summary.json.
@@ -195,6 +199,7 @@ class ResultsWriter {
   std::map<int, BranchModel> branch_models_;  // branches of another model (SetBranchModel)
   std::map<int, std::vector<ClassifiedPoint>> classified_;
   std::map<int, std::vector<StudyPoint>> points_;
+  std::map<int, BranchFamily> families_;  // SetBranchFamily
   std::vector<StudyOrbit> orbits_;
   std::map<int, StudyBranch> live_;  // the branches being traced, as the point hook sees them (no points)
   const StudyHooks* hooks_ = nullptr;

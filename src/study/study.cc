@@ -6,7 +6,7 @@
 //
 // Steps in files of their own: run_setup.h (options -> validated set-up), point_analysis.h (each accepted
 // point), summary_json.h (options and special points in the document), period_doubled_families.h,
-// word_families.h, parameter_curves.h, family_report.h.
+// word_families.h, parameter_curves.h, families.h (every branch's family and ranges).
 #include <fmt/format.h>
 #include <openssl/evp.h>
 
@@ -24,7 +24,7 @@
 #include <stdexcept>
 
 #include "family_guide.h"
-#include "family_report.h"
+#include "families.h"
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/conservation_check.h"
 #include "hybridcont/exploration.h"
@@ -35,6 +35,7 @@
 #include "hybridcont/study.h"
 #include "hybridcont/timebased_shooting.h"
 #include "hybridcont/version.h"
+#include "modelfile/model_cache.h"
 #include "model_exploration.h"
 #include "orbit_start.h"
 #include "parameter_curves.h"
@@ -195,13 +196,13 @@ void WriteKeyframeOrbits(const BifurcationDiagram& diagram, const PointLog& log,
 }
 
 // Per branch with physical orbits: its family, where its orbits are physical and where stable, in the
-// continued coordinate, each end from the special point located there (family_report.h).
+// continued coordinate, each end from the special point located there (families.h).
 std::string RangesReport(const BifurcationDiagram& diagram, const Scenario& sc, const ShootingLayout& layout,
                          ResultsWriter& writer) {
   std::string report = fmt::format("Physical families (where their orbits are physical and where stable, in {}):\n",
                                    layout.continued_name());
   std::string families;
-  for (const Branch& b : diagram.branches) families += BranchRangesReport(b, layout, sc.describe, writer);
+  for (const Branch& b : diagram.branches) families += AssignBranchFamily(b, layout, sc.describe, writer);
   return report + (families.empty() ? "  none\n" : families);
 }
 
@@ -368,7 +369,7 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
     try {
       curves = TraceParameterCurves(model, setup, from_curve ? restart_points : diagram, writer.dir(), &curves_report,
                                     &result->curves);
-    } catch (const std::runtime_error& e) {  // a curve file that could not be written (a full disk)
+    } catch (const CurveFileError& e) {  // a curve file that could not be written (a full disk)
       writer.RecordWriteError(e.what());
     }
     if (from_curve && curves.empty()) {
@@ -435,33 +436,10 @@ void CheckConservationAtStart(const HybridModel& model, const std::string& argum
 }
 
 
-// SHA-256 of a file's bytes as hex; empty when it cannot be read.
-std::string FileDigest(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return "";
-  const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  unsigned int size = 0;
-  if (EVP_Digest(bytes.data(), bytes.size(), digest, &size, EVP_sha256(), nullptr) != 1) return "";
-  std::string hex;
-  for (unsigned int i = 0; i < size; ++i) hex += fmt::format("{:02x}", digest[i]);
-  return hex;
-}
-
-// The model file a study reads (as MakeStudyModel finds it).
-std::string ModelFilePath(const StudyOptions& o) {
-  std::error_code ec;
-  const std::filesystem::path path = o.model;
-  if (path.is_relative() && !std::filesystem::exists(path, ec) && !o.models_directory.empty()) {
-    return (std::filesystem::path(o.models_directory) / path.filename()).string();
-  }
-  return o.model;
-}
-
 // The options that decide a study's results, with the model's parameter values and, for a model file, the
 // digest of its text: a resumed study must have the same (threads, the folder and how it is written do not
 // change the results).
-nlohmann::json ResultOptionsJson(const StudyOptions& o, const HybridModel& model) {
+nlohmann::json ResultOptionsJson(const StudyOptions& o, const HybridModel& model, const StudyModelSource& source) {
   const auto values = [](const std::vector<NamedValue>& list) {
     nlohmann::json a = nlohmann::json::array();
     for (const NamedValue& v : list) a.push_back({v.name, v.value});
@@ -476,7 +454,7 @@ nlohmann::json ResultOptionsJson(const StudyOptions& o, const HybridModel& model
   for (const ParameterInfo& info : model.parameters()) parameters[info.name] = model.parameter(info.name);
   nlohmann::json j = {{"model", o.model},
                       {"model_name", model.name()},
-                      {"model_text_sha256", IsModelFilePath(o.model) ? FileDigest(ModelFilePath(o)) : ""},
+                      {"model_text_sha256", source.sha256},
                       {"parameters", parameters},
                       {"until", values(o.until)},
                       {"bounds", bounds},
@@ -527,6 +505,7 @@ struct PreparedStudy {
   RunSetup setup;
   std::unique_ptr<ModelExploration> exploration;
   std::unique_ptr<FamilyGuide> guide;  // options.families_of: prunes the exploration's half-branches
+  StudyModelSource source;             // which model it is (recorded in the result)
 };
 
 // `given`: the caller's model (copied; options.model and models_directory are then not read).
@@ -534,11 +513,22 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
   PreparedStudy p;
   NoteBuffer notes(hooks);
   std::ostream log(&notes);
-  if (options.model.empty() && given == nullptr) {
+  if (options.model.empty() && options.model_text.empty() && given == nullptr) {
     throw StudyOptionError("model", -1, "'': name a built-in model or a model file");
   }
-  if (given != nullptr) {
-    p.model = std::make_unique<HybridModel>(given->Clone());
+  if (given != nullptr || !options.model_text.empty()) {
+    if (given != nullptr) {
+      p.model = std::make_unique<HybridModel>(given->Clone());
+    } else {
+      ModelFileOptions file_options;
+      file_options.log = &log;
+      p.model = std::make_unique<HybridModel>(
+          LoadModelText(options.model_text, "<" + (options.model.empty() ? "model text" : options.model) + ">", file_options));
+    }
+    p.source = options.model_text.empty()
+                   ? StudyModelSource{StudyModelSource::Kind::kCaller, p.model->name(), "", "", ""}
+                   : StudyModelSource{StudyModelSource::Kind::kText, p.model->name(), "",
+                                      internal::Sha256Hex(options.model_text), options.model_text};
     std::set<std::string> assigned;
     for (std::size_t i = 0; i < options.parameters.size(); ++i) {
       const NamedValue& v = options.parameters[i];
@@ -553,8 +543,10 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
       }
     }
   } else {
+    p.source = FindStudyModel(options.model, options.models_directory);
     p.model = std::make_unique<HybridModel>(
         MakeStudyModel(options.model, options.parameters, options.models_directory, &log));
+    p.source.name = p.model->name();
   }
   log.flush();
   const HybridModel& model = *p.model;
@@ -729,13 +721,14 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
   std::unique_ptr<ResumeStore> store;
   if (!dir.empty()) {
     try {
-      store = std::make_unique<ResumeStore>(dir, ResultOptionsJson(options, model), options.resume);
+      store = std::make_unique<ResumeStore>(dir, ResultOptionsJson(options, model, p.source), options.resume);
     } catch (const std::invalid_argument& e) {
       throw StudyOptionError("resume", -1, e.what());
     }
     p.exploration->set_branch_store(store.get());
   }
   ResultsWriter writer(dir, model, options_json, p.setup.free, &hooks);
+  writer.Annotate("model_source", ModelSourceJson(p.source));
   writer.set_resume_store(store.get());
   // Every exploration of the study (the period-doubled and word families', the starts' of a free parameter)
   // stops at a stop request or a failed write.
@@ -764,6 +757,8 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
                                 guided["rays"].get<int>()));
     }
   }
+  // The families as every front end shows them (families.h), for the folder's readers.
+  writer.Annotate("families", FamiliesJson(ResultFromSummary(writer.summary(), {}).families));
   // A stopped study ends its folder as "cancelled": whole, but not the whole study (--resume completes it).
   if (!writer.Finish(result.status == ExplorationStatus::kCancelled)) writer.Fail(writer.write_error());  // a full disk: the folder is marked incomplete
   const bool complete = writer.write_error().empty() && result.status != ExplorationStatus::kCancelled;

@@ -33,15 +33,6 @@ std::string RangeText(const Range& r, const std::vector<StudySpecialPoint>& spec
   return fmt::format("{:.10g} .. {:.10g}   ({} .. {})", lo, hi, end(forward ? r.from : r.to), end(forward ? r.to : r.from));
 }
 
-bool InPhysicalRange(const StudyBranch& b, int index) {
-  for (const Range& r : b.ranges.physical) {
-    if (index >= std::min(r.first_point, r.last_point) - 1 && index <= std::max(r.first_point, r.last_point)) {
-      return true;
-    }
-  }
-  return false;
-}
-
 // Whether two lists of ranges are the same stretches of the coordinate (ends within 1e-8 relative).
 bool SameRanges(const std::vector<Range>& a, const std::vector<Range>& b) {
   if (a.size() != b.size()) return false;
@@ -80,6 +71,19 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
   }
   out += fmt::format("\n{}: {} branch{} with physical orbits of {} ({} points)\n", study.model, physical_branches,
                      physical_branches == 1 ? "" : "es", study.branches.size(), points);
+  // The families over all their branches (FoldFamilies): what a sweep's table and Python's families say.
+  if (!study.families.empty()) {
+    out += "families, over all their branches:\n";
+    const auto list = [](const std::vector<FamilyInterval>& intervals) {
+      std::string text;
+      for (const FamilyInterval& i : intervals) text += fmt::format("{}{:.10g} .. {:.10g}", text.empty() ? "" : ", ", i.from, i.to);
+      return text.empty() ? std::string("nowhere") : text;
+    };
+    for (const StudyFamily& f : study.families) {
+      out += fmt::format("  {}: physical {} {}; stable {}\n", f.name, f.continued, list(f.physical),
+                         f.stable.empty() ? std::string("nowhere") : f.continued + " " + list(f.stable));
+    }
+  }
   // Which branches leave each special point: the families a point connects.
   std::map<int, std::vector<int>> children;
   for (const StudyBranch& b : study.branches) {
@@ -100,7 +104,7 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
       continue;
     }
     std::string head = fmt::format("\n{} (branch {}", b.family.empty() ? "unnamed family" : b.family, b.id);
-    if (!b.origin.empty()) head += ", " + b.origin;
+    if (!b.origin.empty() && b.family.rfind(b.origin, 0) != 0) head += ", " + b.origin;
     // The image of a traced branch under a symmetry: where that branch is a physical family too, its special
     // points and connections were listed with it.
     const bool image_of_family = b.image_of >= 0 && !study.branch(b.image_of).ranges.physical.empty();
@@ -120,7 +124,7 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
     // Its located special points on physical stretches, and where other families leave them.
     std::string located, leads;
     for (const StudySpecialPoint& sp : study.special_points) {
-      if (sp.branch != b.id || sp.duplicate_of >= 0 || sp.code == "start" || !InPhysicalRange(b, sp.index)) continue;
+      if (sp.branch != b.id || sp.duplicate_of >= 0 || sp.code == "start" || !b.OnPhysicalStretch(sp.index)) continue;
       located += fmt::format("    {:<6} {} = {:.10g}  T = {:.10g}  {}\n", sp.Label(), c, Coordinate(b, sp.u), sp.T,
                              sp.status == "located" ? fmt::format("(to {:.1e})", sp.precision) : "(" + sp.status + ")");
       const auto it = children.find(sp.id);

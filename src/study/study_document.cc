@@ -38,6 +38,7 @@ std::vector<Range> RangesFromSummary(const nlohmann::json& entry, const std::str
     range.to = EndFromSummary(r, "to", at);
     range.first_point = JsonInt(r, "first_point", at);
     range.last_point = JsonInt(r, "last_point", at);
+    range.family = JsonText(r, "family", at, "");
     ranges.push_back(range);
   }
   return ranges;
@@ -112,6 +113,17 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
     }
   }
   r.unknown_names = JsonTexts(summary, "unknowns", "summary");
+  // Which model (since 0.7.0); a folder without the record is rebuilt by the model's name, as it was then.
+  r.model_source = {StudyModelSource::Kind::kName, r.model, "", "", ""};
+  if (const nlohmann::json* m = FindField(summary, "model_source")) {
+    if (!m->is_object()) Malformed("model_source", "expected an object");
+    const std::string kind = JsonText(*m, "kind", "model_source");
+    if (!FromString(kind, &r.model_source.kind)) Malformed("model_source.kind", "'" + kind + "' is no kind of model source");
+    r.model_source.name = JsonText(*m, "name", "model_source", r.model);
+    r.model_source.path = JsonText(*m, "path", "model_source", "");
+    r.model_source.sha256 = JsonText(*m, "sha256", "model_source", "");
+    r.model_source.text = JsonText(*m, "text", "model_source", "");
+  }
   // The continued coordinate: the first free parameter, else H (options.free, summary_json.h).
   std::string continued = "H";
   if (const nlohmann::json* options = FindField(summary, "options"); options != nullptr && options->is_object()) {
@@ -191,6 +203,7 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
       r.orbits.push_back(std::move(o));
     }
   }
+  r.families = FoldFamilies(r.branches, r.special_points);  // derived: summary.json's "families" is not read
   r.summary_json = summary.dump(1);
   return r;
 }

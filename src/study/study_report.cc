@@ -2,11 +2,18 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <memory>
 #include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -241,11 +248,25 @@ std::string Read(const std::filesystem::path& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-// The template with `marker` replaced by `text` (once; the marker must be there).
-void Fill(std::string* page, const std::string& marker, const std::string& text) {
-  const std::size_t at = page->find(marker);
-  if (at == std::string::npos) throw std::runtime_error("report: the template lacks " + marker);
-  page->replace(at, marker.size(), text);
+// The template with each marker replaced by its text. Every marker is found in the template itself (once; it
+// must be there) before anything is inserted, so that inserted text holding a marker (a family's name in the
+// data) is never taken for one.
+std::string FillTemplate(const std::string& page, std::vector<std::pair<std::string, std::string>> parts) {
+  std::vector<std::pair<std::size_t, std::size_t>> at;  // (position in page, part)
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const std::size_t where = page.find(parts[i].first);
+    if (where == std::string::npos) throw std::runtime_error("report: the template lacks " + parts[i].first);
+    at.push_back({where, i});
+  }
+  std::sort(at.begin(), at.end());
+  std::string out;
+  std::size_t done = 0;
+  for (const auto& [where, i] : at) {
+    if (where < done) throw std::runtime_error("report: the template's markers overlap");
+    out += page.substr(done, where - done) + parts[i].second;
+    done = where + parts[i].first.size();
+  }
+  return out + page.substr(done);
 }
 
 }  // namespace
@@ -309,11 +330,43 @@ std::string StudyReportHtml(const StudyResult& study, const ReportAssets& assets
     }
     return text;
   };
-  Fill(&page, "/*HYBRIDCONT_STYLE*/", Read(assets.viewer_css));
-  Fill(&page, "/*HYBRIDCONT_PLOTLY*/", inert(Read(assets.plotly_js)));
-  Fill(&page, "/*HYBRIDCONT_DATA*/", inert(StudyReportData(study, model)));
-  Fill(&page, "/*HYBRIDCONT_VIEWER*/", inert(Read(assets.viewer_js)));
+  // The data is JSON: every "<" (only ever inside its strings) written as \u003c, so that no text of the study
+  // ("<!--<script>" in a family's name) changes how the page's script element is parsed.
+  std::string data = StudyReportData(study, model), escaped;
+  for (const char c : data) escaped += c == '<' ? std::string("\\u003c") : std::string(1, c);
+  page = FillTemplate(page, {{"/*HYBRIDCONT_STYLE*/", Read(assets.viewer_css)},
+                             {"/*HYBRIDCONT_PLOTLY*/", inert(Read(assets.plotly_js))},
+                             {"/*HYBRIDCONT_DATA*/", escaped},
+                             {"/*HYBRIDCONT_VIEWER*/", inert(Read(assets.viewer_js))}});
   return page;
+}
+
+std::string SaveStudyReport(const StudyResult& study, const std::filesystem::path& dir, const ReportAssets& assets,
+                            const HybridModel* model) {
+  if (const std::string missing = assets.Missing(); !missing.empty()) return "the report's files are missing: " + missing;
+  const std::filesystem::path target = dir / "report.html";
+  std::filesystem::path temporary;
+  try {
+    const std::string html = StudyReportHtml(study, assets, model);
+    std::string name = (dir / ".report.html.XXXXXX").string();
+    const int fd = mkstemp(name.data());
+    if (fd < 0) return "cannot write " + (dir / ".report.html.*").string() + " (" + std::strerror(errno) + ")";
+    close(fd);
+    temporary = name;
+    {
+      std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+      out << html;
+      if (!out.flush()) throw std::runtime_error("cannot write " + temporary.string());
+    }
+    std::filesystem::permissions(temporary, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write |
+                                                std::filesystem::perms::group_read | std::filesystem::perms::others_read);
+    std::filesystem::rename(temporary, target);
+  } catch (const std::exception& e) {
+    std::error_code ec;
+    if (!temporary.empty()) std::filesystem::remove(temporary, ec);
+    return e.what();
+  }
+  return "";
 }
 
 }  // namespace hybridcont

@@ -123,4 +123,29 @@ nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayo
   return list;
 }
 
+nlohmann::json FamiliesJson(const std::vector<StudyFamily>& families) {
+  const auto intervals = [](const std::vector<FamilyInterval>& list) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const FamilyInterval& i : list) {
+      a.push_back({{"from", i.from}, {"to", i.to}, {"from_end", i.from_end}, {"to_end", i.to_end}});
+    }
+    return a;
+  };
+  nlohmann::json out = nlohmann::json::array();
+  for (const StudyFamily& f : families) {
+    out.push_back({{"name", f.name}, {"continued", f.continued}, {"branches", f.branches},
+                   {"physical", intervals(f.physical)}, {"stable", intervals(f.stable)},
+                   {"special_points", f.special_points}});
+  }
+  return out;
+}
+
+nlohmann::json ModelSourceJson(const StudyModelSource& source) {
+  nlohmann::json j = {{"kind", ToString(source.kind)}, {"name", source.name}};
+  if (!source.path.empty()) j["path"] = source.path;
+  if (!source.sha256.empty()) j["sha256"] = source.sha256;
+  if (source.kind == StudyModelSource::Kind::kText) j["text"] = source.text;
+  return j;
+}
+
 }  // namespace hybridcont::study

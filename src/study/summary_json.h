@@ -26,6 +26,16 @@ nlohmann::json OptionsJson(const StudyOptions& options, const RunSetup& setup);
 nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayout& layout,
                                  const HybridModel* model = nullptr, const IntegratorOptions& integrator = {});
 
+// The study's families (FoldFamilies), summary.json's "families": derived from the branches, written for
+// readers of the folder that do not fold ranges themselves (LoadStudy folds them again):
+//   [{"name", "continued", "branches": [ids], "physical": [{"from", "to", "from_end", "to_end"}], "stable": [...],
+//     "special_points": [labels]}]
+nlohmann::json FamiliesJson(const std::vector<StudyFamily>& families);
+
+// The study's model_source (study.h, StudyModelSource): {"kind", "name", "path", "sha256", "text"}, the
+// fields its kind has.
+nlohmann::json ModelSourceJson(const StudyModelSource& source);
+
 }  // namespace hybridcont::study
 
 #endif  // HYBRIDCONT_STUDY_SUMMARY_JSON_H_

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "family_boundaries.h"
-#include "family_report.h"
+#include "families.h"
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/corrector.h"
 #include "hybridcont/orbit_observables.h"
@@ -183,7 +183,7 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
   if (!model.automaton()) return "";
   const HybridAutomaton& automaton = *model.automaton();
   std::string report = "Phase-sequence changes (words of the automaton):\n";
-  std::string word_ranges;  // the answer per family of the other words (family_report.h)
+  std::string word_ranges;  // the answer per family of the other words (families.h)
   if (!setup.free.empty()) return report + "  not followed in a run with free parameters\n";
   if (!setup.free.observables.empty()) {
     return report + "  not followed in a run with observables among the unknowns (--until, --bound or --fix on an "
@@ -257,7 +257,7 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
       w.branches.branches.push_back(b);
       // Its families named by their word: the [[families]] rules are written for the file's word.
       const std::string word_name = automaton.WordName(w.word);
-      word_ranges += BranchRangesReport(b, word_layout, [&](const Vector&) { return word_name; }, writer);
+      word_ranges += AssignBranchFamily(b, word_layout, [&](const Vector&) { return word_name; }, writer);
     }
     return d;
   };

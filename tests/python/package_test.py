@@ -57,7 +57,7 @@ def test_same_diagram_as_the_command_line_on_the_paper_models(tmp_path, name):
 def test_dataframes_name_what_they_hold():
     study = hc.run("slip", progress=False, max_branches=8)
     assert {"label", "type", "branch", "index", "H", "T", "status", "precision", "u"} <= set(study.special_points.columns)
-    assert {"family", "branch", "kind", "from", "to", "from_how", "to_how"} <= set(study.families.columns)
+    assert {"family", "kind", "continued", "from", "to", "from_end", "to_end", "branches"} <= set(study.families.columns)
     assert {"id", "family", "parent", "termination", "points", "word"} <= set(study.branches.columns)
     hopping = study.families.query("family == 'hopping in place' and kind == 'stable'")
     assert hopping["from"].iloc[0] == pytest.approx(1.282809324, abs=1e-9)
