@@ -87,7 +87,7 @@ class StateBasedShooting : public ShootingProblem {
   std::vector<std::string> names_;
   Vector fixed_levels_;
   PoincareResult map_result_;
-  // cache of the last evaluated point (one integration per point, STYLE.md practice 8)
+  // cache of the last evaluated point (one integration per point, conventions §8)
   Vector cached_u_;
   bool cached_jacobian_ = false;
   bool cache_valid_ = false;

@@ -356,7 +356,8 @@ struct StudyHooks {
 HybridModel MakeStudyModel(const std::string& model, const std::vector<NamedValue>& parameters = {},
                            const std::string& models_directory = "", std::ostream* log = nullptr,
                            bool compile = true);
-// Where MakeStudyModel finds `model`: a built-in model, or a model file (its absolute path and digest).
+// Where MakeStudyModel finds `model`: a built-in model, or a model file (its absolute path; sha256 is left
+// empty: the study takes the digest of the file it has read, so that nothing else is ever read).
 StudyModelSource FindStudyModel(const std::string& model, const std::string& models_directory = "");
 
 // The model a study was computed on, rebuilt from its record (StudyResult::model_source) at the study's

@@ -24,7 +24,7 @@
 // with D_{m+1} = I and de_{m+1} = da. No saltation matrices are needed (paper §3.4).
 //
 // One integration of every phase per evaluation point: r and dr are read from the same flows, and a
-// second call at the same u (e.g. r first, then dr) reuses the cache (STYLE.md practice 8).
+// second call at the same u (e.g. r first, then dr) reuses the cache (conventions §8).
 //
 // Given u, the m+1 segment flows are independent: with many segments (the ball-chain) they are
 // integrated on several threads (set_threads), each segment by its own integrator, so r, dr and the

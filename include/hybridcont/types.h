@@ -4,7 +4,7 @@
 //   hybridcont::Matrix Phi(4, 4); // a fundamental matrix, a Jacobian
 //
 // Dynamic sizes throughout the public API: phases of one model have different dimensions (SLIP: stance 4,
-// flight 5), so the sizes are run-time values. Hot loops use workspaces sized once (STYLE.md practice 6).
+// flight 5), so the sizes are run-time values. Hot loops use workspaces sized once (conventions §6).
 #ifndef HYBRIDCONT_TYPES_H_
 #define HYBRIDCONT_TYPES_H_
 

@@ -62,7 +62,7 @@ std::string CorrectorResult::BriefReport() const {
 
 using internal::JacobianToleranceScope;
 
-// Scratch space sized once per problem (STYLE.md practice 6): the Newton loop allocates nothing after the
+// Scratch space sized once per problem (conventions §6): the Newton loop allocates nothing after the
 // first call.
 struct Corrector::Workspace {
   Vector r, F, delta, kernel, unit_last, border, correction;

@@ -4,7 +4,7 @@
 // B = df~/dxi and, for free model parameters p (PhaseFlow::set_free_parameters), B_p = df~/dp: Psi then
 // has k + q columns, dphi/dxi followed by dphi/dp.
 // The functor is a cheap handle (odeint copies systems by value); its scratch space lives in
-// AugmentedRhsWorkspace, made once per integrator (STYLE.md practice 6). A non-finite model value sets
+// AugmentedRhsWorkspace, made once per integrator (conventions §6). A non-finite model value sets
 // the workspace's flag and time and returns dz = 0, so that the stepper's arithmetic stays finite and
 // the driving loop reports the failure with phase and time.
 #ifndef HYBRIDCONT_SRC_INTEGRATION_AUGMENTED_RHS_H_

@@ -52,8 +52,12 @@ std::string CheckOwned(const fs::path& path, bool folder) {
   return "";
 }
 
-// The SHA-256 of a file's bytes, streamed; "" if it cannot be read.
+
+}  // namespace
+
 std::string Sha256OfFile(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return "";  // a folder, a FIFO, a device: never read
   std::ifstream in(path, std::ios::binary);
   if (!in) return "";
   EVP_MD_CTX* context = EVP_MD_CTX_new();
@@ -73,8 +77,6 @@ std::string Sha256OfFile(const fs::path& path) {
   EVP_MD_CTX_free(context);
   return ok ? Hex(digest, length) : "";
 }
-
-}  // namespace
 
 std::string Sha256Hex(const std::string& bytes) {
   unsigned char digest[EVP_MAX_MD_SIZE];

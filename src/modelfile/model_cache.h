@@ -29,6 +29,8 @@ namespace hybridcont::internal {
 
 // Hexadecimal SHA-256 of `bytes` (OpenSSL's libcrypto).
 std::string Sha256Hex(const std::string& bytes);
+// Hexadecimal SHA-256 of a regular file's bytes, streamed; "" for anything else or a file that cannot be read.
+std::string Sha256OfFile(const std::filesystem::path& path);
 
 // The folder's trust: "" when it is (or was just made, mode 0700) a folder of the effective user that no one
 // else can write; else why not ("... is writable by others (mode 0777)").

@@ -547,6 +547,8 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
     p.model = std::make_unique<HybridModel>(
         MakeStudyModel(options.model, options.parameters, options.models_directory, &log));
     p.source.name = p.model->name();
+    // The model file as read (it has been read whole, so it is a regular file): its digest identifies the model.
+    if (p.source.kind == StudyModelSource::Kind::kFile) p.source.sha256 = internal::Sha256OfFile(p.source.path);
   }
   log.flush();
   const HybridModel& model = *p.model;

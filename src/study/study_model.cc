@@ -6,8 +6,6 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <set>
 #include <stdexcept>
@@ -39,11 +37,6 @@ void SetParameters(const std::vector<NamedValue>& parameters, HybridModel* model
   }
 }
 
-std::string FileDigest(const std::filesystem::path& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return "";
-  return internal::Sha256Hex(std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>()));
-}
 
 }  // namespace
 
@@ -93,7 +86,7 @@ StudyModelSource FindStudyModel(const std::string& name, const std::string& mode
   }
   const std::filesystem::path absolute = std::filesystem::absolute(path, ec).lexically_normal();
   const std::string where = ec ? path.string() : absolute.string();
-  return {StudyModelSource::Kind::kFile, name, where, FileDigest(where), ""};
+  return {StudyModelSource::Kind::kFile, name, where, "", ""};
 }
 
 HybridModel MakeStudyModel(const std::string& name, const std::vector<NamedValue>& parameters,
@@ -122,7 +115,7 @@ HybridModel ModelOfStudy(const StudyResult& study, const std::string& models_dir
         if (!std::filesystem::is_regular_file(source.path, ec)) {
           throw std::invalid_argument(what + ": its model file " + source.path + " is gone");
         }
-        const std::string now = FileDigest(source.path);
+        const std::string now = internal::Sha256OfFile(source.path);
         if (now != source.sha256) {
           throw std::invalid_argument(what + ": its model file " + source.path + " has changed since the study (SHA-256 " +
                                       source.sha256.substr(0, 12) + "... then, " + now.substr(0, 12) +

@@ -8,7 +8,7 @@
 //   - a second-order jet           for the Hessians of H (needed by A = df~/dx when xi != 0):
 //     HessianJet<n> (internal/hessian_jet.h) for n <= kMaxFixedJetDim, Jet2 = AutoDiffScalar<Jet> above.
 // Derivative vectors are fixed-capacity (kMaxPhaseDim) stack storage, so no evaluation allocates on the
-// heap. Eigen's AutoDiff module is the well-kept library this builds on (STYLE.md practice 4).
+// heap. Eigen's AutoDiff module is the well-kept library this builds on (conventions §4).
 #ifndef HYBRIDCONT_AUTODIFF_PHASE_H_
 #define HYBRIDCONT_AUTODIFF_PHASE_H_
 

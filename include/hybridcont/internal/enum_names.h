@@ -1,5 +1,5 @@
-// One table per enum gives both directions of its string form (configuration is data: STYLE.md
-// practice 14). Used by the library's sources to implement the public `ToString(E)` / `FromString(text, E*)`
+// One table per enum gives both directions of its string form (configuration is data: conventions §14).
+// Used by the library's sources to implement the public `ToString(E)` / `FromString(text, E*)`
 // pairs; not used directly by library users.
 //
 //   constexpr internal::EnumName<PredictorType> kPredictorNames[] = {

@@ -13,7 +13,7 @@
 // It offers the operators and functions of Eigen's AutoDiffScalar (the first-order jet), so a model that
 // compiles for one compiles for the other.
 //
-// Why hand-written (STYLE.md practice 4 prefers a well-kept library): nested Eigen AutoDiffScalars, the
+// Why hand-written (conventions §4 prefers a well-kept library): nested Eigen AutoDiffScalars, the
 // library way, cost about twice as much per SLIP evaluation, and Ceres' Jet cannot be nested for this
 // (docs/design/shooting.md, "A hand-written second-order jet").
 #ifndef HYBRIDCONT_HESSIAN_JET_H_

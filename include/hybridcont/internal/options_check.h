@@ -1,4 +1,4 @@
-// The one validation helper behind every options struct's `Validate()` (STYLE.md practice 2): a chain of
+// The one validation helper behind every options struct's `Validate()` (conventions §2): a chain of
 // checks that keeps the first failure, phrased as "<Struct>::<field> = <value> must <constraint>".
 //
 //   std::string IntegratorOptions::Validate() const {
