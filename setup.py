@@ -39,7 +39,7 @@ class CMakeBuild(build_ext):
         if not os.path.exists(os.path.join(build, "CMakeCache.txt")):
             generator = ["-G", "Ninja"] if shutil.which("ninja") else []
             subprocess.run(["cmake", "-S", ROOT, "-B", build, *generator, "-DCMAKE_BUILD_TYPE=Release",
-                            "-DBUILD_TESTING=OFF", "-DHYBRIDCONT_BUILD_BENCH=OFF",
+                            "-DBUILD_TESTING=OFF", "-DHYBRIDCONT_BUILD_BENCH=OFF", "-DHYBRIDCONT_BUILD_CLI=OFF",
                             "-DPython_EXECUTABLE=" + sys.executable], check=True)
         else:  # an existing build tree: for this interpreter (a reconfigure that changes nothing is quick)
             subprocess.run(["cmake", build, "-DPython_EXECUTABLE=" + sys.executable], check=True,

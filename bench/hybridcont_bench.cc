@@ -19,7 +19,7 @@
 #include "hybridcont/model_file.h"
 #include "hybridcont/models.h"
 #include "hybridcont/study.h"
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 #include "../tests/mass_chain_text.h"
 
 namespace hybridcont::study {

@@ -21,9 +21,9 @@
 #include "hybridcont/model_file.h"
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/shooting_layout.h"
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 #include "study_fixture.h"
-#include "scenario.h"
+#include "study/engine/scenario.h"
 
 namespace hybridcont {
 namespace {

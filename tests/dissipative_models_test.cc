@@ -31,10 +31,10 @@
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/simulation_start.h"
 #include "hybridcont/timebased_shooting.h"
-#include "model_exploration.h"
-#include "orbit_start.h"
-#include "run_setup.h"
-#include "scenario.h"
+#include "study/engine/model_exploration.h"
+#include "study/engine/orbit_start.h"
+#include "study/engine/run_setup.h"
+#include "study/engine/scenario.h"
 
 namespace hybridcont {
 namespace {

@@ -12,7 +12,7 @@
 #include "hybridcont/exploration.h"
 #include "hybridcont/models.h"
 #include "hybridcont/timebased_shooting.h"
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 
 namespace hybridcont {
 namespace {

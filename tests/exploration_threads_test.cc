@@ -17,7 +17,7 @@
 #include "continuation_test_problems.h"
 #include "hybridcont/exploration.h"
 #include "hybridcont/models.h"
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 
 namespace hybridcont {
 namespace {

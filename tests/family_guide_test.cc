@@ -1,5 +1,5 @@
 // A study guided by the families of a saved study at other parameter values (StudyOptions::families_of,
-// src/study/family_guide.h): it traces only the half-branches that led to a family there, and its families
+// src/study/stages/family_guide.h): it traces only the half-branches that led to a family there, and its families
 // are those of the whole exploration at its own parameters, range for range and point for point.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -11,7 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "family_guide.h"
+#include "study/stages/family_guide.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/study.h"
 

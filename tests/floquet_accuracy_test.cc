@@ -15,7 +15,7 @@
 #include "hybridcont/exploration.h"
 #include "hybridcont/floquet.h"
 #include "hybridcont/models.h"
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 
 namespace hybridcont {
 namespace {

@@ -14,7 +14,7 @@
 #include "hybridcont/floquet_test_functions.h"
 #include "hybridcont/models.h"
 #include "hybridcont/timebased_shooting.h"
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 
 namespace hybridcont {
 namespace {

@@ -10,7 +10,7 @@
 #include "hybridcont/exploration.h"
 #include "hybridcont/models.h"
 #include "hybridcont/shooting_layout.h"
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 
 namespace hybridcont {
 namespace {

@@ -22,9 +22,9 @@
 #include "hybridcont/models.h"
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/shooting_layout.h"
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 #include "study_fixture.h"
-#include "scenario.h"
+#include "study/engine/scenario.h"
 
 namespace hybridcont {
 namespace {

@@ -14,8 +14,8 @@
 
 #include "hybridcont/models.h"
 #include "hybridcont/setup_evaluation.h"
-#include "results_writer.h"
-#include "scenario.h"
+#include "study/io/results_writer.h"
+#include "study/engine/scenario.h"
 
 namespace hybridcont {
 namespace {

@@ -26,7 +26,7 @@
 #include "hybridcont/orbit_trace.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/timebased_shooting.h"
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 
 namespace hybridcont {
 namespace {

@@ -22,7 +22,7 @@
 
 #include "hybridcont/exploration.h"
 #include "hybridcont/models.h"
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 
 namespace hybridcont {
 namespace {

@@ -15,7 +15,7 @@
 #include "hybridcont/exploration.h"
 #include "hybridcont/models.h"
 #include "study_fixture.h"
-#include "scenario.h"
+#include "study/engine/scenario.h"
 
 namespace hybridcont {
 namespace {

@@ -1,4 +1,4 @@
-// Changes of the phase sequence (word_change.h, src/study/word_families.h) against closed forms: the ball between
+// Changes of the phase sequence (word_change.h, src/study/stages/word_families.h) against closed forms: the ball between
 // a floor and a ceiling (models/ball-ceiling.toml: one word below H = g h, another above) and the SLIP's
 // hopping in place handed over to the stance-only oscillation where its flight time vanishes (models/slip.toml).
 #include "hybridcont/word_change.h"

@@ -128,7 +128,7 @@ struct StudyOptions {
   std::optional<RestartSpec> restart;  // begin at a labelled point of a saved study instead of the model's start
   // A saved study of the same model at nearby parameter values (a sweep's neighbouring grid point): trace only
   // the half-branches whose counterpart there led to a family; the others, which found no physical orbit
-  // there, are not traced (src/study/family_guide.h says how counterparts are matched). The saved study's
+  // there, are not traced (src/study/stages/family_guide.h says how counterparts are matched). The saved study's
   // families are continued to these parameter values without repeating its whole exploration. Empty: the
   // whole exploration. summary.json's "guided" says what was pruned.
   std::string families_of;
@@ -143,7 +143,7 @@ struct StudyOptions {
   // The results folder (docs/results-format.md), written as the study grows; empty: nothing is written.
   std::string out_dir;
   bool overwrite = false;  // replace another model's results in out_dir (refused otherwise)
-  // Continue the study saved (possibly interrupted) in out_dir (src/study/resume_store.h): branches traced there are taken as they
+  // Continue the study saved (possibly interrupted) in out_dir (src/study/io/resume_store.h): branches traced there are taken as they
   // are, the rest computed. The options must be those of the saved study.
   bool resume = false;
 };

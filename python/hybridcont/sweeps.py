@@ -27,7 +27,7 @@ Strategies (the table's ``strategy`` column says which one each grid point took)
   ``continue``   the grid is covered breadth-first from the point nearest the model's own parameters, each
                  point after a neighbour one step closer (Dask runs a task once its neighbour's is done), whose
                  families it continues: its study leaves out the half-branches whose counterparts at the
-                 neighbour led to no family (``families_of``, src/study/family_guide.h). The SLIP's exploration
+                 neighbour led to no family (``families_of``, src/study/stages/family_guide.h). The SLIP's exploration
                  is 23 half-branches, its families' 5. Where a family of the neighbour is not found, the grid
                  point is explored whole instead ("explore (a family of 3_4 not continued)"); so is the first
                  grid point, and a point whose neighbour's study did not complete (stopped at max_branches: it

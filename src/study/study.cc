@@ -23,8 +23,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "family_guide.h"
-#include "families.h"
+#include "study/stages/family_guide.h"
+#include "study/stages/families.h"
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/conservation_check.h"
 #include "hybridcont/exploration.h"
@@ -36,19 +36,19 @@
 #include "hybridcont/timebased_shooting.h"
 #include "hybridcont/version.h"
 #include "modelfile/model_cache.h"
-#include "model_exploration.h"
-#include "orbit_start.h"
-#include "parameter_curves.h"
-#include "parameter_starts.h"
-#include "period_doubled_families.h"
-#include "point_analysis.h"
-#include "restart.h"
-#include "results_writer.h"
-#include "run_setup.h"
-#include "scenario.h"
-#include "study_document.h"
-#include "summary_json.h"
-#include "word_families.h"
+#include "study/engine/model_exploration.h"
+#include "study/engine/orbit_start.h"
+#include "study/stages/parameter_curves.h"
+#include "study/engine/parameter_starts.h"
+#include "study/stages/period_doubled_families.h"
+#include "study/engine/point_analysis.h"
+#include "study/stages/restart.h"
+#include "study/io/results_writer.h"
+#include "study/engine/run_setup.h"
+#include "study/engine/scenario.h"
+#include "study/io/study_document.h"
+#include "study/io/summary_json.h"
+#include "study/stages/word_families.h"
 
 namespace hybridcont::study {
 namespace {

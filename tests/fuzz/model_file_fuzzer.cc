@@ -67,7 +67,7 @@ std::string EvaluateEveryFunction(const HybridModel& model) {
   return {};
 }
 
-// What a run evaluates of the set-up before it writes anything (src/study/scenario.cc: DefaultScenario).
+// What a run evaluates of the set-up before it writes anything (src/study/engine/scenario.cc: DefaultScenario).
 void EvaluateSetup(const HybridModel& model) {
   const Vector u = StartPoint(model);
   const RunSpec& run = model.setup().run;

@@ -20,8 +20,8 @@
 
 #include "hybridcont/exploration.h"
 #include "hybridcont/model.h"
-#include "results_writer.h"
-#include "run_setup.h"
+#include "study/io/results_writer.h"
+#include "study/engine/run_setup.h"
 
 namespace hybridcont::study {
 

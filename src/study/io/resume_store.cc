@@ -1,4 +1,4 @@
-#include "resume_store.h"
+#include "study/io/resume_store.h"
 
 #include <cerrno>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "hybridcont/version.h"
-#include "json_fields.h"
+#include "study/io/json_fields.h"
 
 namespace hybridcont::study {
 

@@ -1,4 +1,4 @@
-#include "point_analysis.h"
+#include "study/engine/point_analysis.h"
 
 #include <algorithm>
 #include <cmath>

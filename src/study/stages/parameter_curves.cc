@@ -1,4 +1,4 @@
-#include "parameter_curves.h"
+#include "study/stages/parameter_curves.h"
 
 #include <fmt/format.h>
 
@@ -10,8 +10,8 @@
 #include "hybridcont/orbit_observables.h"
 #include "hybridcont/special_point_curve.h"
 #include "hybridcont/timebased_shooting.h"
-#include "family_boundaries.h"
-#include "point_analysis.h"
+#include "study/engine/family_boundaries.h"
+#include "study/engine/point_analysis.h"
 
 namespace hybridcont::study {
 

@@ -1,4 +1,4 @@
-#include "orbit_start.h"
+#include "study/engine/orbit_start.h"
 
 #include <fmt/format.h>
 

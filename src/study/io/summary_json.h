@@ -12,7 +12,7 @@
 #include "hybridcont/study.h"
 #include "hybridcont/exploration.h"
 #include "hybridcont/shooting_layout.h"
-#include "run_setup.h"
+#include "study/engine/run_setup.h"
 
 namespace hybridcont::study {
 

@@ -1,4 +1,4 @@
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 
 #include <fmt/format.h>
 
@@ -9,7 +9,7 @@
 #include <string>
 #include <stdexcept>
 
-#include "family_boundaries.h"
+#include "study/engine/family_boundaries.h"
 #include "hybridcont/classification.h"
 #include "hybridcont/branch_switching.h"
 #include "hybridcont/corrector.h"

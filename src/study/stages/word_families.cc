@@ -1,4 +1,4 @@
-#include "word_families.h"
+#include "study/stages/word_families.h"
 
 #include <fmt/format.h>
 
@@ -8,18 +8,18 @@
 #include <memory>
 #include <vector>
 
-#include "family_boundaries.h"
-#include "families.h"
+#include "study/engine/family_boundaries.h"
+#include "study/stages/families.h"
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/corrector.h"
 #include "hybridcont/orbit_observables.h"
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/timebased_shooting.h"
 #include "hybridcont/word_change.h"
-#include "model_exploration.h"
-#include "point_analysis.h"
-#include "scenario.h"
-#include "summary_json.h"
+#include "study/engine/model_exploration.h"
+#include "study/engine/point_analysis.h"
+#include "study/engine/scenario.h"
+#include "study/io/summary_json.h"
 
 namespace hybridcont::study {
 namespace {

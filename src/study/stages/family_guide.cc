@@ -1,11 +1,11 @@
-#include "family_guide.h"
+#include "study/stages/family_guide.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "hybridcont/setup_evaluation.h"
-#include "json_fields.h"
+#include "study/io/json_fields.h"
 #include "hybridcont/study.h"
 
 namespace hybridcont::study {

@@ -43,8 +43,8 @@
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/study.h"
-#include "families.h"
-#include "resume_store.h"
+#include "study/stages/families.h"
+#include "study/io/resume_store.h"
 
 namespace hybridcont::study {
 

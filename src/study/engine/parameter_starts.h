@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "hybridcont/timebased_shooting.h"
-#include "run_setup.h"
+#include "study/engine/run_setup.h"
 
 namespace hybridcont::study {
 

@@ -1,4 +1,4 @@
-#include "families.h"
+#include "study/stages/families.h"
 
 #include <fmt/format.h>
 
@@ -9,7 +9,7 @@
 #include <set>
 #include <utility>
 
-#include "results_writer.h"
+#include "study/io/results_writer.h"
 
 namespace hybridcont::study {
 

@@ -1,4 +1,4 @@
-#include "restart.h"
+#include "study/stages/restart.h"
 
 #include <fmt/format.h>
 

@@ -9,7 +9,7 @@
 #include "hybridcont/flow.h"
 #include "hybridcont/model.h"
 #include "hybridcont/shooting_layout.h"
-#include "scenario.h"
+#include "study/engine/scenario.h"
 
 namespace hybridcont::study {
 

@@ -1,4 +1,4 @@
-#include "period_doubled_families.h"
+#include "study/stages/period_doubled_families.h"
 
 #include <fmt/format.h>
 
@@ -12,11 +12,11 @@
 #include "hybridcont/floquet.h"
 #include "hybridcont/period_doubling.h"
 #include "hybridcont/timebased_shooting.h"
-#include "families.h"
-#include "model_exploration.h"
-#include "point_analysis.h"
-#include "scenario.h"
-#include "summary_json.h"
+#include "study/stages/families.h"
+#include "study/engine/model_exploration.h"
+#include "study/engine/point_analysis.h"
+#include "study/engine/scenario.h"
+#include "study/io/summary_json.h"
 
 namespace hybridcont::study {
 namespace {

@@ -1,4 +1,4 @@
-#include "run_setup.h"
+#include "study/engine/run_setup.h"
 
 #include <fmt/format.h>
 
@@ -8,7 +8,7 @@
 #include <thread>
 
 #include "hybridcont/setup_evaluation.h"
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 #include "hybridcont/study.h"
 
 namespace hybridcont::study {

@@ -8,7 +8,7 @@
 #include "hybridcont/orbit_analysis.h"
 #include "hybridcont/replay.h"
 #include "hybridcont/timebased_shooting.h"
-#include "results_writer.h"
+#include "study/io/results_writer.h"
 
 namespace hybridcont::study {
 

@@ -19,8 +19,8 @@
 #include <nlohmann/json.hpp>
 
 #include "hybridcont/study.h"
-#include "results_writer.h"
-#include "study_document.h"
+#include "study/io/results_writer.h"
+#include "study/io/study_document.h"
 
 namespace hybridcont {
 

@@ -19,8 +19,8 @@
 #include "hybridcont/statebased_shooting.h"
 #include "hybridcont/timebased_shooting.h"
 #include "hybridcont/study.h"
-#include "resume_store.h"
-#include "scenario.h"
+#include "study/io/resume_store.h"
+#include "study/engine/scenario.h"
 
 namespace hybridcont::study {
 

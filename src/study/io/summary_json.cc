@@ -1,11 +1,11 @@
-#include "summary_json.h"
+#include "study/io/summary_json.h"
 
 #include <cmath>
 #include <memory>
 #include <stdexcept>
 
 #include "hybridcont/orbit_observables.h"
-#include "model_exploration.h"
+#include "study/engine/model_exploration.h"
 
 namespace hybridcont::study {
 

@@ -1,4 +1,4 @@
-#include "scenario.h"
+#include "study/engine/scenario.h"
 
 #include <fmt/format.h>
 

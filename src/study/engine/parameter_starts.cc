@@ -1,4 +1,4 @@
-#include "parameter_starts.h"
+#include "study/engine/parameter_starts.h"
 
 #include <fmt/format.h>
 
@@ -7,8 +7,8 @@
 
 #include "hybridcont/corrector.h"
 #include "hybridcont/orbit_observables.h"
-#include "model_exploration.h"
-#include "point_analysis.h"
+#include "study/engine/model_exploration.h"
+#include "study/engine/point_analysis.h"
 
 namespace hybridcont::study {
 

@@ -1,6 +1,6 @@
-#include "study_document.h"
+#include "study/io/study_document.h"
 
-#include "json_fields.h"
+#include "study/io/json_fields.h"
 
 #include <cmath>
 #include <limits>

@@ -1,9 +1,9 @@
-#include "family_boundaries.h"
+#include "study/engine/family_boundaries.h"
 
 #include <cmath>
 
 #include "hybridcont/shooting_layout.h"
-#include "point_analysis.h"
+#include "study/engine/point_analysis.h"
 
 namespace hybridcont::study {
 

@@ -31,7 +31,7 @@
 
 #include "hybridcont/exploration.h"
 #include "hybridcont/study.h"
-#include "run_setup.h"
+#include "study/engine/run_setup.h"
 
 namespace hybridcont::study {
 

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "hybridcont/shooting_layout.h"
-#include "run_setup.h"
+#include "study/engine/run_setup.h"
 
 namespace hybridcont::study {
 

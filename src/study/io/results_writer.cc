@@ -1,4 +1,4 @@
-#include "results_writer.h"
+#include "study/io/results_writer.h"
 
 #include <fmt/format.h>
 
@@ -11,7 +11,7 @@
 #include <stdexcept>
 
 #include "hybridcont/version.h"
-#include "study_document.h"
+#include "study/io/study_document.h"
 
 namespace hybridcont::study {
 
