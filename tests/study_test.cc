@@ -478,6 +478,16 @@ TEST(Study, RestartFromAPdPointGivesThePeriodDoubledFamilyOfTheFullRun) {
   EXPECT_EQ(summary["families"][0]["physical"][0]["from"].get<double>(), doubled->physical.front().from);
   EXPECT_EQ(summary["restarted_from"]["label"], "PD4");
   EXPECT_EQ(summary["restarted_from"]["kind"], "period-doubled");
+  // The same restart from the saved study in memory (no folder on either side): the same family.
+  StudyOptions in_memory = Slip();
+  in_memory.restart = RestartSpec{"", "PD4", RestartSpec::Kind::kAuto, std::make_shared<const StudyResult>(RunStudy(Slip()))};
+  const StudyResult m = RunStudy(in_memory);
+  ASSERT_EQ(m.branches.size(), r.branches.size());
+  for (std::size_t k = 0; k < r.branches.size(); ++k) {
+    ASSERT_EQ(m.branches[k].points.size(), r.branches[k].points.size());
+    for (std::size_t i = 0; i < r.branches[k].points.size(); ++i) EXPECT_EQ(m.branches[k].points[i].u, r.branches[k].points[i].u);
+  }
+  EXPECT_EQ(m.families, r.families);
   for (const fs::path& d : {full, saved, restarted}) fs::remove_all(d);
 }
 

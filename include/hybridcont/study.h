@@ -73,11 +73,18 @@ bool FromString(const std::string& text, Formulation* f);
 //   label "B5:12" (point 12 of branch 5)             — kind kContinue (both directions) or kFree (--free P).
 // kAuto picks what the label's type implies: PD → kPeriodDoubled, SB/BP → kSwitch, TP → kCurve (with
 // curves set), a branch or point → kContinue (kFree with free set).
+// The study restarted from is a saved one (`from`, its folder) or one in memory (`study`, e.g. the result of
+// an earlier RunStudy: no folder needed on either side). The restart's record (summary.json's restarted_from)
+// names the folder, or "(a study in memory)".
+struct StudyResult;
 struct RestartSpec {
   enum class Kind { kAuto, kContinue, kSwitch, kPeriodDoubled, kCurve, kFree };
-  std::string from;  // the saved study's folder
+  std::string from;  // the saved study's folder (read when `study` is null)
   std::string label;
   Kind kind = Kind::kAuto;
+  std::shared_ptr<const StudyResult> study;  // a study in memory; `from` is not read then
+  // The study restarted from, as a label's message names it: the folder, or "(a study in memory)".
+  std::string Source() const { return study ? std::string("(a study in memory)") : from; }
 };
 std::string ToString(RestartSpec::Kind kind);
 

@@ -469,7 +469,7 @@ nlohmann::json ResultOptionsJson(const StudyOptions& o, const HybridModel& model
                       {"free", o.free},
                       {"fix", o.fix ? nlohmann::json({o.fix->name, o.fix->value}) : nlohmann::json(nullptr)},
                       {"curves", o.curves}};
-  if (o.restart) j["restart"] = {o.restart->from, o.restart->label, ToString(o.restart->kind)};
+  if (o.restart) j["restart"] = {o.restart->Source(), o.restart->label, ToString(o.restart->kind)};
   if (!o.families_of.empty()) j["families_of"] = o.families_of;
   if (!o.families.empty()) j["families"] = o.families;
   if (!o.start_must_converge) j["start_must_converge"] = false;

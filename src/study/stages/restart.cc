@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <regex>
 
 #include "hybridcont/shooting_layout.h"
@@ -13,12 +14,13 @@ namespace hybridcont::study {
 namespace {
 
 [[noreturn]] void Refuse(const RestartSpec& spec, const std::string& why) {
-  throw StudyOptionError("restart", -1, "'" + spec.from + "' '" + spec.label + "': " + why);
+  throw StudyOptionError("restart", -1, "'" + spec.Source() + "' '" + spec.label + "': " + why);
 }
 
-StudyResult Saved(const RestartSpec& spec) {
+std::shared_ptr<const StudyResult> Saved(const RestartSpec& spec) {
+  if (spec.study) return spec.study;
   try {
-    return LoadStudy(spec.from);
+    return std::make_shared<const StudyResult>(LoadStudy(spec.from));
   } catch (const std::invalid_argument& e) {
     Refuse(spec, std::string("not a saved study: ") + e.what());
   }
@@ -37,7 +39,8 @@ bool BranchLabel(const std::string& label, int* branch, int* point) {
 }  // namespace
 
 double RestartLevel(const RestartSpec& spec) {
-  const StudyResult saved = Saved(spec);
+  const std::shared_ptr<const StudyResult> held = Saved(spec);
+  const StudyResult& saved = *held;
   const auto H = std::find(saved.unknown_names.begin(), saved.unknown_names.end(), "H");
   if (H == saved.unknown_names.end()) return std::nan("");
   const Eigen::Index h = H - saved.unknown_names.begin();
@@ -54,7 +57,8 @@ double RestartLevel(const RestartSpec& spec) {
 
 RestartPlan PlanRestart(const RestartSpec& spec, const StudyOptions& options, const HybridModel& model) {
   if (options.formulation != Formulation::kTimeBased) Refuse(spec, "a restart needs the time-based formulation");
-  const StudyResult saved = Saved(spec);
+  const std::shared_ptr<const StudyResult> held = Saved(spec);
+  const StudyResult& saved = *held;
   if (saved.model != model.name()) {
     Refuse(spec, "the saved study is of model '" + saved.model + "', not '" + model.name() + "'");
   }
@@ -72,7 +76,7 @@ RestartPlan PlanRestart(const RestartSpec& spec, const StudyOptions& options, co
                  "observables among the unknowns cannot be restarted from)");
   }
   RestartPlan plan;
-  plan.where = {{"folder", spec.from}, {"label", spec.label}};
+  plan.where = {{"folder", spec.Source()}, {"label", spec.label}};
   int branch = -1, index = -1;
   using Kind = RestartSpec::Kind;
   if (BranchLabel(spec.label, &branch, &index)) {
@@ -98,7 +102,7 @@ RestartPlan PlanRestart(const RestartSpec& spec, const StudyOptions& options, co
     if (!(plan.tangent.norm() > 0)) Refuse(spec, "the branch does not move at that point");
     plan.where["branch"] = branch;
     plan.where["point"] = at;
-    plan.description = fmt::format("point {} of branch {} of {}", at, branch, spec.from);
+    plan.description = fmt::format("point {} of branch {} of {}", at, branch, spec.Source());
   } else {
     const StudySpecialPoint* sp = saved.FindSpecialPoint(spec.label);
     if (sp == nullptr) {
@@ -155,7 +159,7 @@ RestartPlan PlanRestart(const RestartSpec& spec, const StudyOptions& options, co
     plan.point.component = sp->component;
     plan.point.u = sp->u;
     plan.where["special_point"] = sp->id;
-    plan.description = fmt::format("{} of {}", sp->Label(), spec.from);
+    plan.description = fmt::format("{} of {}", sp->Label(), spec.Source());
   }
   plan.where["kind"] = ToString(plan.kind);
   const auto H = std::find(saved.unknown_names.begin(), saved.unknown_names.end(), "H");
