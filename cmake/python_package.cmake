@@ -2,14 +2,17 @@
 # SOURCE/python/hybridcont and its data under DEST/data — the shipped model files, the figure script and the
 # viewers of the study's and the sweep's reports with Plotly.js (PLOTLY_JS, installed from npm by the build; empty without npm). Run by the
 # build (cmake -P) after the extension module is linked into DEST; copies only what changed.
-file(GLOB modules ${SOURCE}/python/hybridcont/*.py)
-file(COPY ${modules} DESTINATION ${DEST})
-# A module removed from the source leaves the package too.
-file(GLOB built ${DEST}/*.py)
+# The package's modules and subpackages (hybridcont/sweeps/), as laid out in the source.
+file(GLOB_RECURSE modules RELATIVE ${SOURCE}/python/hybridcont ${SOURCE}/python/hybridcont/*.py)
+foreach(module ${modules})
+  get_filename_component(folder ${module} DIRECTORY)
+  file(COPY ${SOURCE}/python/hybridcont/${module} DESTINATION ${DEST}/${folder})
+endforeach()
+# A module removed from the source leaves the package too (sweeps.py, now the package sweeps/, included).
+file(GLOB_RECURSE built RELATIVE ${DEST} ${DEST}/*.py)
 foreach(module ${built})
-  get_filename_component(name ${module} NAME)
-  if(NOT EXISTS ${SOURCE}/python/hybridcont/${name})
-    file(REMOVE ${module})
+  if(NOT module MATCHES "^data/" AND NOT EXISTS ${SOURCE}/python/hybridcont/${module})
+    file(REMOVE ${DEST}/${module})
   endif()
 endforeach()
 file(COPY ${SOURCE}/models/ DESTINATION ${DEST}/data/models)

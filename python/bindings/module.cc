@@ -322,6 +322,13 @@ py::list FamiliesOf(const StudyResult& study) {
   return out;
 }
 
+// The special points' labels by id (StudySpecialPoint::Label: what --at and continue_from name).
+py::dict LabelsOf(const StudyResult& study) {
+  py::dict out;
+  for (const StudySpecialPoint& sp : study.special_points) out[py::int_(sp.id)] = sp.Label();
+  return out;
+}
+
 py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& model, const py::object& on_progress,
                             const py::object& on_point, const py::object& on_note, const py::object& report_assets) {
   const StudyOptions options = OptionsOf(options_dict);
@@ -386,6 +393,7 @@ py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& mod
   out["answer"] = OneScreenAnswer(result, result.work.wall_seconds);
   out["report"] = result.report;
   out["families"] = FamiliesOf(result);
+  out["labels"] = LabelsOf(result);
   return out;
 }
 
@@ -404,6 +412,7 @@ py::dict LoadStudyFromPython(const std::string& dir) {
   out["version"] = study.version;
   out["answer"] = OneScreenAnswer(study, study.work.wall_seconds);
   out["families"] = FamiliesOf(study);
+  out["labels"] = LabelsOf(study);
   return out;
 }
 

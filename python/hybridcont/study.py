@@ -212,6 +212,7 @@ class Study:
         self.version = info["version"]
         self._answer = info["answer"]
         self._families = list(info["families"])
+        self._labels = dict(info["labels"])  # special point id -> label, the library's one rule
         self.interrupted = bool(result and result["interrupted"])
         self.write_error = result["write_error"] if result else ""
         self.wall_seconds = result["wall_seconds"] if result else None
@@ -283,7 +284,7 @@ class Study:
                 if sp.get("duplicate_of", -1) >= 0:
                     continue
                 row = dict(sp)
-                row["label"] = "%s%d" % (sp["type"], sp["id"]) if sp["type"] != "start" else "start%d" % sp["id"]
+                row["label"] = self._labels[sp["id"]]
                 row["u"] = np.array(sp.get("u") or [], dtype=float)
                 rows.append(row)
             frame = pd.DataFrame(rows)

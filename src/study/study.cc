@@ -43,6 +43,7 @@
 #include "study/stages/period_doubled_families.h"
 #include "study/engine/point_analysis.h"
 #include "study/stages/restart.h"
+#include "study/study_model.h"
 #include "study/io/results_writer.h"
 #include "study/engine/run_setup.h"
 #include "study/engine/scenario.h"
@@ -264,30 +265,35 @@ std::string RunReport(const BifurcationDiagram& diagram, const std::string& floq
 }
 
 // ---- 2. compute, streaming every accepted point; 3. summary, key-frame orbits, report, figures
-void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridModel& model, const RunSetup& setup,
-             const RestartPlan* restart, ModelExploration& exploration, ResultsWriter& writer, StudyResult* result) {
-  const Formulation formulation = options.formulation;
-  const ShootingLayout& layout = exploration.shooting().layout();
-  PointStream stream(model, setup, exploration, writer);
-  const auto start_time = std::chrono::steady_clock::now();
-  const auto on_point = [&](const ProgressInfo& info, const Vector& u_problem) { stream.Add(info, u_problem); };
-  std::string starts_report;
+
+// The study's own families as the exploration traced them (time-based layout), and what the later stages
+// start from.
+struct ExploredFamilies {
   BifurcationDiagram diagram;
-  // A write that fails (a full disk) stops the run at once: the branches end at their last point, nothing
-  // more is computed, and the run says which file could not be written.
-  exploration.set_cancel([&writer, &hooks] { return writer.failed() || (hooks.stop_requested && hooks.stop_requested()); });
-  const auto say = [&](const std::string& stage, const std::string& text) {
-    if (hooks.on_progress) hooks.on_progress({stage, writer.next_branch_id(), writer.num_points(), text});
-  };
-  // A restart's special point, for the stages that start from special points (period-doubled families, curves).
+  // A restart's special point, for the stages that start from special points (period-doubled families,
+  // curves); empty otherwise.
   BifurcationDiagram restart_points;
+  std::string starts_report;  // where the exploration began, in words
+};
+
+using PointSink = std::function<void(const ProgressInfo& info, const Vector& u_problem)>;
+using StageSay = std::function<void(const std::string& stage, const std::string& text)>;
+
+// The exploration of the study's own families: from a restart's point, from the model's start, or (a free
+// parameter) from the starts found in it; each accepted point goes to `on_point`, every branch to the writer.
+ExploredFamilies ExploreFamilies(const HybridModel& model, const RunSetup& setup, const RestartPlan* restart,
+                                 Formulation formulation, ModelExploration& exploration, ResultsWriter& writer,
+                                 const PointSink& on_point, const StageSay& say) {
+  const ShootingLayout& layout = exploration.shooting().layout();
+  ExploredFamilies out;
+  BifurcationDiagram& diagram = out.diagram;
+  int skipped = 0;  // starts on branches traced from earlier starts
   using Kind = RestartSpec::Kind;
   if (restart != nullptr) {
     writer.Annotate("restarted_from", restart->where);
-    starts_report = "Restarted from " + restart->description + " (" + ToString(restart->kind) + ")\n";
-    say("start", starts_report);
+    out.starts_report = "Restarted from " + restart->description + " (" + ToString(restart->kind) + ")\n";
+    say("start", out.starts_report);
     diagram.unknown_names = layout.unknown_names();
-    int skipped = 0;
     switch (restart->kind) {
       case Kind::kContinue:
         diagram = exploration.RunFromPoint(restart->u, restart->tangent, on_point);
@@ -307,26 +313,24 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
       case Kind::kPeriodDoubled:
       case Kind::kCurve:
       case Kind::kAuto:
-        restart_points.unknown_names = layout.unknown_names();
-        restart_points.special_points = {restart->point};
+        out.restart_points.unknown_names = layout.unknown_names();
+        out.restart_points.special_points = {restart->point};
         break;
     }
   } else if (setup.free.empty()) {
-    starts_report = exploration.start_report();
-    if (!starts_report.empty()) say("start", starts_report);  // how far Newton moved a guess
+    out.starts_report = exploration.start_report();
+    if (!out.starts_report.empty()) say("start", out.starts_report);  // how far Newton moved a guess
     diagram = exploration.Run(on_point);
   } else if (model.num_first_integrals() == 0) {  // the family in the parameter from the model's start
     const OrbitStarts starts = FindOrbitStarts(model, setup, layout);
-    int skipped = 0;
     say("start", starts.report);
     diagram = exploration.RunFromStarts(starts.points, on_point, &skipped);
-    starts_report = starts.report + fmt::format("  {} of them on branches traced from earlier starts\n", skipped);
+    out.starts_report = starts.report + fmt::format("  {} of them on branches traced from earlier starts\n", skipped);
   } else {
     const ParameterStarts starts = FindParameterStarts(model, setup, exploration.shooting());
-    int skipped = 0;
     diagram = exploration.RunFromStarts(starts.points, on_point, &skipped);
-    starts_report = starts.report + fmt::format("  {} of them on branches traced from earlier starts\n", skipped);
-    say("start", starts_report);
+    out.starts_report = starts.report + fmt::format("  {} of them on branches traced from earlier starts\n", skipped);
+    say("start", out.starts_report);
     writer.Annotate("starts", {{"crossings", starts.crossings},
                                {"distinct", starts.points.size()},
                                {"on_traced_branches", skipped},
@@ -335,40 +339,40 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   if (formulation == Formulation::kStateBased) ConvertToTimeBased(exploration, layout, &diagram);
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
   exploration.ForgetBranchPointAnalyses();  // every point of the exploration has been analysed
-  result->status = diagram.status;
-  result->message = diagram.message;
-  result->diagram = diagram;
   writer.Annotate("exploration", {{"status", ToString(diagram.status)}, {"message", diagram.message}});
-  if (writer.failed()) return;  // the failed write is the result's write_error
-  nlohmann::json special_points = SpecialPointsJson(diagram, layout, &model, setup.integrator);
-  const std::unique_ptr<HybridModel> at_point = setup.free.empty() ? nullptr : std::make_unique<HybridModel>(model.Clone());
-  const std::string floquet_report = FloquetReport(diagram, layout, [&](const Vector& u) {
-    if (at_point) SetFreeParameters(layout, u, at_point.get());
-    return IsPhysical(at_point ? *at_point : model, OrbitPart(layout, u), setup.integrator);
-  });
-  std::string period_doubled;
-  const bool from_pd = restart != nullptr && restart->kind == Kind::kPeriodDoubled;
-  const bool from_curve = restart != nullptr && restart->kind == Kind::kCurve;
-  const std::unique_ptr<HybridModel> doubled =
-      options.period_doubling || from_pd ? std::make_unique<HybridModel>(RepeatedModel(model, 2)) : nullptr;
+  return out;
+}
+
+// The stages after the exploration, each until a stop request: the period-doubled families, the families of
+// other words, the two-parameter curves. Their special points join `special_points`, their curves the result;
+// returns their report sections.
+// `doubled`: RepeatedModel(model, 2) where period-doubled families are explored (it must outlive the writer's
+// use of their branches), else null.
+std::string RunLaterStages(const StudyOptions& options, const HybridModel& model, const HybridModel* doubled,
+                           const RunSetup& setup, const RestartPlan* restart, const ExploredFamilies& explored,
+                           ResultsWriter& writer,
+                           const StudyHooks& hooks, const StageSay& say, nlohmann::json* special_points,
+                           StudyResult* result) {
+  const bool from_pd = restart != nullptr && restart->kind == RestartSpec::Kind::kPeriodDoubled;
+  const bool from_curve = restart != nullptr && restart->kind == RestartSpec::Kind::kCurve;
   const auto stopped = [&] { return writer.failed() || (hooks.stop_requested && hooks.stop_requested()); };
-  if (doubled && !stopped()) {
+  std::string report;
+  if (doubled != nullptr && !stopped()) {
     say("period-doubled families", "");
-    period_doubled =
-        ExplorePeriodDoubledFamilies(model, *doubled, setup, from_pd ? restart_points : diagram, &special_points, writer);
+    report += ExplorePeriodDoubledFamilies(model, *doubled, setup, from_pd ? explored.restart_points : explored.diagram,
+                                           special_points, writer);
   }
-  std::string words;
   if (options.follow_word_changes && !stopped()) {
     say("words", "");
-    words = ExploreWordChanges(model, setup, diagram, &special_points, writer, hooks);
+    report += ExploreWordChanges(model, setup, explored.diagram, special_points, writer, hooks);
   }
-  std::string curves_report;
   if (!setup.curve_parameter.empty() && !stopped()) {
     say("curves", "");
     nlohmann::json curves = nlohmann::json::array();
+    std::string curves_report;
     try {
-      curves = TraceParameterCurves(model, setup, from_curve ? restart_points : diagram, writer.dir(), &curves_report,
-                                    &result->curves);
+      curves = TraceParameterCurves(model, setup, from_curve ? explored.restart_points : explored.diagram, writer.dir(),
+                                    &curves_report, &result->curves);
     } catch (const CurveFileError& e) {  // a curve file that could not be written (a full disk)
       writer.RecordWriteError(e.what());
     }
@@ -377,21 +381,53 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
                                    restart->where.value("label", std::string()));
     }
     writer.Annotate("curves", std::move(curves));
+    report += curves_report;
   }
-  // A stop (or a failed write) during the stages after the exploration: what they did is kept, the study is
-  // not complete.
+  // A stop (or a failed write) during these stages: what they did is kept, the study is not complete.
   if (stopped() && result->status == ExplorationStatus::kCompleted) {
     result->status = ExplorationStatus::kCancelled;
     result->message = "stopped after the exploration, before the study's end";
     writer.Annotate("exploration", {{"status", ToString(result->status)}, {"message", result->message}});
   }
+  return report;
+}
+
+void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridModel& model, const RunSetup& setup,
+             const RestartPlan* restart, ModelExploration& exploration, ResultsWriter& writer, StudyResult* result) {
+  const ShootingLayout& layout = exploration.shooting().layout();
+  PointStream stream(model, setup, exploration, writer);
+  const auto start_time = std::chrono::steady_clock::now();
+  // A write that fails (a full disk) stops the run at once: the branches end at their last point, nothing
+  // more is computed, and the run says which file could not be written.
+  exploration.set_cancel([&writer, &hooks] { return writer.failed() || (hooks.stop_requested && hooks.stop_requested()); });
+  const StageSay say = [&](const std::string& stage, const std::string& text) {
+    if (hooks.on_progress) hooks.on_progress({stage, writer.next_branch_id(), writer.num_points(), text});
+  };
+  const ExploredFamilies explored =
+      ExploreFamilies(model, setup, restart, options.formulation, exploration, writer,
+                      [&](const ProgressInfo& info, const Vector& u_problem) { stream.Add(info, u_problem); }, say);
+  const BifurcationDiagram& diagram = explored.diagram;
+  result->status = diagram.status;
+  result->message = diagram.message;
+  result->diagram = diagram;
+  if (writer.failed()) return;  // the failed write is the result's write_error
+  nlohmann::json special_points = SpecialPointsJson(diagram, layout, &model, setup.integrator);
+  const std::unique_ptr<HybridModel> at_point = setup.free.empty() ? nullptr : std::make_unique<HybridModel>(model.Clone());
+  const std::string floquet_report = FloquetReport(diagram, layout, [&](const Vector& u) {
+    if (at_point) SetFreeParameters(layout, u, at_point.get());
+    return IsPhysical(at_point ? *at_point : model, OrbitPart(layout, u), setup.integrator);
+  });
+  const bool period_doubling = options.period_doubling || (restart && restart->kind == RestartSpec::Kind::kPeriodDoubled);
+  const std::unique_ptr<HybridModel> doubled =
+      period_doubling ? std::make_unique<HybridModel>(RepeatedModel(model, 2)) : nullptr;
+  const std::string stages = RunLaterStages(options, model, doubled.get(), setup, restart, explored, writer, hooks, say,
+                                            &special_points, result);
   writer.SetSpecialPoints(special_points);
   say("key frames", "");
   WriteKeyframeOrbits(diagram, stream.log(), model, setup, layout, writer);
   const std::string ranges = RangesReport(diagram, setup.scenario, layout, writer);
-  const std::string report =
-      RunReport(diagram, starts_report + floquet_report + ranges + period_doubled + words + curves_report, start_time,
-                exploration, stream.floquet_map());
+  const std::string report = RunReport(diagram, explored.starts_report + floquet_report + ranges + stages, start_time,
+                                       exploration, stream.floquet_map());
   writer.SetReport(report);
   result->report = report;
   const TestFunctionWork tests = exploration.test_function_work();
@@ -509,49 +545,40 @@ struct PreparedStudy {
 };
 
 // `given`: the caller's model (copied; options.model and models_directory are then not read).
-PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, const HybridModel* given = nullptr) {
-  PreparedStudy p;
-  NoteBuffer notes(hooks);
-  std::ostream log(&notes);
+// The study's model: the caller's (copied), made of options.model_text, or options.model (a built-in model or
+// a model file) at options.parameters; *source says which (study.h, StudyModelSource).
+std::unique_ptr<HybridModel> BuildModel(const StudyOptions& options, const HybridModel* given, std::ostream& log,
+                                        StudyModelSource* source) {
   if (options.model.empty() && options.model_text.empty() && given == nullptr) {
     throw StudyOptionError("model", -1, "'': name a built-in model or a model file");
   }
-  if (given != nullptr || !options.model_text.empty()) {
-    if (given != nullptr) {
-      p.model = std::make_unique<HybridModel>(given->Clone());
-    } else {
-      ModelFileOptions file_options;
-      file_options.log = &log;
-      p.model = std::make_unique<HybridModel>(
-          LoadModelText(options.model_text, "<" + (options.model.empty() ? "model text" : options.model) + ">", file_options));
-    }
-    p.source = options.model_text.empty()
-                   ? StudyModelSource{StudyModelSource::Kind::kCaller, p.model->name(), "", "", ""}
-                   : StudyModelSource{StudyModelSource::Kind::kText, p.model->name(), "",
-                                      internal::Sha256Hex(options.model_text), options.model_text};
-    std::set<std::string> assigned;
-    for (std::size_t i = 0; i < options.parameters.size(); ++i) {
-      const NamedValue& v = options.parameters[i];
-      const std::string text = fmt::format("'{}={:g}'", v.name, v.value);
-      if (!assigned.insert(v.name).second) {
-        throw StudyOptionError("parameters", static_cast<int>(i), text + ": '" + v.name + "' is given twice");
-      }
-      try {
-        p.model->SetParameter(v.name, v.value);
-      } catch (const std::invalid_argument& e) {
-        throw StudyOptionError("parameters", static_cast<int>(i), text + ": " + e.what());
-      }
-    }
-  } else {
-    p.source = FindStudyModel(options.model, options.models_directory);
-    p.model = std::make_unique<HybridModel>(
-        MakeStudyModel(options.model, options.parameters, options.models_directory, &log));
-    p.source.name = p.model->name();
+  std::unique_ptr<HybridModel> model;
+  if (given == nullptr && options.model_text.empty()) {
+    *source = FindStudyModel(options.model, options.models_directory);
+    model = std::make_unique<HybridModel>(MakeStudyModel(options.model, options.parameters, options.models_directory, &log));
+    source->name = model->name();
     // The model file as read (it has been read whole, so it is a regular file): its digest identifies the model.
-    if (p.source.kind == StudyModelSource::Kind::kFile) p.source.sha256 = internal::Sha256OfFile(p.source.path);
+    if (source->kind == StudyModelSource::Kind::kFile) source->sha256 = internal::Sha256OfFile(source->path);
+    return model;
   }
-  log.flush();
-  const HybridModel& model = *p.model;
+  if (given != nullptr) {
+    model = std::make_unique<HybridModel>(given->Clone());
+  } else {
+    ModelFileOptions file_options;
+    file_options.log = &log;
+    model = std::make_unique<HybridModel>(LoadModelText(
+        options.model_text, "<" + (options.model.empty() ? "model text" : options.model) + ">", file_options));
+  }
+  *source = options.model_text.empty()
+                ? StudyModelSource{StudyModelSource::Kind::kCaller, model->name(), "", "", ""}
+                : StudyModelSource{StudyModelSource::Kind::kText, model->name(), "",
+                                   internal::Sha256Hex(options.model_text), options.model_text};
+  SetStudyParameters(options.parameters, model.get());
+  return model;
+}
+
+// Options that contradict each other, whatever the model.
+void CheckOptionPairs(const StudyOptions& options) {
   if (options.resume && options.out_dir.empty()) {
     throw StudyOptionError("resume", -1, ": needs the results folder to resume in (out_dir)");
   }
@@ -565,73 +592,95 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
   if (!options.free.empty() && options.period_doubling) {
     throw StudyOptionError("period_doubling", -1, ": not with a free parameter (free '" + options.free + "')");
   }
+  if (!options.families.empty() && options.families_of.empty()) {
+    throw StudyOptionError("families", 0, "'" + options.families[0] + "': needs the saved study whose families are "
+                           "continued (families_of, --families-of)");
+  }
+}
+
+// An automaton's starts in other words take transitions the file's word may not: their words are checked too,
+// at their typical states and their starts; and every transition that none of these words takes, which only a
+// change of the phase sequence would reach, on a word through it at the typical states.
+void CheckAutomatonWords(const HybridModel& model, const std::string& argument) {
+  if (model.automaton() == nullptr) return;
+  std::vector<Word> checked = {model.word()};
+  for (const StartSpec& start : model.setup().word_starts) {
+    const HybridModel word_model = WordModelAt(model, start.word);
+    CheckConservationAtStart(word_model, argument, ShootingLayout(word_model), StartPoint(word_model, start));
+    checked.push_back(start.word);
+  }
+  const HybridAutomaton& automaton = *model.automaton();
+  for (const Word& word : WordsThroughEveryTransition(automaton, checked)) {
+    const HybridModel word_model = WordModelAt(model, word);
+    try {
+      CheckConservationAtStart(word_model, argument, ShootingLayout(word_model), Vector());
+    } catch (const std::invalid_argument& e) {
+      // Named by the transitions that brought the word in: those no start's word takes.
+      std::string transitions;
+      for (const int k : TransitionsOf(word)) {
+        const bool taken = std::any_of(checked.begin(), checked.end(), [k](const Word& w) {
+          return std::find(w.begin(), w.end(), k) != w.end();
+        });
+        if (!taken) transitions += (transitions.empty() ? "'" : ", '") + automaton.transitions()[k].name + "'";
+      }
+      throw std::invalid_argument("transition " + transitions + ", which a change of the phase sequence may take " +
+                                  "(checked on the word " + automaton.WordName(word) + "): " + e.what());
+    }
+  }
+}
+
+// options.families_of: the saved study's families guide the exploration (family_guide.h).
+void AttachGuide(const StudyOptions& options, PreparedStudy* p) {
+  const auto refuse = [&](const std::string& why) {
+    throw StudyOptionError("families_of", -1, "'" + options.families_of + "': " + why);
+  };
+  if (options.restart) refuse("not with a restart (a restart traces from its point; families_of from the model's start)");
+  if (!options.free.empty()) refuse("not with a free parameter (free '" + options.free + "')");
+  if (options.formulation != Formulation::kTimeBased) refuse("needs the time-based formulation");
+  p->guide = std::make_unique<FamilyGuide>(FamilyGuide::Load(options.families_of, *p->model,
+                                                             p->exploration->shooting().layout(), options.families,
+                                                             OptionsJson(options, p->setup)));
+  p->exploration->set_ray_filter([guide = p->guide.get(), exploration = p->exploration.get()](const Vector& u,
+                                                                                             const Vector& v) {
+    return guide->Prune(u, v, exploration->unknown_scales());
+  });
+}
+
+// The ordinary run's start, checked (a guess corrected) before anything is written: a start that is not an
+// orbit is an error of the model's input, said per part of the cycle that does not close (or, where a start
+// may fail, a note and the study's status).
+void CheckStart(const StudyOptions& options, const StudyHooks& hooks, PreparedStudy* p) {
+  const HybridModel& model = *p->model;
+  if (!p->setup.free.empty() || model.num_first_integrals() == 0 || options.restart) return;
+  std::string why;
+  if (p->exploration->PrepareStart(&why)) return;
+  SourceLocation where = model.setup().start.where;
+  if (where.field.empty()) where.field = "start";
+  if (options.start_must_converge) throw ModelInputError(where, why);
+  if (hooks.on_note) {
+    const std::string message = ModelInputError(where, why).what();
+    hooks.on_note(message.substr(0, message.find('\n')) + " (the study goes on without it)");
+  }
+}
+
+PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, const HybridModel* given = nullptr) {
+  PreparedStudy p;
+  {
+    NoteBuffer notes(hooks);
+    std::ostream log(&notes);
+    p.model = BuildModel(options, given, log, &p.source);
+    log.flush();
+  }
+  const HybridModel& model = *p.model;
+  CheckOptionPairs(options);
   p.setup = MakeRunSetup(options, model);
   // The period-doubled families' model is drawn too: its presentation is checked before anything runs.
   if (options.period_doubling) OrbitPresentation(RepeatedModel(model, 2), p.setup.free);
   p.exploration = MakeExploration(options, model, p.setup);
   CheckConservationAtStart(model, options.model, p.exploration->shooting().layout(), p.setup.scenario.start);
-  // An automaton's starts in other words take transitions the file's word may not: their words are checked
-  // too, at their typical states and their starts; and every transition that none of these words takes, which
-  // only a change of the phase sequence would reach, on a word through it at the typical states.
-  if (model.automaton() != nullptr) {
-    std::vector<Word> checked = {model.word()};
-    for (const StartSpec& start : model.setup().word_starts) {
-      const HybridModel word_model = WordModelAt(model, start.word);
-      CheckConservationAtStart(word_model, options.model, ShootingLayout(word_model), StartPoint(word_model, start));
-      checked.push_back(start.word);
-    }
-    const HybridAutomaton& automaton = *model.automaton();
-    for (const Word& word : WordsThroughEveryTransition(automaton, checked)) {
-      const HybridModel word_model = WordModelAt(model, word);
-      try {
-        CheckConservationAtStart(word_model, options.model, ShootingLayout(word_model), Vector());
-      } catch (const std::invalid_argument& e) {
-        // Named by the transitions that brought the word in: those no start's word takes.
-        std::string transitions;
-        for (const int k : TransitionsOf(word)) {
-          const bool taken = std::any_of(checked.begin(), checked.end(), [k](const Word& w) {
-            return std::find(w.begin(), w.end(), k) != w.end();
-          });
-          if (!taken) transitions += (transitions.empty() ? "'" : ", '") + automaton.transitions()[k].name + "'";
-        }
-        throw std::invalid_argument("transition " + transitions + ", which a change of the phase sequence may take " +
-                                    "(checked on the word " + automaton.WordName(word) + "): " + e.what());
-      }
-    }
-  }
-  if (!options.families.empty() && options.families_of.empty()) {
-    throw StudyOptionError("families", 0, "'" + options.families[0] + "': needs the saved study whose families are "
-                           "continued (families_of, --families-of)");
-  }
-  if (!options.families_of.empty()) {
-    const auto refuse = [&](const std::string& why) {
-      throw StudyOptionError("families_of", -1, "'" + options.families_of + "': " + why);
-    };
-    if (options.restart) refuse("not with a restart (a restart traces from its point; families_of from the model's start)");
-    if (!options.free.empty()) refuse("not with a free parameter (free '" + options.free + "')");
-    if (options.formulation != Formulation::kTimeBased) refuse("needs the time-based formulation");
-    p.guide = std::make_unique<FamilyGuide>(
-        FamilyGuide::Load(options.families_of, model, p.exploration->shooting().layout(), options.families,
-                          OptionsJson(options, p.setup)));
-    p.exploration->set_ray_filter([guide = p.guide.get(), exploration = p.exploration.get()](const Vector& u,
-                                                                                           const Vector& v) {
-      return guide->Prune(u, v, exploration->unknown_scales());
-    });
-  }
-  // The ordinary run's start, checked (a guess corrected) before anything is written: a start that is not an
-  // orbit is an error of the model's input, said per part of the cycle that does not close.
-  if (p.setup.free.empty() && model.num_first_integrals() > 0 && !options.restart) {
-    std::string why;
-    if (!p.exploration->PrepareStart(&why)) {
-      SourceLocation where = model.setup().start.where;
-      if (where.field.empty()) where.field = "start";
-      if (options.start_must_converge) throw ModelInputError(where, why);
-      if (hooks.on_note) {
-        const std::string message = ModelInputError(where, why).what();
-        hooks.on_note(message.substr(0, message.find('\n')) + " (the study goes on without it)");
-      }
-    }
-  }
+  CheckAutomatonWords(model, options.model);
+  if (!options.families_of.empty()) AttachGuide(options, &p);
+  CheckStart(options, hooks, &p);
   return p;
 }
 

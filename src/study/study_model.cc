@@ -1,4 +1,4 @@
-#include "hybridcont/study.h"
+#include "study/study_model.h"
 
 #include <fmt/format.h>
 
@@ -16,10 +16,7 @@
 
 namespace hybridcont {
 
-namespace {
-
-// Sets each named value on the model (each name once); a name the model does not have is the option's error.
-void SetParameters(const std::vector<NamedValue>& parameters, HybridModel* model) {
+void SetStudyParameters(const std::vector<NamedValue>& parameters, HybridModel* model) {
   std::set<std::string> assigned;
   for (std::size_t i = 0; i < parameters.size(); ++i) {
     const NamedValue& p = parameters[i];
@@ -36,9 +33,6 @@ void SetParameters(const std::vector<NamedValue>& parameters, HybridModel* model
     }
   }
 }
-
-
-}  // namespace
 
 std::string ToString(StudyModelSource::Kind kind) {
   switch (kind) {
@@ -97,7 +91,7 @@ HybridModel MakeStudyModel(const std::string& name, const std::vector<NamedValue
   options.compile = compile;
   HybridModel model = source.kind == StudyModelSource::Kind::kBuiltin ? MakeBuiltinModel(name)
                                                                        : LoadModelFile(source.path, options);
-  SetParameters(parameters, &model);
+  SetStudyParameters(parameters, &model);
   return model;
 }
 

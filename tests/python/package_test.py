@@ -191,6 +191,73 @@ def test_restart_save_load_and_the_report(tmp_path):
     assert [os.path.basename(f) for f in files] == ["T_H.png", "T_H.svg"]
 
 
+def test_every_family_of_a_restart_is_in_the_answer_the_tables_and_the_folder(tmp_path):
+    """The period-doubled family of a restart from PD4 (and of a run with period_doubling) is a family like any
+    other: named, with its physical and stable ranges, the same numbers in the one-screen answer, Python's
+    families, summary.json and a sweep's table row."""
+    from hybridcont.sweeps import family_rows
+    study = hc.run("slip", out=tmp_path / "A", progress=False)
+    doubled = study.continue_from("PD4", out=tmp_path / "B", progress=False)
+    name = "period-doubled backward hopping / forward hopping"
+    assert "2 branches with physical orbits of 2" in str(doubled)
+    families = doubled.families
+    assert set(families.family) == {name}
+    physical = families[families.kind == "physical"].iloc[0]
+    stable = families[families.kind == "stable"].iloc[0]
+    assert physical["from"] == pytest.approx(1.282699643, abs=1e-7) and physical["to"] == pytest.approx(1.427197748, abs=1e-8)
+    assert stable["to"] == pytest.approx(1.282809324, abs=1e-8)
+    assert "  %s: physical H %.10g .. %.10g; stable H %.10g .. %.10g" % (
+        name, physical["from"], physical["to"], stable["from"], stable["to"]) in str(doubled)
+    assert doubled.summary["families"][0]["physical"][0]["from"] == physical["from"]
+    rows = family_rows(doubled, "0", {"k": 40.0})
+    assert [r["exists"] for r in rows if r["family"] == "hopping in place"] == [False]  # the model's, not here
+    row = [r for r in rows if r["family"] == name][0]
+    assert row["physical_from"] == physical["from"] and row["stable_to"] == stable["to"]
+    assert row["physical_ranges"] == "%.17g..%.17g" % (physical["from"], physical["to"])
+    # The same family in a whole run with period doubling, the same numbers.
+    whole = hc.run("slip", out=tmp_path / "C", progress=False, period_doubling=True)
+    same = whole.families[whole.families.family == name]
+    assert list(same["from"]) == list(families["from"]) and list(same["to"]) == list(families["to"])
+
+
+def test_a_folder_rebuilds_its_own_model_never_another_of_its_name(tmp_path):
+    """A user's slip.toml with other physics, elsewhere: hc.load and the report use it, and refuse with the reason
+    once it has changed; never the built-in SLIP."""
+    text = open(os.path.join(MODELS, "slip.toml")).read()
+    # Other physics: the leg swings twice as stiffly in flight (the start, at zero flight time, is the same).
+    stiffer = text.replace('dalpha = "-alpha*w2"', 'dalpha = "-2*alpha*w2"')
+    assert stiffer != text
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "slip.toml").write_text(stiffer)
+    study = hc.run(str(tmp_path / "mine" / "slip.toml"), out=tmp_path / "out", progress=False, max_branches=8)
+    assert study.summary["model_source"]["kind"] == "file"
+    loaded = hc.load(tmp_path / "out")
+    points = loaded.points
+    flying = points[(points.physical == 1) & (points.t2 > 0.05) & (points.x2_dx.abs() > 0.05)].iloc[0]  # the leg swings
+    branch, index = int(flying.branch), int(flying["index"])
+    u = loaded.u(branch, index)
+    assert np.abs(loaded.evaluate(branch, index)["r"]).max() < 1e-8  # an orbit of the user's model
+    shipped = hc.model(os.path.join(MODELS, "slip.toml"))  # the same name and layout, the shipped physics
+    assert np.abs(shipped.evaluate(u)["r"]).max() > 1e-3
+    (tmp_path / "mine" / "slip.toml").write_text(stiffer + "# edited\n")
+    with pytest.raises(ValueError, match="has changed since the study"):
+        hc.load(tmp_path / "out").evaluate(branch, index)
+    # The report of the changed folder says why it has no animations, and is still written.
+    page = hc.load(tmp_path / "out").report_html()
+    assert "study-data" in page
+
+
+def test_a_rerun_leaves_nothing_of_the_previous_study(tmp_path):
+    hc.run("slip", out=tmp_path / "r", progress=False, max_branches=4).plot()
+    assert os.path.exists(tmp_path / "r" / "words.png") or os.path.exists(tmp_path / "r" / "figures.txt")
+    drawn = (tmp_path / "r" / "figures.txt").read_text().split()
+    assert drawn and all(os.path.exists(tmp_path / "r" / f) for f in drawn)
+    hc.run("slip", out=tmp_path / "r", progress=False, max_branches=4, report=False)
+    assert not [f for f in drawn if os.path.exists(tmp_path / "r" / f)]
+    assert not os.path.exists(tmp_path / "r" / "report.html")
+    assert not [f for f in os.listdir(tmp_path / "r") if f.endswith(".tmp")]
+
+
 def test_continuation_point_by_point():
     slip = hc.model("slip")
     study = hc.run(slip, progress=False, max_branches=4)

@@ -134,6 +134,13 @@ def test_the_tool_runs_a_sweep_and_refuses_a_bad_grid(tmp_path):
     assert not os.path.exists(tmp_path / "range")
     proc = subprocess.run([tool, "sweep", "slip", "--grid", "k=1:2"], capture_output=True, text=True)
     assert proc.returncode == 2 and "NAME=START:STOP:COUNT" in proc.stderr
+    # Options are checked by the library as `run` checks them: no nan, inf or empty name; several monitor values.
+    for bad, said in ((["--set", "k=nan"], "not finite"), (["--until", "=1"], "expected NAME=VALUE"),
+                      (["--bound", "H=inf:2"], "not finite"), (["--fix", "H=1e999"], "not finite")):
+        proc = subprocess.run([tool, "sweep", "slip", "--grid", "k=20:40:2", *bad, "--out", str(tmp_path / "nan")],
+                              capture_output=True, text=True)
+        assert proc.returncode == 2 and said in proc.stderr, (bad, proc.stderr)
+        assert not os.path.exists(tmp_path / "nan")
     # Families in a free parameter at each grid point: explored whole (a guide continues families in H), said.
     out = str(tmp_path / "free")
     proc = subprocess.run([tool, "sweep", "slip", "--grid", "w2=5:6:2", "--free", "k", "--fix", "H=1.5", "--workers",

@@ -176,256 +176,294 @@ ExplorationOptions WordOptions(const ExplorationOptions& run, const ShootingLayo
   return o;
 }
 
-}  // namespace
+// The exploration of an automaton's words, one family at a time: the words the model's starts declare, then
+// every degeneracy of every physical family scanned, its candidate changes of word checked and the accepted
+// ones explored in their word, until no family is left to scan (or kMaxWords words).
+class WordExplorer {
+ public:
+  WordExplorer(const HybridModel& model, const RunSetup& setup, nlohmann::json* special_points, ResultsWriter& writer,
+               const StudyHooks& hooks)
+      : model_(model), setup_(setup), integrator_(setup.integrator), replay_(ReplayOptionsFor(setup.integrator)),
+        automaton_(*model.automaton()), special_points_(special_points), writer_(writer), hooks_(hooks) {}
 
-std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
-                               nlohmann::json* special_points, ResultsWriter& writer, const StudyHooks& hooks) {
-  if (!model.automaton()) return "";
-  const HybridAutomaton& automaton = *model.automaton();
-  std::string report = "Phase-sequence changes (words of the automaton):\n";
-  std::string word_ranges;  // the answer per family of the other words (families.h)
-  if (!setup.free.empty()) return report + "  not followed in a run with free parameters\n";
-  if (!setup.free.observables.empty()) {
-    return report + "  not followed in a run with observables among the unknowns (--until, --bound or --fix on an "
-                    "observable)\n";
+  // The report section; the words and changes annotated into the summary.
+  std::string Run(const BifurcationDiagram& diagram) {
+    words_.push_back({model_.word(), nullptr, &model_, nullptr, diagram});
+    words_.back().exploration = std::make_unique<ModelExploration>(model_, setup_.scenario, integrator_, setup_.exploration);
+    to_scan_.push_back({0, diagram});
+    StartDeclaredWords();
+    while (!to_scan_.empty()) {
+      const int entry = to_scan_.front().first;
+      const BifurcationDiagram scan = std::move(to_scan_.front().second);
+      to_scan_.pop_front();
+      Scan(entry, scan);
+    }
+    nlohmann::json words_json = nlohmann::json::array();
+    for (const WordEntry& w : words_) {
+      nlohmann::json ids = nlohmann::json::array();
+      for (const Branch& b : w.branches.branches) ids.push_back(b.id);
+      words_json.push_back({{"word", w.model->WordModeNames()}, {"name", automaton_.WordName(w.word)}, {"branches", ids}});
+    }
+    writer_.Annotate("words", words_json);
+    writer_.Annotate("word_changes", changes_);
+    if (changes_.empty()) report_ += "  none (no physical family reaches a zero duration or a competing guard)\n";
+    if (!word_ranges_.empty()) {
+      report_ += "Physical families of the other words (where their orbits are physical and where stable, in H):\n" +
+                 word_ranges_;
+    }
+    return report_;
   }
-  const IntegratorOptions& integrator = setup.integrator;
-  const ReplayOptions replay = ReplayOptionsFor(integrator);
 
-  std::deque<WordEntry> words;
-  words.push_back({model.word(), nullptr, &model, nullptr, diagram});
-  words.back().exploration =
-      std::make_unique<ModelExploration>(model, setup.scenario, integrator, setup.exploration);
-  nlohmann::json changes = nlohmann::json::array();
-  std::vector<std::pair<int, Vector>> handled;  // (word entry, orbit) of the degeneracies seen
-  const auto seen = [&](int entry, const Vector& u) {
-    for (const auto& [e, v] : handled) {
+ private:
+  const HybridModel& model_;
+  const RunSetup& setup_;
+  const IntegratorOptions& integrator_;
+  const ReplayOptions replay_;
+  const HybridAutomaton& automaton_;
+  nlohmann::json* special_points_;
+  ResultsWriter& writer_;
+  const StudyHooks& hooks_;
+  std::deque<WordEntry> words_;
+  std::deque<std::pair<int, BifurcationDiagram>> to_scan_;  // (word entry, its families still to scan)
+  nlohmann::json changes_ = nlohmann::json::array();        // summary.json's "word_changes"
+  std::vector<std::pair<int, Vector>> handled_;             // (word entry, orbit) of the degeneracies seen
+  std::string report_ = "Phase-sequence changes (words of the automaton):\n";
+  std::string word_ranges_;  // the answer per family of the other words (families.h)
+
+  void Say(const std::string& message) {
+    if (hooks_.on_progress) hooks_.on_progress({"words", writer_.next_branch_id(), 0, message});
+  }
+
+  // Whether the degeneracy at u of word entry `entry` was seen before (recorded if not).
+  bool Seen(int entry, const Vector& u) {
+    for (const auto& [e, v] : handled_) {
       if (e == entry && v.size() == u.size() && (v - u).norm() <= 1e-6 * (1 + u.norm())) return true;
     }
-    handled.emplace_back(entry, u);
+    handled_.emplace_back(entry, u);
     return false;
-  };
+  }
+
   // The entry of `word`, made on first use; -1 (and why) where its exploration cannot be set up.
-  const auto EntryOf = [&](const Word& word, std::string* why) {
-    for (std::size_t e = 0; e < words.size(); ++e) {
-      if (words[e].word == word) return static_cast<int>(e);
+  int EntryOf(const Word& word, std::string* why) {
+    for (std::size_t e = 0; e < words_.size(); ++e) {
+      if (words_[e].word == word) return static_cast<int>(e);
     }
-    if (static_cast<int>(words.size()) >= kMaxWords) {
+    if (static_cast<int>(words_.size()) >= kMaxWords) {
       *why = fmt::format("{} words explored already", kMaxWords);
       return -1;
     }
     WordEntry w;
     w.word = word;
-    w.owned = std::make_unique<HybridModel>(WordModelAt(model, word));
+    w.owned = std::make_unique<HybridModel>(WordModelAt(model_, word));
     w.model = w.owned.get();
     try {
       w.exploration = std::make_unique<ModelExploration>(
-          *w.model, DefaultScenario(*w.model), integrator,
-          WordOptions(setup.exploration, ShootingLayout(model), ShootingLayout(*w.model)));
+          *w.model, DefaultScenario(*w.model), integrator_,
+          WordOptions(setup_.exploration, ShootingLayout(model_), ShootingLayout(*w.model)));
     } catch (const std::invalid_argument& e) {
       *why = e.what();
       return -1;
     }
-    words.push_back(std::move(w));
-    return static_cast<int>(words.size()) - 1;
-  };
+    words_.push_back(std::move(w));
+    return static_cast<int>(words_.size()) - 1;
+  }
+
   // The family of word entry `target` through the orbit u, both directions: its points analysed and written,
-  // its branches and special points numbered after the run's so far.
-  const auto Explore = [&](int target, const Vector& u) {
-    WordEntry& w = words[target];
-    const int offset = writer.next_branch_id();
-    w.exploration->set_branch_store(writer.resume_store(), offset);
-    TimeBasedShooting floquet_map(*w.model, integrator);
+  // its branches and special points numbered after the run's so far, its families named by their word (the
+  // [[families]] rules are written for the file's word).
+  BifurcationDiagram Explore(int target, const Vector& u) {
+    WordEntry& w = words_[target];
+    const int offset = writer_.next_branch_id();
+    w.exploration->set_branch_store(writer_.resume_store(), offset);
+    TimeBasedShooting floquet_map(*w.model, integrator_);
     const ShootingLayout word_layout(*w.model);
     int skipped = 0;
     BifurcationDiagram d = w.exploration->RunFromStarts({u}, [&](const ProgressInfo& info, const Vector& v) {
       const int branch = info.branch_id + offset;
-      if (info.point_index == 0) writer.SetBranchModel(branch, *w.model, automaton.WordName(w.word));
+      if (info.point_index == 0) writer_.SetBranchModel(branch, *w.model, automaton_.WordName(w.word));
       PointRecord record = RecordOf(info, v);
       const auto known = w.exploration->KnownBranchPointAnalysis(v);
-      AnalyzePoint(*w.model, integrator, floquet_map, replay, &record, known ? &*known : nullptr);
-      writer.AddPoint(branch, record);
+      AnalyzePoint(*w.model, integrator_, floquet_map, replay_, &record, known ? &*known : nullptr);
+      writer_.AddPoint(branch, record);
     }, &skipped);
     if (d.status == ExplorationStatus::kStartFailed) return d;
-    RenumberDiagram(offset, static_cast<int>(special_points->size()), &d);
-    for (nlohmann::json& sp : SpecialPointsJson(d, word_layout, w.model, integrator)) {
+    RenumberDiagram(offset, static_cast<int>(special_points_->size()), &d);
+    for (nlohmann::json& sp : SpecialPointsJson(d, word_layout, w.model, integrator_)) {
       sp["word"] = w.model->WordModeNames();
-      special_points->push_back(sp);
+      special_points_->push_back(sp);
     }
+    const std::string word_name = automaton_.WordName(w.word);
     for (const Branch& b : d.branches) {
-      writer.EndBranch(b);
+      writer_.EndBranch(b);
       w.branches.branches.push_back(b);
-      // Its families named by their word: the [[families]] rules are written for the file's word.
-      const std::string word_name = automaton.WordName(w.word);
-      word_ranges += AssignBranchFamily(b, word_layout, [&](const Vector&) { return word_name; }, writer);
+      word_ranges_ += AssignBranchFamily(b, word_layout, [&](const Vector&) { return word_name; }, writer_);
     }
     return d;
-  };
-  std::deque<std::pair<int, BifurcationDiagram>> to_scan = {{0, diagram}};
-  // The starts the model declares in other words: their families first, scanned like the rest.
-  for (std::size_t i = 0; i < model.setup().word_starts.size(); ++i) {
-    const StartSpec& start = model.setup().word_starts[i];
-    std::string why;
-    const int target = EntryOf(start.word, &why);
-    const std::string name = automaton.WordName(start.word);
-    if (target < 0) {
-      report += fmt::format("  start in word {}: not explored, {}\n", name, why);
-      continue;
-    }
-    const HybridModel& word_model = *words[target].model;
-    const ShootingLayout layout(word_model);
-    const Vector guess = StartPoint(word_model, start);
-    TimeBasedShooting map(word_model, integrator);
-    Corrector corrector(&map);
-    Vector u;
-    const CorrectorResult corrected = corrector.CorrectFixedComponent(guess, layout.H_index(), guess(layout.H_index()), &u);
-    if (!corrected.converged()) {
-      report += fmt::format("  start in word {}: the guess does not converge to an orbit at H = {}: {}\n", name,
-                            guess(layout.H_index()), corrected.message);
-      continue;
-    }
-    if (hooks.on_progress) hooks.on_progress({"words", writer.next_branch_id(), 0, fmt::format("word {} from its start:", name)});
-    const BifurcationDiagram d = Explore(target, u);
-    if (d.status == ExplorationStatus::kStartFailed) {
-      report += fmt::format("  start in word {}: not explored, {}\n", name, d.message);
-      continue;
-    }
-    for (const Branch& b : d.branches) writer.AnnotateBranch(b.id, {{"started_in_word", name}});
-    report += fmt::format("  start in word {} (H = {:.10f}): {} branches ({} to {}), {} special points\n", name,
-                          u(layout.H_index()), d.branches.size(), FirstId(d),
-                          FirstId(d) + static_cast<int>(d.branches.size()) - 1, d.special_points.size());
-    to_scan.emplace_back(target, d);
   }
-  while (!to_scan.empty()) {
-    const int entry = to_scan.front().first;
-    const BifurcationDiagram scan = std::move(to_scan.front().second);
-    to_scan.pop_front();
-    const HybridModel& word_model = *words[entry].model;
-    std::vector<Degeneracy> found;
-    ZeroDurations(word_model, scan, integrator, &found);
-    TouchedGuards(word_model, scan, integrator, &found);
-    for (const PhysicalEnd& e : PhysicalEnds(word_model, scan, writer)) {
-      const std::string at = fmt::format("end of a physical family ({})", ToString(e.beyond.reason));
-      report += fmt::format("  word {}: {} at H in [{:.10f}, {:.10f}] (branch {} between points {} and {}; {}):\n    "
-                            "refused: {}\n",
-                            automaton.WordName(words[entry].word), at, std::min(e.H_physical, e.H_beyond),
-                            std::max(e.H_physical, e.H_beyond), e.branch, std::min(e.index_physical, e.index_beyond),
-                            std::max(e.index_physical, e.index_beyond), e.beyond.detail, EndReason(e.beyond.reason));
-      changes.push_back({{"from_word", word_model.WordModeNames()},
-                         {"from_branch", e.branch},
-                         {"at", at},
-                         {"H", 0.5 * (e.H_physical + e.H_beyond)},
-                         {"H_bracket", {e.H_physical, e.H_beyond}},
-                         {"detail", e.beyond.detail},
-                         {"accepted", false},
-                         {"reason", EndReason(e.beyond.reason)}});
-    }
-    for (const Degeneracy& g : found) {
-      if (seen(entry, g.u)) continue;
-      const ShootingLayout layout(word_model);
-      const double H = layout.has_level() ? g.u(layout.H_index()) : std::nan("");
+
+  // The starts the model declares in other words: their families first, scanned like the rest.
+  void StartDeclaredWords() {
+    for (const StartSpec& start : model_.setup().word_starts) {
       std::string why;
-      const std::vector<WordChange> candidates =
-          g.transition < 0 ? WordsWithoutPhase(word_model, g.u, g.segment, integrator, &why)
-                           : WordsWithTransition(word_model, g.u, g.transition, g.segment, g.t, integrator, &why);
-      const std::string kind = g.transition < 0 ? fmt::format("t{} = 0", g.segment + 1)
-                                                : fmt::format("guard of {} touched", automaton.transitions()[g.transition].name);
-      report += fmt::format("  word {}: {} at H = {:.10f} ({}):\n", automaton.WordName(words[entry].word), kind, H, g.where);
-      if (candidates.empty()) {
-        report += "    refused: " + why + "\n";
-        changes.push_back({{"from_word", word_model.WordModeNames()}, {"from_branch", g.branch}, {"at", kind},
-                           {"H", H}, {"accepted", false}, {"reason", why}});
+      const int target = EntryOf(start.word, &why);
+      const std::string name = automaton_.WordName(start.word);
+      if (target < 0) {
+        report_ += fmt::format("  start in word {}: not explored, {}\n", name, why);
         continue;
       }
-      for (const WordChange& c : candidates) {
-        nlohmann::json j = {{"from_word", word_model.WordModeNames()},
-                            {"from_branch", g.branch},
-                            {"at", kind},
-                            {"H", H},
-                            {"rule", c.rule},
-                            {"to_word", automaton.ModeNames(c.word)},
-                            {"residual", c.residual},
-                            {"accepted", c.accepted}};
-        if (!c.accepted) {
-          j["reason"] = c.reason;
-          report += fmt::format("    {}: refused, {}\n", c.rule, c.reason);
-          changes.push_back(j);
-          continue;
-        }
-        j["state_difference"] = c.state_difference;
-        j["period_difference"] = c.period_difference;
-        const int id = static_cast<int>(changes.size());
-        // The word's entry, or a new one.
-        int target = -1;
-        for (std::size_t e = 0; e < words.size(); ++e) {
-          if (words[e].word == c.word) target = static_cast<int>(e);
-        }
-        if (target >= 0) {
-          const int through = words[target].exploration->BranchThrough(words[target].branches, c.u);
-          if (through >= 0) {
-            j["to_branches"] = {through};
-            report += fmt::format("    {}: the orbit continues on branch {} of word {} (already traced); same orbit to "
-                                  "{:.1e} (state at the section), {:.1e} (period)\n",
-                                  c.rule, through, automaton.WordName(c.word), c.state_difference, c.period_difference);
-            changes.push_back(j);
-            continue;
-          }
-        }
-        if (c.singular) {
-          j["accepted"] = false;
-          j["reason"] = "the orbit is a singular point (a branch point) of the new word's map, on no branch of it traced "
-                        "so far: not followed from there";
-          report += fmt::format("    {}: {}\n", c.rule, j["reason"].get<std::string>());
-          changes.push_back(j);
-          continue;
-        }
-        if (target < 0 && (target = EntryOf(c.word, &why)) < 0) {
-          j["reason"] = "not explored: " + why;
-          report += fmt::format("    {}: {}\n", c.rule, j["reason"].get<std::string>());
-          changes.push_back(j);
-          continue;
-        }
-        // Explore the new word's family from the orbit, both directions.
-        if (hooks.on_progress) {
-          hooks.on_progress({"words", writer.next_branch_id(), 0, fmt::format("word {} from {}:", automaton.WordName(c.word), c.rule)});
-        }
-        BifurcationDiagram d = Explore(target, c.u);
-        if (d.status == ExplorationStatus::kStartFailed) {
-          j["reason"] = "not explored: " + d.message;
-          report += fmt::format("    {}: {}\n", c.rule, j["reason"].get<std::string>());
-          changes.push_back(j);
-          continue;
-        }
-        nlohmann::json ids = nlohmann::json::array();
-        for (const Branch& b : d.branches) {
-          writer.AnnotateBranch(b.id, {{"handed_over_from", id}});
-          ids.push_back(b.id);
-        }
-        j["to_branches"] = ids;
-        report += fmt::format("    {}: accepted, same orbit to {:.1e} (state at the section), {:.1e} (period); word {}: "
-                              "{} branches ({} to {}), {} special points\n",
-                              c.rule, c.state_difference, c.period_difference, automaton.WordName(c.word),
-                              d.branches.size(), FirstId(d), FirstId(d) + static_cast<int>(d.branches.size()) - 1,
-                              d.special_points.size());
-        changes.push_back(j);
-        to_scan.emplace_back(target, std::move(d));
+      const HybridModel& word_model = *words_[target].model;
+      const ShootingLayout layout(word_model);
+      const Vector guess = StartPoint(word_model, start);
+      TimeBasedShooting map(word_model, integrator_);
+      Corrector corrector(&map);
+      Vector u;
+      const CorrectorResult corrected = corrector.CorrectFixedComponent(guess, layout.H_index(), guess(layout.H_index()), &u);
+      if (!corrected.converged()) {
+        report_ += fmt::format("  start in word {}: the guess does not converge to an orbit at H = {}: {}\n", name,
+                               guess(layout.H_index()), corrected.message);
+        continue;
       }
+      Say(fmt::format("word {} from its start:", name));
+      const BifurcationDiagram d = Explore(target, u);
+      if (d.status == ExplorationStatus::kStartFailed) {
+        report_ += fmt::format("  start in word {}: not explored, {}\n", name, d.message);
+        continue;
+      }
+      for (const Branch& b : d.branches) writer_.AnnotateBranch(b.id, {{"started_in_word", name}});
+      report_ += fmt::format("  start in word {} (H = {:.10f}): {} branches ({} to {}), {} special points\n", name,
+                             u(layout.H_index()), d.branches.size(), FirstId(d),
+                             FirstId(d) + static_cast<int>(d.branches.size()) - 1, d.special_points.size());
+      to_scan_.emplace_back(target, d);
     }
   }
-  nlohmann::json words_json = nlohmann::json::array();
-  for (const WordEntry& w : words) {
+
+  // The families of `scan` (of word entry `entry`): where they end without a change to offer, and every
+  // degeneracy followed.
+  void Scan(int entry, const BifurcationDiagram& scan) {
+    const HybridModel& word_model = *words_[entry].model;
+    std::vector<Degeneracy> found;
+    ZeroDurations(word_model, scan, integrator_, &found);
+    TouchedGuards(word_model, scan, integrator_, &found);
+    for (const PhysicalEnd& e : PhysicalEnds(word_model, scan, writer_)) {
+      const std::string at = fmt::format("end of a physical family ({})", ToString(e.beyond.reason));
+      report_ += fmt::format("  word {}: {} at H in [{:.10f}, {:.10f}] (branch {} between points {} and {}; {}):\n    "
+                             "refused: {}\n",
+                             automaton_.WordName(words_[entry].word), at, std::min(e.H_physical, e.H_beyond),
+                             std::max(e.H_physical, e.H_beyond), e.branch, std::min(e.index_physical, e.index_beyond),
+                             std::max(e.index_physical, e.index_beyond), e.beyond.detail, EndReason(e.beyond.reason));
+      changes_.push_back({{"from_word", word_model.WordModeNames()},
+                          {"from_branch", e.branch},
+                          {"at", at},
+                          {"H", 0.5 * (e.H_physical + e.H_beyond)},
+                          {"H_bracket", {e.H_physical, e.H_beyond}},
+                          {"detail", e.beyond.detail},
+                          {"accepted", false},
+                          {"reason", EndReason(e.beyond.reason)}});
+    }
+    for (const Degeneracy& g : found) {
+      if (!Seen(entry, g.u)) Follow(entry, g);
+    }
+  }
+
+  // The words a degeneracy offers, each checked and, where accepted, explored or connected.
+  void Follow(int entry, const Degeneracy& g) {
+    const HybridModel& word_model = *words_[entry].model;
+    const ShootingLayout layout(word_model);
+    const double H = layout.has_level() ? g.u(layout.H_index()) : std::nan("");
+    std::string why;
+    const std::vector<WordChange> candidates =
+        g.transition < 0 ? WordsWithoutPhase(word_model, g.u, g.segment, integrator_, &why)
+                         : WordsWithTransition(word_model, g.u, g.transition, g.segment, g.t, integrator_, &why);
+    const std::string kind = g.transition < 0 ? fmt::format("t{} = 0", g.segment + 1)
+                                              : fmt::format("guard of {} touched", automaton_.transitions()[g.transition].name);
+    report_ += fmt::format("  word {}: {} at H = {:.10f} ({}):\n", automaton_.WordName(words_[entry].word), kind, H, g.where);
+    if (candidates.empty()) {
+      report_ += "    refused: " + why + "\n";
+      changes_.push_back({{"from_word", word_model.WordModeNames()}, {"from_branch", g.branch}, {"at", kind},
+                          {"H", H}, {"accepted", false}, {"reason", why}});
+      return;
+    }
+    for (const WordChange& c : candidates) {
+      nlohmann::json j = {{"from_word", word_model.WordModeNames()},
+                          {"from_branch", g.branch},
+                          {"at", kind},
+                          {"H", H},
+                          {"rule", c.rule},
+                          {"to_word", automaton_.ModeNames(c.word)},
+                          {"residual", c.residual},
+                          {"accepted", c.accepted}};
+      if (!c.accepted) {
+        j["reason"] = c.reason;
+        report_ += fmt::format("    {}: refused, {}\n", c.rule, c.reason);
+      } else {
+        Take(c, &j);
+      }
+      changes_.push_back(j);
+    }
+  }
+
+  // An accepted change: the orbit on a branch of its word traced already (the connection), or its family
+  // explored in its word (a word entry made for it), unless that cannot be. Completes the change's record j.
+  void Take(const WordChange& c, nlohmann::json* j) {
+    (*j)["state_difference"] = c.state_difference;
+    (*j)["period_difference"] = c.period_difference;
+    const int id = static_cast<int>(changes_.size());
+    const auto refuse = [&](const std::string& reason) {
+      (*j)["reason"] = reason;
+      report_ += fmt::format("    {}: {}\n", c.rule, reason);
+    };
+    int target = -1;  // the word's entry, or a new one
+    for (std::size_t e = 0; e < words_.size(); ++e) {
+      if (words_[e].word == c.word) target = static_cast<int>(e);
+    }
+    if (target >= 0) {
+      const int through = words_[target].exploration->BranchThrough(words_[target].branches, c.u);
+      if (through >= 0) {
+        (*j)["to_branches"] = {through};
+        report_ += fmt::format("    {}: the orbit continues on branch {} of word {} (already traced); same orbit to "
+                               "{:.1e} (state at the section), {:.1e} (period)\n",
+                               c.rule, through, automaton_.WordName(c.word), c.state_difference, c.period_difference);
+        return;
+      }
+    }
+    if (c.singular) {
+      (*j)["accepted"] = false;
+      return refuse("the orbit is a singular point (a branch point) of the new word's map, on no branch of it traced "
+                    "so far: not followed from there");
+    }
+    std::string why;
+    if (target < 0 && (target = EntryOf(c.word, &why)) < 0) return refuse("not explored: " + why);
+    // Explore the new word's family from the orbit, both directions.
+    Say(fmt::format("word {} from {}:", automaton_.WordName(c.word), c.rule));
+    BifurcationDiagram d = Explore(target, c.u);
+    if (d.status == ExplorationStatus::kStartFailed) return refuse("not explored: " + d.message);
     nlohmann::json ids = nlohmann::json::array();
-    for (const Branch& b : w.branches.branches) ids.push_back(b.id);
-    words_json.push_back({{"word", w.model->WordModeNames()}, {"name", automaton.WordName(w.word)}, {"branches", ids}});
+    for (const Branch& b : d.branches) {
+      writer_.AnnotateBranch(b.id, {{"handed_over_from", id}});
+      ids.push_back(b.id);
+    }
+    (*j)["to_branches"] = ids;
+    report_ += fmt::format("    {}: accepted, same orbit to {:.1e} (state at the section), {:.1e} (period); word {}: "
+                           "{} branches ({} to {}), {} special points\n",
+                           c.rule, c.state_difference, c.period_difference, automaton_.WordName(c.word),
+                           d.branches.size(), FirstId(d), FirstId(d) + static_cast<int>(d.branches.size()) - 1,
+                           d.special_points.size());
+    to_scan_.emplace_back(target, std::move(d));
   }
-  writer.Annotate("words", words_json);
-  writer.Annotate("word_changes", changes);
-  if (changes.empty()) report += "  none (no physical family reaches a zero duration or a competing guard)\n";
-  if (!word_ranges.empty()) {
-    report += "Physical families of the other words (where their orbits are physical and where stable, in H):\n" +
-              word_ranges;
+};
+
+}  // namespace
+
+std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
+                               nlohmann::json* special_points, ResultsWriter& writer, const StudyHooks& hooks) {
+  if (!model.automaton()) return "";
+  const std::string heading = "Phase-sequence changes (words of the automaton):\n";
+  if (!setup.free.empty()) return heading + "  not followed in a run with free parameters\n";
+  if (!setup.free.observables.empty()) {
+    return heading + "  not followed in a run with observables among the unknowns (--until, --bound or --fix on an "
+                     "observable)\n";
   }
-  return report;
+  return WordExplorer(model, setup, special_points, writer, hooks).Run(diagram);
 }
 
 }  // namespace hybridcont::study
