@@ -99,9 +99,22 @@ TEST(Study, RunsWithoutAFolderAndItsFolderReadsBackAsTheSameStudy) {
       }
     }
     for (std::size_t i = 0; i < memory.special_points.size(); ++i) {
-      EXPECT_EQ(other->special_points[i].Label(), memory.special_points[i].Label());
-      EXPECT_EQ(other->special_points[i].u, memory.special_points[i].u);
-      EXPECT_EQ(other->special_points[i].status, memory.special_points[i].status);
+      const StudySpecialPoint& a = memory.special_points[i];
+      const StudySpecialPoint& b = other->special_points[i];
+      EXPECT_EQ(b.Label(), a.Label());
+      EXPECT_EQ(b.u, a.u);
+      EXPECT_EQ(b.status, a.status);
+      EXPECT_EQ(b.branch, a.branch);
+      EXPECT_EQ(b.index, a.index);
+      EXPECT_EQ(b.H, a.H);  // every number to the last bit (JSON keeps 17 digits)
+      EXPECT_EQ(b.T, a.T);
+      EXPECT_EQ(b.precision, a.precision);
+      EXPECT_EQ(b.precision_arclength, a.precision_arclength);
+      EXPECT_EQ(b.precision_H, a.precision_H);
+      EXPECT_EQ(b.residual, a.residual);
+      EXPECT_EQ(b.duplicate_of, a.duplicate_of);
+      EXPECT_EQ(b.message, a.message);
+      EXPECT_EQ(b.word, a.word);
     }
   }
   // The families, folded once, are the same in memory, as written and as read back (to the last bit).

@@ -222,6 +222,8 @@ struct StudySpecialPoint {
   double H = 0, T = 0;       // NaN where the model has no first integral
   std::string status;        // LocationStatus as text
   double precision = 0;      // width of the interval holding it (model units)
+  double precision_arclength = 0;  // the same interval along the branch, in the engine's scaled arclength
+  double precision_H = 0;          // its width in H̄ (NaN without a first integral or widths)
   double residual = 0;
   std::string component;     // a boundary's or target's component
   int duplicate_of = -1;
@@ -229,6 +231,11 @@ struct StudySpecialPoint {
   Vector u;
   std::vector<std::string> word;   // an automaton's word; empty otherwise
   int period_doubled_from = -1;
+  // The free parameters and observables among the unknowns at the point, by name (also in u).
+  std::vector<NamedValue> named_unknowns;
+  // The model's observables and constraints at the point (observable.h; NaN where one is undefined). Empty where
+  // they were not evaluated (a model without observables, a period-doubled family's point).
+  std::vector<NamedValue> observables;
   // The label of a restart (RestartSpec::label): code and id, "PD4".
   std::string Label() const { return code + std::to_string(id); }
 };

@@ -43,6 +43,7 @@
 #include "study/stages/period_doubled_families.h"
 #include "study/engine/point_analysis.h"
 #include "study/stages/restart.h"
+#include "study/stages/special_points.h"
 #include "study/study_model.h"
 #include "study/io/results_writer.h"
 #include "study/engine/run_setup.h"
@@ -351,7 +352,7 @@ ExploredFamilies ExploreFamilies(const HybridModel& model, const RunSetup& setup
 std::string RunLaterStages(const StudyOptions& options, const HybridModel& model, const HybridModel* doubled,
                            const RunSetup& setup, const RestartPlan* restart, const ExploredFamilies& explored,
                            ResultsWriter& writer,
-                           const StudyHooks& hooks, const StageSay& say, nlohmann::json* special_points,
+                           const StudyHooks& hooks, const StageSay& say, std::vector<StudySpecialPoint>* special_points,
                            StudyResult* result) {
   const bool from_pd = restart != nullptr && restart->kind == RestartSpec::Kind::kPeriodDoubled;
   const bool from_curve = restart != nullptr && restart->kind == RestartSpec::Kind::kCurve;
@@ -411,7 +412,7 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   result->message = diagram.message;
   result->diagram = diagram;
   if (writer.failed()) return;  // the failed write is the result's write_error
-  nlohmann::json special_points = SpecialPointsJson(diagram, layout, &model, setup.integrator);
+  std::vector<StudySpecialPoint> special_points = RecordSpecialPoints(diagram, layout, &model, setup.integrator);
   const std::unique_ptr<HybridModel> at_point = setup.free.empty() ? nullptr : std::make_unique<HybridModel>(model.Clone());
   const std::string floquet_report = FloquetReport(diagram, layout, [&](const Vector& u) {
     if (at_point) SetFreeParameters(layout, u, at_point.get());
@@ -422,7 +423,7 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
       period_doubling ? std::make_unique<HybridModel>(RepeatedModel(model, 2)) : nullptr;
   const std::string stages = RunLaterStages(options, model, doubled.get(), setup, restart, explored, writer, hooks, say,
                                             &special_points, result);
-  writer.SetSpecialPoints(special_points);
+  writer.SetSpecialPoints(SpecialPointsJson(special_points));
   say("key frames", "");
   WriteKeyframeOrbits(diagram, stream.log(), model, setup, layout, writer);
   const std::string ranges = RangesReport(diagram, setup.scenario, layout, writer);

@@ -62,9 +62,6 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     families: the families to map (names, e.g. ["hopping in place"]): the table has their rows only, and with
     "continue" each grid point traces only the half-branches that led to them (the first is explored whole).
     options: those of ``hybridcont.run`` (set, until, bound, rtol, ...), for every grid point."""
-    from ..models import Model
-    from dask.distributed import Client, LocalCluster, as_completed
-
     if scheduler is None and _importing_main_script():
         # A local cluster's worker process starts by importing the main script: a sweep at the script's top
         # level would start a cluster in every worker, which then never starts.
@@ -73,15 +70,65 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
 
     values = grid_values(grid)
     points = grid_points(values)
-    # Bad options end the sweep before anything runs (checked at the model's own parameters, the grid's names
-    # against its parameters); what fails later at one grid point is that point's, in its rows.
+    m, model, model_text, options = _checked_model(model, values, options, curves)
+    model_name = m.name if model is None else os.fspath(model)
+    out = os.path.abspath(os.fspath(out))
+    document = model_document(model) if model_text is None else __import__("tomllib").loads(model_text)
+    if not guess_starts(document):
+        document = None  # nothing to carry from a neighbour: every grid point explores from the model's starts
+    families = [families] if isinstance(families, str) else list(families) if families else None
+    strategy = _checked_choices(m, values, options, families, curves, strategy)
+    guided = strategy == "continue"
+    definition = _definition(model_name, values, options, strategy + (" (starts from the neighbours' orbits)"
+                                                                       if document is not None else ""))
+    if curves is not None:
+        definition["curves"] = curves
+    if families:
+        definition["families"] = families
+    _prepare_folder(out, definition, strategy, points, document, resume, overwrite)
+
+    done = {pid for pid, _ in points if os.path.exists(os.path.join(out, "points", pid, "rows.json"))}
+    todo = [(pid, v) for pid, v in points if pid not in done]
+    # Partial folders of an interrupted sweep stay until this one ends: a task of it may still run on an
+    # external cluster and write into its own (each task's name is unique), never into this sweep's.
+    say = _progress(progress, len(points), len(points) - len(todo))
+    # The order of the tasks: a tree over the grid from the point nearest the model's own parameters, each point
+    # after the neighbour it continues from; none (any order) where nothing passes between grid points.
+    tree_order = neighbour_tree(values, {n: m.parameters.get(n) for n in values}) \
+        if guided or document is not None else None
+    extras = curve_points(values, curves, m.parameters.get(curves)) if curves is not None else {}
+    if todo:
+        task = dict(model=model, model_text=model_text, options=options, out=out, document=document, guided=guided,
+                    extras=extras, families=families)
+        _run_tasks(task, points, todo, done, tree_order, definition, scheduler, workers, say)
+    for stale in os.listdir(os.path.join(out, "points")):  # copies of tasks whose worker died
+        if stale.startswith(".partial-"):
+            shutil.rmtree(os.path.join(out, "points", stale), ignore_errors=True)
+    say(done=True)
+    table = assemble(out, points)
+    write_report(out)
+    if maps:
+        try:
+            plot_maps(out)
+        except ImportError as e:  # matplotlib is the figures' (python3-matplotlib), not the sweep's
+            import warnings
+            warnings.warn("maps not drawn: %s" % e, RuntimeWarning, stacklevel=2)
+    return table
+
+
+def _checked_model(model, values, options, curves):
+    """(Model, what the workers get: a name or absolute path, or None with the model's text, the text, the
+    options): bad options end the sweep before anything runs (checked at the model's own parameters, the grid's
+    names against its parameters, each grid value within its parameter's range); what fails later at one grid
+    point is that point's, in its rows."""
+    from ..models import Model
     from ..models import model as make_model
     m = model if isinstance(model, Model) else make_model(os.fspath(model))
     unknown = [n for n in values if n not in m.parameters]
     if unknown:
         raise ValueError("grid %s: model '%s' has no parameter '%s' (parameters: %s)"
                          % (unknown[0], m.name, unknown[0], ", ".join(m.parameters)))
-    probe = m.with_parameters()  # each grid value within its parameter's range (bad input, not a failed point)
+    probe = m.with_parameters()
     for name, vals in values.items():
         for v in vals:
             try:
@@ -102,13 +149,12 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     if model_text is None:
         from ..study import check
         check(model, **dict(options, curves=curves) if curves is not None else options)
-    model_name = m.name if model is None else os.fspath(model)
-    out = os.path.abspath(os.fspath(out))
-    document = model_document(model) if model_text is None else __import__("tomllib").loads(model_text)
-    if not guess_starts(document):
-        document = None  # nothing to carry from a neighbour: every grid point explores from the model's starts
-    families = [families] if isinstance(families, str) else list(families) if families else None
-    for i, name in enumerate(families or []):
+    return m, model, model_text, options
+
+
+def _checked_choices(m, values, options, families, curves, strategy):
+    """The strategy the sweep takes (``continue`` needs families in H); families, curves and strategy checked."""
+    for name in families or []:
         # A family is named by the model's rules, or (an automaton's family of another word) by its word.
         if name not in m.families and " > " not in name:
             raise ValueError("family '%s': not a family of model '%s' (families: %s; an automaton's family of "
@@ -122,15 +168,14 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
         # A guide continues families in H, in the time-based formulation (StudyOptions::families_of).
         import warnings
         warnings.warn("sweep: strategy 'continue' needs families in H in the time-based formulation: every grid "
-                      "point is explored whole", RuntimeWarning, stacklevel=2)
-        strategy = "explore"
-    guided = strategy == "continue"
-    definition = _definition(model_name, values, options, strategy + (" (starts from the neighbours' orbits)"
-                                                                       if document is not None else ""))
-    if curves is not None:
-        definition["curves"] = curves
-    if families:
-        definition["families"] = families
+                      "point is explored whole", RuntimeWarning, stacklevel=3)
+        return "explore"
+    return strategy
+
+
+def _prepare_folder(out, definition, strategy, points, document, resume, overwrite):
+    """The sweep's folder with its definition (sweep.json): a new one, the same sweep resumed (its finished grid
+    points' files checked before anything runs), or one replaced with overwrite; refused otherwise."""
     definition_file = os.path.join(out, "sweep.json")
     if os.path.exists(definition_file) and overwrite and not resume:
         shutil.rmtree(out)  # replaced whole, whatever its files hold
@@ -163,67 +208,51 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
         json.dump(definition, f, indent=1)
     os.replace(definition_file + ".tmp", definition_file)
 
-    done = {pid for pid, _ in points if os.path.exists(os.path.join(out, "points", pid, "rows.json"))}
-    todo = [(pid, v) for pid, v in points if pid not in done]
-    # Partial folders of an interrupted sweep stay until this one ends: a task of it may still run on an
-    # external cluster and write into its own (each task's name is unique), never into this sweep's.
-    say = _progress(progress, len(points), len(points) - len(todo))
-    # The order of the tasks: a tree over the grid from the point nearest the model's own parameters, each point
-    # after the neighbour it continues from; none (any order) where nothing passes between grid points.
-    tree_order = neighbour_tree(values, {n: m.parameters.get(n) for n in values}) \
-        if guided or document is not None else None
-    extras = curve_points(values, curves, m.parameters.get(curves)) if curves is not None else {}
-    if todo:
-        cluster = None
-        if scheduler is None:
-            with _main_script_hidden():
-                cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
-                                       processes=True, dashboard_address=":0")
-        client = Client(scheduler or cluster)
-        try:
-            # Task names of this sweep's own (a shared scheduler runs other sweeps: the same name would be
-            # taken for the same task).
-            from dask.base import tokenize
-            prefix = "point-%s-" % tokenize(out, json.dumps(definition, sort_keys=True))[:12]
-            futures = []
-            if not tree_order:
-                futures = [client.submit(run_grid_point, model, model_text, pid, v, options, out, None, None, False,
-                                         extras.get(pid), families, key=prefix + pid, pure=False) for pid, v in todo]
-            else:
-                # Breadth-first from the point nearest the model's own parameters: each task gets its neighbour's
-                # result (a future: Dask runs it after that one); finished points pass theirs from their folder.
-                tree, order = tree_order
-                by_id = dict(points)
-                results = {}
-                for pid in order:
-                    parent = results.get(tree[pid]) if tree[pid] is not None else None
-                    if pid in done:
-                        results[pid] = passed_on(os.path.join(out, "points", pid), document, None)
-                        continue
-                    results[pid] = client.submit(run_grid_point, model, model_text, pid, by_id[pid], options, out,
-                                                 document, parent, guided, extras.get(pid), families,
-                                                 key=prefix + pid, pure=False)
-                    futures.append(results[pid])
-            for future in as_completed(futures):
-                future.result()
-                say()
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
-    for stale in os.listdir(os.path.join(out, "points")):  # copies of tasks whose worker died
-        if stale.startswith(".partial-"):
-            shutil.rmtree(os.path.join(out, "points", stale), ignore_errors=True)
-    say(done=True)
-    table = assemble(out, points)
-    write_report(out)
-    if maps:
-        try:
-            plot_maps(out)
-        except ImportError as e:  # matplotlib is the figures' (python3-matplotlib), not the sweep's
-            import warnings
-            warnings.warn("maps not drawn: %s" % e, RuntimeWarning, stacklevel=2)
-    return table
+
+def _run_tasks(task, points, todo, done, tree_order, definition, scheduler, workers, say):
+    """The grid points still to compute, one Dask task each, on a local cluster or the scheduler's; in the tree's
+    order where a grid point continues its neighbour's (its task gets the neighbour's result as a future)."""
+    from dask.base import tokenize
+    from dask.distributed import Client, LocalCluster, as_completed
+    cluster = None
+    if scheduler is None:
+        with _main_script_hidden():
+            cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
+                                   processes=True, dashboard_address=":0")
+    client = Client(scheduler or cluster)
+    out, document, extras = task["out"], task["document"], task["extras"]
+
+    def submit(pid, values, document, parent, guided):
+        return client.submit(run_grid_point, task["model"], task["model_text"], pid, values, task["options"], out,
+                             document, parent, guided, extras.get(pid), task["families"], key=prefix + pid,
+                             pure=False)
+    try:
+        # Task names of this sweep's own (a shared scheduler runs other sweeps: the same name would be taken for
+        # the same task).
+        prefix = "point-%s-" % tokenize(out, json.dumps(definition, sort_keys=True))[:12]
+        futures = []
+        if not tree_order:
+            futures = [submit(pid, v, None, None, False) for pid, v in todo]
+        else:
+            # Breadth-first from the point nearest the model's own parameters: each task gets its neighbour's
+            # result (a future: Dask runs it after that one); finished points pass theirs from their folder.
+            tree, order = tree_order
+            by_id = dict(points)
+            results = {}
+            for pid in order:
+                parent = results.get(tree[pid]) if tree[pid] is not None else None
+                if pid in done:
+                    results[pid] = passed_on(os.path.join(out, "points", pid), document, None)
+                    continue
+                results[pid] = submit(pid, by_id[pid], document, parent, task["guided"])
+                futures.append(results[pid])
+        for future in as_completed(futures):
+            future.result()
+            say()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
 
 
 def _progress(progress, total, done):

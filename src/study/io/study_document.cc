@@ -2,9 +2,11 @@
 
 #include "study/io/json_fields.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <stdexcept>
 
 namespace hybridcont::study {
@@ -83,6 +85,8 @@ StudySpecialPoint SpecialPointFromSummary(const nlohmann::json& entry, const std
   p.T = JsonNumber(entry, "T", where, kNaN);
   p.status = JsonText(entry, "status", where);
   p.precision = JsonNumber(entry, "precision", where, kNaN);
+  p.precision_arclength = JsonNumber(entry, "precision_arclength", where, kNaN);
+  p.precision_H = JsonNumber(entry, "precision_H", where, kNaN);
   p.residual = JsonNumber(entry, "residual", where, kNaN);
   p.component = JsonText(entry, "component", where, "");
   p.duplicate_of = JsonInt(entry, "duplicate_of", where, -1);
@@ -97,6 +101,21 @@ StudySpecialPoint SpecialPointFromSummary(const nlohmann::json& entry, const std
   }
   p.word = JsonTexts(entry, "word", where);
   p.period_doubled_from = JsonInt(entry, "period_doubled_from", where, -1);
+  // The unknowns written by name (free parameters, observables among the unknowns): every other numeric field;
+  // ResultFromSummary puts them in the order of the branch's unknowns.
+  static const std::set<std::string> kFields = {"id", "type", "branch", "index", "H", "T", "status", "precision",
+                                                "precision_arclength", "precision_H", "residual", "component",
+                                                "duplicate_of", "message", "u", "word", "period_doubled_from",
+                                                "observables"};
+  for (const auto& [name, value] : entry.items()) {
+    if (!kFields.count(name) && value.is_number()) p.named_unknowns.push_back({name, value.get<double>()});
+  }
+  if (const nlohmann::json* values = FindField(entry, "observables")) {
+    if (!values->is_object()) Malformed(where + ".observables", "expected an object");
+    for (const auto& [name, value] : values->items()) {
+      p.observables.push_back({name, value.is_null() ? kNaN : JsonNumberValue(value, where + ".observables." + name)});
+    }
+  }
   return p;
 }
 
@@ -202,6 +221,13 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
       }
       r.orbits.push_back(std::move(o));
     }
+  }
+  for (StudySpecialPoint& p : r.special_points) {  // named unknowns in the order of the branch's layout
+    if (p.branch < 0 || p.branch >= static_cast<int>(r.branches.size()) || p.named_unknowns.size() < 2) continue;
+    const std::vector<std::string>& names = r.branches[p.branch].unknown_names;
+    const auto position = [&](const NamedValue& v) { return std::find(names.begin(), names.end(), v.name) - names.begin(); };
+    std::stable_sort(p.named_unknowns.begin(), p.named_unknowns.end(),
+                     [&](const NamedValue& a, const NamedValue& b) { return position(a) < position(b); });
   }
   r.families = FoldFamilies(r.branches, r.special_points);  // derived: summary.json's "families" is not read
   r.summary_json = summary.dump(1);

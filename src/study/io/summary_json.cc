@@ -58,66 +58,34 @@ nlohmann::json OptionsJson(const StudyOptions& options, const RunSetup& setup) {
   return j;
 }
 
-nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayout& layout, const HybridModel* model,
-                                 const IntegratorOptions& integrator) {
+nlohmann::json SpecialPointsJson(const std::vector<StudySpecialPoint>& points) {
+  // NaN is written as null (JSON has no NaN); LoadStudy reads null back as NaN.
+  const auto number = [](double v) { return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v); };
   nlohmann::json list = nlohmann::json::array();
-  // The model at a point's parameter values (free parameters are unknowns), for its observables.
-  std::unique_ptr<HybridModel> at_point;
-  if (model != nullptr && !model->observables().empty()) at_point = std::make_unique<HybridModel>(model->Clone());
-  for (const SpecialPoint& sp : d.special_points) {
-    const bool level = layout.has_level();  // no H̄ without a first integral
-    const double H = sp.u.size() && level ? sp.u(layout.H_index()) : std::nan("");
-    const double precision_H = sp.interval_width.size() && level ? sp.interval_width(layout.H_index()) : std::nan("");
-    // "precision": the width of the interval that holds the point, as a distance in u (model units); state-based runs know the widths of their own unknowns
-    // only (x̄_1, ξ, H̄; NaN for the rest). "precision_arclength": the same interval along the branch in
-    // the engine's scaled arclength (SpecialPoint::precision()).
-    const double precision_u =
-        sp.interval_width.size() ? sp.interval_width.array().isNaN().select(0.0, sp.interval_width.array()).matrix().norm()
-                                 : sp.precision();
-    nlohmann::json j = {{"id", sp.id},
-                        {"type", Code(sp.type)},
-                        {"branch", sp.branch_id},
-                        {"index", sp.index},
-                        {"H", H},
-                        {"T", sp.u.size() ? layout.Period(sp.u) : std::nan("")},
-                        {"status", ToString(sp.status)},
-                        {"precision", precision_u},
-                        {"precision_arclength", sp.precision()},
-                        {"precision_H", precision_H},
-                        {"residual", sp.residual_norm},
-                        {"component", sp.component},
-                        {"duplicate_of", sp.duplicate_of},
-                        {"message", sp.message}};
-    j["u"] = std::vector<double>(sp.u.data(), sp.u.data() + sp.u.size());
-    // Each free parameter's value as a field of its own, e.g. "k": 31.5 (also in "u").
-    if (sp.u.size() == layout.num_unknowns()) {
-      for (int i = 0; i < layout.num_free_parameters(); ++i) {
-        j[layout.unknown_names()[layout.parameter_index(i)]] = sp.u(layout.parameter_index(i));
-      }
-      // And each observable that joined the unknowns, e.g. "speed": 0.5.
-      for (int i = 0; i < layout.num_observables(); ++i) {
-        j[layout.unknown_names()[layout.observable_index(i)]] = sp.u(layout.observable_index(i));
-      }
-      if (at_point) {
-        nlohmann::json values = nlohmann::json::object();
-        bool in_range = true;
-        for (int i = 0; i < layout.num_free_parameters() && in_range; ++i) {
-          try {
-            at_point->SetParameterValue(layout.parameter_model_index(i), sp.u(layout.parameter_index(i)));
-          } catch (const std::invalid_argument&) {
-            in_range = false;
-          }
-        }
-        ObservableEvaluator evaluator(*at_point, layout, integrator);
-        for (int k = 0; k < static_cast<int>(at_point->observables().size()); ++k) {
-          double v = 0.0;
-          const std::string& name = at_point->observables()[k].name;
-          if (in_range && evaluator.Evaluate(k, sp.u, &v, nullptr).ok) values[name] = v;
-          else values[name] = nullptr;
-        }
-        j["observables"] = values;
-      }
+  for (const StudySpecialPoint& p : points) {
+    nlohmann::json j = {{"id", p.id},
+                        {"type", p.code},
+                        {"branch", p.branch},
+                        {"index", p.index},
+                        {"H", number(p.H)},
+                        {"T", number(p.T)},
+                        {"status", p.status},
+                        {"precision", number(p.precision)},
+                        {"precision_arclength", number(p.precision_arclength)},
+                        {"precision_H", number(p.precision_H)},
+                        {"residual", number(p.residual)},
+                        {"component", p.component},
+                        {"duplicate_of", p.duplicate_of},
+                        {"message", p.message}};
+    j["u"] = std::vector<double>(p.u.data(), p.u.data() + p.u.size());
+    for (const NamedValue& v : p.named_unknowns) j[v.name] = number(v.value);  // "k": 31.5 (also in "u")
+    if (!p.observables.empty()) {
+      nlohmann::json values = nlohmann::json::object();
+      for (const NamedValue& v : p.observables) values[v.name] = number(v.value);
+      j["observables"] = values;
     }
+    if (!p.word.empty()) j["word"] = p.word;
+    if (p.period_doubled_from >= 0) j["period_doubled_from"] = p.period_doubled_from;
     list.push_back(j);
   }
   return list;

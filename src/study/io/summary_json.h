@@ -20,11 +20,10 @@ namespace hybridcont::study {
 // exploration limits, start conditions and the scenario's unknown scales.
 nlohmann::json OptionsJson(const StudyOptions& options, const RunSetup& setup);
 
-// The continuation's special points of `d` (u in the time-based layout described by `layout`). With a
-// model, each point also gets "observables": the model's observables and constraints at it (evaluated at
-// its parameter values; null where one is undefined).
-nlohmann::json SpecialPointsJson(const BifurcationDiagram& d, const ShootingLayout& layout,
-                                 const HybridModel* model = nullptr, const IntegratorOptions& integrator = {});
+// The study's special points (special_points.h, RecordSpecialPoints), summary.json's "special_points": one set
+// of fields for every point, plus each free parameter and observable unknown by name, "observables" where they
+// were evaluated, "word" (another word's point) and "period_doubled_from" (a period-doubled family's).
+nlohmann::json SpecialPointsJson(const std::vector<StudySpecialPoint>& points);
 
 // The study's families (FoldFamilies), summary.json's "families": derived from the branches, written for
 // readers of the folder that do not fold ranges themselves (LoadStudy folds them again):

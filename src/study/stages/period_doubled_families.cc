@@ -16,7 +16,7 @@
 #include "study/engine/model_exploration.h"
 #include "study/engine/point_analysis.h"
 #include "study/engine/scenario.h"
-#include "study/io/summary_json.h"
+#include "study/stages/special_points.h"
 
 namespace hybridcont::study {
 namespace {
@@ -58,7 +58,7 @@ std::string Multipliers(const FloquetResult& f) {
 }  // namespace
 
 std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridModel& doubled, const RunSetup& setup,
-                                         const BifurcationDiagram& diagram, nlohmann::json* special_points,
+                                         const BifurcationDiagram& diagram, std::vector<StudySpecialPoint>* special_points,
                                          ResultsWriter& writer) {
   // A model without first integral is followed in its parameter: both maps have it free (setup.free).
   const ShootingLayout parent(model, setup.free), layout(doubled, setup.free);
@@ -101,9 +101,9 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
     ++families;
     RenumberDiagram(offset, static_cast<int>(special_points->size()), &d);
     for (SpecialPoint& sp : d.special_points) sp.message += " [period-doubled family of PD #" + std::to_string(pd_id) + "]";
-    for (nlohmann::json& j : SpecialPointsJson(d, layout)) {
-      j["period_doubled_from"] = pd_id;
-      special_points->push_back(j);
+    for (StudySpecialPoint& p : RecordSpecialPoints(d, layout)) {
+      p.period_doubled_from = pd_id;
+      special_points->push_back(std::move(p));
     }
     for (const Branch& b : d.branches) {
       writer.EndBranch(b);

@@ -25,7 +25,7 @@ namespace hybridcont::study {
 // special_points, writes their branches through `writer` (its hooks see their points); returns the
 // report section.
 std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridModel& doubled, const RunSetup& setup,
-                                         const BifurcationDiagram& diagram, nlohmann::json* special_points,
+                                         const BifurcationDiagram& diagram, std::vector<StudySpecialPoint>* special_points,
                                          ResultsWriter& writer);
 
 }  // namespace hybridcont::study

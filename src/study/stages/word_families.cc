@@ -19,7 +19,7 @@
 #include "study/engine/model_exploration.h"
 #include "study/engine/point_analysis.h"
 #include "study/engine/scenario.h"
-#include "study/io/summary_json.h"
+#include "study/stages/special_points.h"
 
 namespace hybridcont::study {
 namespace {
@@ -181,7 +181,7 @@ ExplorationOptions WordOptions(const ExplorationOptions& run, const ShootingLayo
 // ones explored in their word, until no family is left to scan (or kMaxWords words).
 class WordExplorer {
  public:
-  WordExplorer(const HybridModel& model, const RunSetup& setup, nlohmann::json* special_points, ResultsWriter& writer,
+  WordExplorer(const HybridModel& model, const RunSetup& setup, std::vector<StudySpecialPoint>* special_points, ResultsWriter& writer,
                const StudyHooks& hooks)
       : model_(model), setup_(setup), integrator_(setup.integrator), replay_(ReplayOptionsFor(setup.integrator)),
         automaton_(*model.automaton()), special_points_(special_points), writer_(writer), hooks_(hooks) {}
@@ -220,7 +220,7 @@ class WordExplorer {
   const IntegratorOptions& integrator_;
   const ReplayOptions replay_;
   const HybridAutomaton& automaton_;
-  nlohmann::json* special_points_;
+  std::vector<StudySpecialPoint>* special_points_;
   ResultsWriter& writer_;
   const StudyHooks& hooks_;
   std::deque<WordEntry> words_;
@@ -288,9 +288,9 @@ class WordExplorer {
     }, &skipped);
     if (d.status == ExplorationStatus::kStartFailed) return d;
     RenumberDiagram(offset, static_cast<int>(special_points_->size()), &d);
-    for (nlohmann::json& sp : SpecialPointsJson(d, word_layout, w.model, integrator_)) {
-      sp["word"] = w.model->WordModeNames();
-      special_points_->push_back(sp);
+    for (StudySpecialPoint& p : RecordSpecialPoints(d, word_layout, w.model, integrator_)) {
+      p.word = w.model->WordModeNames();
+      special_points_->push_back(std::move(p));
     }
     const std::string word_name = automaton_.WordName(w.word);
     for (const Branch& b : d.branches) {
@@ -455,7 +455,7 @@ class WordExplorer {
 }  // namespace
 
 std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
-                               nlohmann::json* special_points, ResultsWriter& writer, const StudyHooks& hooks) {
+                               std::vector<StudySpecialPoint>* special_points, ResultsWriter& writer, const StudyHooks& hooks) {
   if (!model.automaton()) return "";
   const std::string heading = "Phase-sequence changes (words of the automaton):\n";
   if (!setup.free.empty()) return heading + "  not followed in a run with free parameters\n";

@@ -33,7 +33,8 @@ inline constexpr int kMaxWords = 8;
 // Appends the new families' special points to special_points, writes their branches through `writer` and
 // annotates summary.json; returns the report section ("" for a model without an automaton).
 std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
-                               nlohmann::json* special_points, ResultsWriter& writer, const StudyHooks& hooks);
+                               std::vector<StudySpecialPoint>* special_points, ResultsWriter& writer,
+                               const StudyHooks& hooks);
 
 }  // namespace hybridcont::study
 

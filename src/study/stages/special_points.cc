@@ -1,0 +1,72 @@
+#include "study/stages/special_points.h"
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include "hybridcont/orbit_observables.h"
+#include "hybridcont/special_point.h"
+
+namespace hybridcont::study {
+
+std::vector<StudySpecialPoint> RecordSpecialPoints(const BifurcationDiagram& d, const ShootingLayout& layout,
+                                                   const HybridModel* model, const IntegratorOptions& integrator) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  std::vector<StudySpecialPoint> out;
+  // The model at a point's parameter values (free parameters are unknowns), for its observables.
+  std::unique_ptr<HybridModel> at_point;
+  if (model != nullptr && !model->observables().empty()) at_point = std::make_unique<HybridModel>(model->Clone());
+  const bool level = layout.has_level();  // no H̄ without a first integral
+  for (const SpecialPoint& sp : d.special_points) {
+    StudySpecialPoint p;
+    p.id = sp.id;
+    p.type = sp.type;
+    p.code = Code(sp.type);
+    p.branch = sp.branch_id;
+    p.index = sp.index;
+    p.H = sp.u.size() && level ? sp.u(layout.H_index()) : kNaN;
+    p.T = sp.u.size() ? layout.Period(sp.u) : kNaN;
+    p.status = ToString(sp.status);
+    // The width of the interval that holds the point, as a distance in u (model units); state-based runs know
+    // the widths of their own unknowns only (x̄_1, ξ, H̄; NaN for the rest, left out of the distance).
+    p.precision = sp.interval_width.size()
+                      ? sp.interval_width.array().isNaN().select(0.0, sp.interval_width.array()).matrix().norm()
+                      : sp.precision();
+    p.precision_arclength = sp.precision();
+    p.precision_H = sp.interval_width.size() && level ? sp.interval_width(layout.H_index()) : kNaN;
+    p.residual = sp.residual_norm;
+    p.component = sp.component;
+    p.duplicate_of = sp.duplicate_of;
+    p.message = sp.message;
+    p.u = sp.u;
+    if (sp.u.size() == layout.num_unknowns()) {
+      for (int i = 0; i < layout.num_free_parameters(); ++i) {
+        p.named_unknowns.push_back({layout.unknown_names()[layout.parameter_index(i)], sp.u(layout.parameter_index(i))});
+      }
+      for (int i = 0; i < layout.num_observables(); ++i) {
+        p.named_unknowns.push_back({layout.unknown_names()[layout.observable_index(i)], sp.u(layout.observable_index(i))});
+      }
+      if (at_point) {
+        bool in_range = true;
+        for (int i = 0; i < layout.num_free_parameters() && in_range; ++i) {
+          try {
+            at_point->SetParameterValue(layout.parameter_model_index(i), sp.u(layout.parameter_index(i)));
+          } catch (const std::invalid_argument&) {
+            in_range = false;
+          }
+        }
+        ObservableEvaluator evaluator(*at_point, layout, integrator);
+        for (int k = 0; k < static_cast<int>(at_point->observables().size()); ++k) {
+          double v = 0.0;
+          const bool ok = in_range && evaluator.Evaluate(k, sp.u, &v, nullptr).ok;
+          p.observables.push_back({at_point->observables()[k].name, ok ? v : kNaN});
+        }
+      }
+    }
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+}  // namespace hybridcont::study
