@@ -12,6 +12,8 @@
 #include <string>
 
 #include "cli_runner.h"
+#include "hybridcont/study.h"
+#include "study/io/summary_json.h"
 
 namespace hybridcont::app {
 namespace {
@@ -62,6 +64,19 @@ TEST_P(ShippedExample, RunsToItsNamedPhysicalFamilies) {
     }
   }
   EXPECT_GT(physical_branches, 0) << GetParam();
+  // The folder read back is the study that wrote it: its families, folded again from the branches read back,
+  // are those the run wrote from memory (summary.json's "families"), to the last bit; its special points and
+  // key frames are all there; its model is rebuilt from its record.
+  const StudyResult loaded = LoadStudy(out.string());
+  EXPECT_EQ(study::FamiliesJson(loaded.families), summary["families"]) << GetParam();
+  EXPECT_EQ(loaded.special_points.size(), summary["special_points"].size());
+  ASSERT_EQ(loaded.orbits.size(), summary["orbits"].size());
+  for (const StudyOrbit& o : loaded.orbits) {
+    EXPECT_EQ(o.t.size(), o.x.size());
+    EXPECT_FALSE(o.t.empty());
+  }
+  EXPECT_EQ(loaded.model_source.kind, StudyModelSource::Kind::kFile);
+  EXPECT_EQ(ModelOfStudy(loaded).name(), loaded.model);
   std::set<std::string> expected = DeclaredFamilies(file);
   // The bouncing pendulum's swinging orbits repeat every second bounce: the period-doubled family of its
   // vertical bouncing, which `--period-doubling` follows (its file says so).

@@ -140,6 +140,18 @@ TEST(Study, RunsWithoutAFolderAndItsFolderReadsBackAsTheSameStudy) {
   EXPECT_EQ(memory.orbits.size(), loaded.orbits.size());
   EXPECT_FALSE(memory.orbits.empty());
   EXPECT_FALSE(memory.orbits.front().t.empty());  // sampled in memory
+  for (std::size_t i = 0; i < memory.orbits.size() && i < loaded.orbits.size(); ++i) {  // and read back exactly
+    const StudyOrbit& a = memory.orbits[i];
+    const StudyOrbit& b = loaded.orbits[i];
+    EXPECT_EQ(b.branch, a.branch);
+    EXPECT_EQ(b.index, a.index);
+    EXPECT_EQ(b.family, a.family);
+    EXPECT_EQ(b.t, a.t);
+    EXPECT_EQ(b.segment, a.segment);
+    ASSERT_EQ(b.x.size(), a.x.size());
+    for (std::size_t k = 0; k < a.x.size(); ++k) EXPECT_EQ(b.x[k], a.x[k]) << "orbit " << i << " sample " << k;
+    EXPECT_EQ(b.monodromy, a.monodromy);
+  }
   EXPECT_THROW(memory.branch(23), std::out_of_range);
   EXPECT_THROW(memory.branch(-1), std::out_of_range);
   fs::remove_all(dir);

@@ -329,7 +329,7 @@ struct StudyResult {
   std::string summary_json;
   // The exploration of the study's own families as the engine gives it (time-based layout, model units): every
   // branch's ContinuationPoint and SpecialPoint with tangents, interval widths and test values, the branch
-  // switches and the start's analysis. Not read back by LoadStudy (empty there).
+  // switches and the start's analysis. Not saved, so not read back by LoadStudy (empty there).
   BifurcationDiagram diagram;
 
   // The special point with this label ("PD4"), or null.
@@ -391,8 +391,11 @@ StudyResult RunStudy(const HybridModel& model, const StudyOptions& options, cons
 // study would say (bound widened to a target, no bound).
 std::vector<std::string> CheckStudyOptions(const StudyOptions& options);
 
-// The study saved in a results folder (docs/results-format.md; a folder of an interrupted study too). Throws
-// std::invalid_argument naming the file, line and field for a folder that is not a saved study.
+// The study saved in a results folder (docs/results-format.md; a folder of an interrupted study too): its
+// branches with their analysed points, special points, families, curves and key-frame orbits with their
+// samples, the record of its model. Not read back: the engine's diagram (tangents, interval widths, test
+// values: StudyResult::diagram is empty). Throws std::invalid_argument naming the file, line and field for a
+// folder that is not a saved study.
 StudyResult LoadStudy(const std::string& dir);
 
 }  // namespace hybridcont

@@ -417,10 +417,11 @@ std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int 
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const OrbitSample& s = samples[k];
     const int phase = s.segment % model_.num_phases();
-    f << fmt::format("{:.12g},{},{}", s.t, s.segment + 1, model_.phase(phase).name());
+    // Time and states at full precision (read back exactly by LoadStudy); the drawing's points at 12 digits.
+    f << fmt::format("{:.17g},{},{}", s.t, s.segment + 1, model_.phase(phase).name());
     for (int p = 0; p < model_.num_phases(); ++p) {
       for (int c = 0; c < model_.phase(p).dim(); ++c) {
-        if (p == phase) f << fmt::format(",{:.12g}", s.x(c));
+        if (p == phase) f << fmt::format(",{:.17g}", s.x(c));
         else f << ",";
       }
     }

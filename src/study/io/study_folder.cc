@@ -3,8 +3,8 @@
 //
 // Precision: u is written with 17 significant digits and read back exactly; the analysis columns
 // (multipliers, replay errors, test functions) with 10 and the residual with 4 (docs/results-format.md), so
-// a loaded analysis equals the computed one to that many digits. Key-frame orbits are listed (branch, point,
-// family, H, T) without their samples, which stay in orbit-<k>.csv.
+// a loaded analysis equals the computed one to that many digits. Key-frame orbits are read with their samples
+// (orbit-<k>.csv: time and states at 17 digits, exactly; older folders' 12).
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -184,6 +184,53 @@ void ReadCurves(const nlohmann::json& summary, const fs::path& dir, StudyResult*
   }
 }
 
+// The samples of the key-frame orbits r lists (summary.json's "orbits", in order): orbit-<k>.csv's time,
+// segment and the state of the sample's phase (its columns "<phase>.<state>", the phases in the order of
+// summary.json's "phases"; the sample's phase is its segment modulo their number).
+void ReadOrbitSamples(const nlohmann::json& summary, const fs::path& dir, StudyResult* r) {
+  if (!summary.contains("orbits") || !summary["orbits"].is_array()) return;
+  std::vector<std::size_t> offset, dim;  // of each phase's columns after t, segment, phase
+  std::size_t columns = 0;
+  if (summary.contains("phases") && summary["phases"].is_array()) {
+    for (const nlohmann::json& phase : summary["phases"]) {
+      const std::size_t n = phase.is_object() && phase.contains("states") && phase["states"].is_array() ? phase["states"].size() : 0;
+      offset.push_back(3 + columns);
+      dim.push_back(n);
+      columns += n;
+    }
+  }
+  if (offset.empty()) return;
+  const nlohmann::json& list = summary["orbits"];
+  for (std::size_t i = 0; i < list.size() && i < r->orbits.size(); ++i) {
+    if (!list[i].is_object() || !list[i].contains("file") || !list[i]["file"].is_string()) continue;
+    const std::string file = list[i]["file"];
+    if (fs::path(file).filename().string() != file) {
+      throw std::invalid_argument("orbits[" + std::to_string(i) + "].file: '" + file + "' is not a file name");
+    }
+    std::ifstream f(dir / file);
+    std::string line;
+    if (!f || !std::getline(f, line)) continue;  // an orbit file that was not written (a full disk)
+    StudyOrbit& orbit = r->orbits[i];
+    for (int row = 2; std::getline(f, line); ++row) {
+      const std::vector<std::string> fields = SplitRow(line);
+      const std::string where = (dir / file).string() + ":" + std::to_string(row);
+      if (fields.size() < 3 + columns) throw std::invalid_argument(where + ": " + std::to_string(fields.size()) + " fields, too few");
+      const double segment = Field(fields[1], where + ", column 'segment'");
+      if (!(segment >= 1 && segment <= 1e6 && segment == std::floor(segment))) {
+        throw std::invalid_argument(where + ", column 'segment': '" + fields[1] + "' is not a segment number");
+      }
+      const std::size_t phase = static_cast<std::size_t>(segment - 1) % offset.size();
+      Vector x(static_cast<Eigen::Index>(dim[phase]));
+      for (std::size_t c = 0; c < dim[phase]; ++c) {
+        x(static_cast<Eigen::Index>(c)) = Field(fields[offset[phase] + c], where + ", state " + std::to_string(c + 1));
+      }
+      orbit.t.push_back(Field(fields[0], where + ", column 't'"));
+      orbit.segment.push_back(static_cast<int>(segment) - 1);
+      orbit.x.push_back(std::move(x));
+    }
+  }
+}
+
 }  // namespace
 
 StudyResult LoadStudy(const std::string& dir_text) {
@@ -237,6 +284,7 @@ StudyResult LoadStudy(const std::string& dir_text) {
     }
     StudyResult r = study::ResultFromSummary(summary, std::move(points));
     ReadCurves(summary, dir, &r);
+    ReadOrbitSamples(summary, dir, &r);
     return r;
   } catch (const std::invalid_argument& e) {
     const std::string what = e.what();
