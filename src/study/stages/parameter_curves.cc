@@ -150,74 +150,105 @@ bool OnCurve(const std::vector<std::vector<Eigen::Vector2d>>& curves, const Eige
   return false;
 }
 
-}  // namespace
-
-nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
-                                    const std::filesystem::path& dir, std::string* report,
-                                    std::vector<StudyCurve>* typed) {
-  const std::string& p = setup.curve_parameter;
-  const double p0 = model.parameter(p);
-  TimeBasedShooting base(model, setup.integrator, FreeParameters{{p}, {{p, p0}}, {}});
-  const int fix_row = base.layout().fixed_row(0);
-  SpecialPointCurveOptions options;
-  ContinuationOptions& c = options.continuation;
-  c.bounds = {setup.curve_bound};
-  for (const ComponentBound& b : setup.exploration.continuation.bounds) {
-    if (b.component == "H") c.bounds.push_back(b);
+// The curves of one study in (H, p): from its special points, then along the boundaries of its physical
+// families; each written as curve_<id>.csv (with a folder) and recorded in the summary's list and the typed
+// result, said in the report.
+class CurveTracer {
+ public:
+  CurveTracer(const HybridModel& model, const RunSetup& setup, const std::filesystem::path& dir, std::string* report,
+              std::vector<StudyCurve>* typed)
+      : model_(model), setup_(setup), p_(setup.curve_parameter), p0_(model.parameter(p_)),
+        base_(model, setup.integrator, FreeParameters{{p_}, {{p_, p0_}}, {}}), fix_row_(base_.layout().fixed_row(0)),
+        layout_(model), dir_(dir), report_(report), typed_(typed) {
+    ContinuationOptions& c = options_.continuation;
+    c.bounds = {setup.curve_bound};
+    for (const ComponentBound& b : setup.exploration.continuation.bounds) {
+      if (b.component == "H") c.bounds.push_back(b);
+    }
+    // Steps relative to the parameter's size: the curves are traced unscaled. At most a quarter of the
+    // families' largest step: a curve is drawn through its points (a region's edge in the report, a line of a
+    // figure), and the families' step would leave a visible polygon (~40 points over the SLIP's k in [10, 160]).
+    const double scale = std::max(1.0, std::abs(p0_));
+    c.initial_step = setup.scenario.initial_step * scale;
+    c.max_step = setup.scenario.max_step * scale / 4;
+    c.max_points = setup.scenario.max_points;
   }
-  // Steps relative to the parameter's size: the curves are traced unscaled. At most a quarter of the
-  // families' largest step: a curve is drawn through its points (a region's edge in the report, a line of a
-  // figure), and the families' step would leave a visible polygon (~40 points over the SLIP's k in [10, 160]).
-  const double scale = std::max(1.0, std::abs(p0));
-  c.initial_step = setup.scenario.initial_step * scale;
-  c.max_step = setup.scenario.max_step * scale / 4;
-  c.max_points = setup.scenario.max_points;
-  nlohmann::json curves = nlohmann::json::array();
-  *report += fmt::format("Special-point curves in (H, {}) over {} in [{:g}, {:g}]:\n", p, p, setup.curve_bound.lower,
-                         setup.curve_bound.upper);
-  for (const SpecialPoint& sp : diagram.special_points) {
+
+  nlohmann::json Trace(const BifurcationDiagram& diagram) {
+    *report_ += fmt::format("Special-point curves in (H, {}) over {} in [{:g}, {:g}]:\n", p_, p_,
+                            setup_.curve_bound.lower, setup_.curve_bound.upper);
+    for (const SpecialPoint& sp : diagram.special_points) FromSpecialPoint(sp, diagram);
+    Boundaries(diagram);
+    if (curves_.empty()) *report_ += "  none\n";
+    return curves_;
+  }
+
+ private:
+  const HybridModel& model_;
+  const RunSetup& setup_;
+  const std::string p_;
+  const double p0_;
+  TimeBasedShooting base_;
+  const int fix_row_;
+  const ShootingLayout layout_;
+  const std::filesystem::path dir_;
+  std::string* report_;
+  std::vector<StudyCurve>* typed_;
+  SpecialPointCurveOptions options_;
+  nlohmann::json curves_ = nlohmann::json::array();
+  std::map<std::string, std::vector<std::vector<Eigen::Vector2d>>> traced_;  // boundaries' (H, p) polylines
+
+  // Writes the curve's file and records it (`entry` gets its id and file); returns its id.
+  int Record(const SpecialPointCurve& curve, nlohmann::json entry) {
+    const int id = static_cast<int>(curves_.size());
+    const std::string file = "curve_" + std::to_string(id) + ".csv";
+    if (!dir_.empty() && !WriteCurve(curve, p_, dir_ / file)) throw CurveFileError("writing " + (dir_ / file).string() + " failed");
+    entry["id"] = id;
+    entry["file"] = file;
+    curves_.push_back(std::move(entry));
+    if (typed_) typed_->push_back(Typed(curve, p_, curves_.back()));
+    return id;
+  }
+
+  // A fold, an SB point, or a PD or NS point (the zero of its Floquet test function: the stability boundary a
+  // multiplier crossing -1 or a complex pair crossing the circle draws in the plane) continued in (H, p).
+  void FromSpecialPoint(const SpecialPoint& sp, const BifurcationDiagram& diagram) {
     const bool fold = sp.type == SpecialPointType::kTurningPoint && sp.component == "H";
-    // A PD or NS point: the zero of its Floquet test function, continued in (H, p) (the stability boundary a
-    // multiplier crossing -1 or a complex pair crossing the circle draws in the plane).
     const bool floquet = sp.type == SpecialPointType::kPeriodDoubling || sp.type == SpecialPointType::kNeimarkSacker;
     if (!(fold || floquet || sp.type == SpecialPointType::kSimpleBifurcation) || sp.duplicate_of >= 0 ||
         sp.u.size() == 0 || (floquet && sp.status != LocationStatus::kLocated)) {
-      continue;
+      return;
     }
-    if (!IsPhysical(model, sp.u, setup.integrator)) continue;
+    if (!IsPhysical(model_, sp.u, setup_.integrator)) return;
     // A PD or NS point at a branch point of its family (the SLIP's PD where forward hopping leaves hopping in
     // place) is no regular zero of its test function there: its curve is the branch point's.
-    const auto at_branch_point = [&] {
-      return std::any_of(diagram.special_points.begin(), diagram.special_points.end(), [&](const SpecialPoint& q) {
-        return q.branch_id == sp.branch_id && q.id != sp.id && q.u.size() == sp.u.size() &&
-               (q.type == SpecialPointType::kSimpleBifurcation || q.type == SpecialPointType::kFloquetBranchPoint) &&
-               (q.u - sp.u).lpNorm<Eigen::Infinity>() <= 1e-6 * (1 + sp.u.lpNorm<Eigen::Infinity>());
-      });
-    };
-    if (floquet && at_branch_point()) {
-      *report += fmt::format("  from special point {} ({}): not traced (at a branch point of its family, where its "
-                             "test function has no regular zero)\n", sp.id, Code(sp.type));
-      continue;
+    const bool at_branch_point =
+        std::any_of(diagram.special_points.begin(), diagram.special_points.end(), [&](const SpecialPoint& q) {
+          return q.branch_id == sp.branch_id && q.id != sp.id && q.u.size() == sp.u.size() &&
+                 (q.type == SpecialPointType::kSimpleBifurcation || q.type == SpecialPointType::kFloquetBranchPoint) &&
+                 (q.u - sp.u).lpNorm<Eigen::Infinity>() <= 1e-6 * (1 + sp.u.lpNorm<Eigen::Infinity>());
+        });
+    if (floquet && at_branch_point) {
+      *report_ += fmt::format("  from special point {} ({}): not traced (at a branch point of its family, where its "
+                              "test function has no regular zero)\n", sp.id, Code(sp.type));
+      return;
     }
     SpecialPointCurve curve;
     try {
       if (floquet) {
-        const CurveDefinition definition{CurveKind::kTestFunction, fix_row, "H", FloquetZero(model, setup, p0, sp.type)};
-        curve = TraceSpecialPointCurve(&base, definition, OnBaseMap(sp, p0).u, options);
+        const CurveDefinition definition{CurveKind::kTestFunction, fix_row_, "H", FloquetZero(model_, setup_, p0_, sp.type)};
+        curve = TraceSpecialPointCurve(&base_, definition, OnBaseMap(sp, p0_).u, options_);
       } else {
-        curve = TraceSpecialPointCurve(&base, OnBaseMap(sp, p0), fix_row, "H", options);
+        curve = TraceSpecialPointCurve(&base_, OnBaseMap(sp, p0_), fix_row_, "H", options_);
       }
     } catch (const std::invalid_argument& e) {  // a point the defining system does not accept
-      *report += fmt::format("  from special point {}: not traced ({})\n", sp.id, e.what());
-      continue;
+      *report_ += fmt::format("  from special point {}: not traced ({})\n", sp.id, e.what());
+      return;
     }
     if (floquet && curve.status != CurveStatus::kTraced) {
-      *report += fmt::format("  from special point {} ({}): not traced ({})\n", sp.id, Code(sp.type), curve.message);
-      continue;
+      *report_ += fmt::format("  from special point {} ({}): not traced ({})\n", sp.id, Code(sp.type), curve.message);
+      return;
     }
-    const int id = static_cast<int>(curves.size());
-    const std::string file = "curve_" + std::to_string(id) + ".csv";
-    if (!dir.empty() && !WriteCurve(curve, p, dir / file)) throw CurveFileError("writing " + (dir / file).string() + " failed");
     const auto column = [&](const std::string& name) {
       return static_cast<int>(std::find(curve.unknown_names.begin(), curve.unknown_names.end(), name) -
                               curve.unknown_names.begin());
@@ -225,89 +256,88 @@ nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& se
     nlohmann::json codim_two = nlohmann::json::array();
     for (const CodimTwoPoint& q : curve.codim_two_points) {
       codim_two.push_back({{"type", ToString(q.type)}, {"name", q.name}, {"status", ToString(q.status)},
-                           {"H", q.u(column("H"))}, {p, q.u(column(p))}});
+                           {"H", q.u(column("H"))}, {p_, q.u(column(p_))}});
     }
-    curves.push_back({{"id", id},
-                      {"type", floquet ? ToString(sp.type) : ToString(curve.kind)},
-                      {"file", file},
-                      {"special_point", sp.id},
-                      {"status", ToString(curve.status)},
-                      {"message", curve.message},
-                      {"points", curve.points.size()},
-                      {"termination", {ToString(curve.backward_termination), ToString(curve.forward_termination)}},
-                      {"codim_two", codim_two}});
-    if (typed) typed->push_back(Typed(curve, p, curves.back()));
-    *report += fmt::format("  curve {} ({}) from special point {} at H = {:.10f}: {} points, {}; {} codimension-two "
-                           "points\n",
-                           id, floquet ? ToString(sp.type) : ToString(curve.kind), sp.id,
-                           sp.u(base.layout().H_index()), curve.points.size(),
-                           ToString(curve.status), curve.codim_two_points.size());
+    const std::string type = floquet ? ToString(sp.type) : ToString(curve.kind);
+    const int id = Record(curve, {{"type", type},
+                                  {"special_point", sp.id},
+                                  {"status", ToString(curve.status)},
+                                  {"message", curve.message},
+                                  {"points", curve.points.size()},
+                                  {"termination", {ToString(curve.backward_termination), ToString(curve.forward_termination)}},
+                                  {"codim_two", codim_two}});
+    *report_ += fmt::format("  curve {} ({}) from special point {} at H = {:.10f}: {} points, {}; {} codimension-two "
+                            "points\n",
+                            id, type, sp.id, sp.u(base_.layout().H_index()), curve.points.size(),
+                            ToString(curve.status), curve.codim_two_points.size());
   }
-  // Boundaries of the physical families: a duration through 0 between two points of a branch with a
-  // physical side, and located constraint boundaries (CB). One curve per boundary and place.
-  const ShootingLayout layout(model);
-  std::map<std::string, std::vector<std::vector<Eigen::Vector2d>>> traced;
-  const auto trace = [&](const Boundary& boundary, const Vector& orbit, const std::string& from) {
+
+  // The boundary through the orbit (a duration or a constraint at 0) continued in (H, p).
+  void BoundaryCurve(const Boundary& boundary, const Vector& orbit, const std::string& from) {
     std::vector<std::string> names;
     std::string why;
     std::vector<Vector> points;
     try {
-      points = TraceBoundary(model, setup, boundary, orbit, p0, c, &names, &why);
+      points = TraceBoundary(model_, setup_, boundary, orbit, p0_, options_.continuation, &names, &why);
     } catch (const std::invalid_argument& e) {
       why = e.what();
     }
     if (points.empty()) {
-      *report += fmt::format("  boundary {} = 0 from {}: not traced ({})\n", boundary.name, from, why);
+      *report_ += fmt::format("  boundary {} = 0 from {}: not traced ({})\n", boundary.name, from, why);
       return;
     }
     const int h = static_cast<int>(std::find(names.begin(), names.end(), "H") - names.begin());
-    const int q = static_cast<int>(std::find(names.begin(), names.end(), p) - names.begin());
+    const int q = static_cast<int>(std::find(names.begin(), names.end(), p_) - names.begin());
     std::vector<Eigen::Vector2d> polyline;
     for (const Vector& u : points) polyline.emplace_back(u(h), u(q));
     SpecialPointCurve curve;
     curve.unknown_names = names;
     curve.points = points;
-    const int id = static_cast<int>(curves.size());
-    const std::string file = "curve_" + std::to_string(id) + ".csv";
-    if (!dir.empty() && !WriteCurve(curve, p, dir / file)) throw CurveFileError("writing " + (dir / file).string() + " failed");
-    curves.push_back({{"id", id},
-                      {"type", "boundary"},
-                      {"name", boundary.name + " = 0"},
-                      {"file", file},
-                      {"special_point", nullptr},
-                      {"status", "traced"},
-                      {"message", ""},
-                      {"points", points.size()},
-                      {"codim_two", nlohmann::json::array()}});
-    if (typed) typed->push_back(Typed(curve, p, curves.back()));
-    *report += fmt::format("  curve {} (boundary {} = 0) from {}: {} points, H in [{:.6f}, {:.6f}]\n", id,
-                           boundary.name, from, points.size(),
-                           std::min_element(polyline.begin(), polyline.end(),
-                                            [](const auto& a, const auto& b) { return a(0) < b(0); })->x(),
-                           std::max_element(polyline.begin(), polyline.end(),
-                                            [](const auto& a, const auto& b) { return a(0) < b(0); })->x());
-    traced[boundary.name].push_back(std::move(polyline));
-  };
-  const double tol = 1e-3 * (1 + std::abs(p0));
-  for (const DurationCrossing& c : DurationCrossings(model, diagram, setup.integrator, /*zero_points=*/false)) {
-    const std::string name = std::string("t").append(std::to_string(c.segment + 1));
-    if (OnCurve(traced[name], Eigen::Vector2d(c.u(layout.H_index()), p0), tol)) continue;
-    trace({name, false}, c.u, fmt::format("branch {} between points {} and {}", c.branch, c.point, c.point + 1));
+    const int id = Record(curve, {{"type", "boundary"},
+                                  {"name", boundary.name + " = 0"},
+                                  {"special_point", nullptr},
+                                  {"status", "traced"},
+                                  {"message", ""},
+                                  {"points", points.size()},
+                                  {"codim_two", nlohmann::json::array()}});
+    const auto by_H = [](const auto& a, const auto& b) { return a(0) < b(0); };
+    *report_ += fmt::format("  curve {} (boundary {} = 0) from {}: {} points, H in [{:.6f}, {:.6f}]\n", id,
+                            boundary.name, from, points.size(),
+                            std::min_element(polyline.begin(), polyline.end(), by_H)->x(),
+                            std::max_element(polyline.begin(), polyline.end(), by_H)->x());
+    traced_[boundary.name].push_back(std::move(polyline));
   }
-  for (const SpecialPoint& sp : diagram.special_points) {
-    if (sp.type != SpecialPointType::kConstraintBoundary || sp.duplicate_of >= 0 || sp.u.size() == 0) continue;
-    // The constraint whose interior minimum vanishes there.
-    ObservableEvaluator evaluator(model, layout, setup.integrator);
-    const Vector u = sp.u.head(layout.num_unknowns());
-    const int best = VanishingObservable(model, evaluator, u, [](const Observable& o) { return o.constraint; },
-                                         /*interior_only=*/true);
-    if (best < 0) continue;
-    const std::string& name = model.observables()[best].name;
-    if (OnCurve(traced[name], Eigen::Vector2d(sp.u(layout.H_index()), p0), tol)) continue;
-    trace({name, true}, sp.u.head(layout.num_unknowns()), fmt::format("special point {} (CB)", sp.id));
+
+  // Boundaries of the physical families: a duration through 0 between two points of a branch with a physical
+  // side, and located constraint boundaries (CB). One curve per boundary and place.
+  void Boundaries(const BifurcationDiagram& diagram) {
+    const double tol = 1e-3 * (1 + std::abs(p0_));
+    for (const DurationCrossing& c : DurationCrossings(model_, diagram, setup_.integrator, /*zero_points=*/false)) {
+      const std::string name = std::string("t").append(std::to_string(c.segment + 1));
+      if (OnCurve(traced_[name], Eigen::Vector2d(c.u(layout_.H_index()), p0_), tol)) continue;
+      BoundaryCurve({name, false}, c.u, fmt::format("branch {} between points {} and {}", c.branch, c.point, c.point + 1));
+    }
+    for (const SpecialPoint& sp : diagram.special_points) {
+      if (sp.type != SpecialPointType::kConstraintBoundary || sp.duplicate_of >= 0 || sp.u.size() == 0) continue;
+      // The constraint whose interior minimum vanishes there.
+      ObservableEvaluator evaluator(model_, layout_, setup_.integrator);
+      const Vector u = sp.u.head(layout_.num_unknowns());
+      const int best = VanishingObservable(model_, evaluator, u, [](const Observable& o) { return o.constraint; },
+                                           /*interior_only=*/true);
+      if (best < 0) continue;
+      const std::string& name = model_.observables()[best].name;
+      if (OnCurve(traced_[name], Eigen::Vector2d(sp.u(layout_.H_index()), p0_), tol)) continue;
+      BoundaryCurve({name, true}, u, fmt::format("special point {} (CB)", sp.id));
+    }
   }
-  if (curves.empty()) *report += "  none\n";
-  return curves;
+};
+
+}  // namespace
+
+nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
+                                    const std::filesystem::path& dir, std::string* report,
+                                    std::vector<StudyCurve>* typed) {
+  return CurveTracer(model, setup, dir, report, typed).Trace(diagram);
 }
 
 }  // namespace hybridcont::study
