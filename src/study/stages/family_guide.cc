@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <utility>
 #include <limits>
 
 #include "hybridcont/setup_evaluation.h"
@@ -16,10 +18,10 @@ namespace {
   throw StudyOptionError("families_of", -1, "'" + dir + "': " + why);
 }
 
-}  // namespace
-
-FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, const ShootingLayout& layout,
-                              const std::vector<std::string>& families, const nlohmann::json& options) {
+// The saved study, checked: of the model, complete (a branch whose switch points were never followed would look
+// like one that led to no family), with the exploration's limits of this study, in the model's own layout.
+StudyResult CheckedGuide(const std::string& dir, const HybridModel& model, const ShootingLayout& layout,
+                         const nlohmann::json& options, nlohmann::json* summary) {
   StudyResult saved;
   try {
     saved = LoadStudy(dir);
@@ -29,9 +31,10 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
   if (saved.model != model.name()) {
     Refuse(dir, "the saved study is of model '" + saved.model + "', not '" + model.name() + "'");
   }
-  const nlohmann::json summary = nlohmann::json::parse(saved.summary_json, nullptr, false);
+  *summary = nlohmann::json::parse(saved.summary_json, nullptr, false);
+  const nlohmann::json& j = *summary;
   const std::string folder_status =
-      summary.is_object() && summary.contains("status") && summary["status"].is_string() ? summary["status"].get<std::string>() : "";
+      j.is_object() && j.contains("status") && j["status"].is_string() ? j["status"].get<std::string>() : "";
   if (folder_status != "complete" || saved.status != ExplorationStatus::kCompleted) {
     // A branch whose switch points were never followed (the study stopped at max_branches, was cancelled, or
     // failed) would look like one that led to no family.
@@ -42,9 +45,9 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
   }
   // What limits the branches the exploration follows must be the same: a branch the guide ended at a nearer
   // bound or target (until), or a switch it did not make (max_depth), may lead to a family beyond.
-  if (summary.is_object() && summary.contains("options") && summary["options"].is_object()) {
+  if (j.is_object() && j.contains("options") && j["options"].is_object()) {
     for (const char* key : {"bounds", "targets", "max_depth"}) {
-      const nlohmann::json& theirs = summary["options"].contains(key) ? summary["options"][key] : nlohmann::json();
+      const nlohmann::json& theirs = j["options"].contains(key) ? j["options"][key] : nlohmann::json();
       if (options.contains(key) && theirs != options[key]) {
         Refuse(dir, std::string("the saved study was run with other ") +
                         (std::string(key) == "targets" ? "targets (until)" : key) + " (" + theirs.dump() + ", this study " +
@@ -56,8 +59,13 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
     Refuse(dir, "the saved study's unknowns are not the model's own layout (a study in a free parameter, or "
                 "with other observables among its unknowns)");
   }
-  // The families asked for must be names the model's rules give, or names the saved study's branches have (an
-  // automaton's families of other words are named by their words).
+  return saved;
+}
+
+// The families asked for must be names the model's rules give, or names the saved study's branches have (an
+// automaton's families of other words are named by their words).
+void CheckFamilyNames(const std::string& dir, const HybridModel& model, const StudyResult& saved,
+                      const std::vector<std::string>& families) {
   std::vector<std::string> known = OrbitPresentation(model).family_names();
   for (const StudyBranch& b : saved.branches) {
     if (!b.family.empty() && std::find(known.begin(), known.end(), b.family) == known.end()) known.push_back(b.family);
@@ -70,30 +78,17 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
                              model.name() + "' nor of '" + dir + "' (families: " + names + ")");
     }
   }
-  const auto wanted = [&](const std::string& family) {
-    return !family.empty() && (families.empty() || std::find(families.begin(), families.end(), family) != families.end());
-  };
-  FamilyGuide guide;
-  guide.dir_ = dir;
+}
+
+// Per branch of the saved study: whether it led to a wanted family. A branch leads to the branches switched to
+// at its special points, the period-doubled families born at its PD points, the families of other words its
+// orbits were handed over to; a branch and its image under a symmetry lead to the images of each other's
+// families. A fixed point of these relations.
+std::vector<bool> LedToFamilies(const StudyResult& saved, const nlohmann::json& summary,
+                                const std::function<bool(const std::string&)>& wanted) {
   const int n = static_cast<int>(saved.branches.size());
-  // Each half-branch of the model's own families that leaves a switch point, and what it led to.
-  std::vector<int> ray_of(n, -1);
   std::vector<bool> fruitful(n, false);
-  for (const StudyBranch& b : saved.branches) {
-    fruitful[b.id] = wanted(b.family);
-    if (!b.origin.empty() || b.unknown_names != saved.unknown_names || b.points.size() < 2) continue;
-    if (b.parent_special_point < 0 || b.parent_special_point >= static_cast<int>(saved.special_points.size())) continue;
-    const StudySpecialPoint& from = saved.special_points[b.parent_special_point];
-    Ray ray;
-    ray.u = from.u.size() == b.points[0].u.size() ? from.u : b.points[0].u;
-    ray.v = b.points[1].u - b.points[0].u;
-    if (!ray.u.allFinite() || !ray.v.allFinite() || !(ray.v.norm() > 0)) continue;
-    ray_of[b.id] = static_cast<int>(guide.rays_.size());
-    guide.rays_.push_back(std::move(ray));
-  }
-  // What a branch led to: the branches switched to at its special points, the period-doubled families born
-  // at its PD points, the families of other words its orbits were handed over to; and a branch and its
-  // image under a symmetry lead to the images of each other's families. A fixed point of these relations.
+  for (const StudyBranch& b : saved.branches) fruitful[b.id] = wanted(b.family);
   std::vector<std::vector<int>> children(n);
   const auto on_branch = [&](int special_point) {
     return special_point >= 0 && special_point < static_cast<int>(saved.special_points.size())
@@ -125,48 +120,79 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
       }
     }
   }
-  for (int b = 0; b < n; ++b) {
-    if (ray_of[b] >= 0) guide.rays_[ray_of[b]].fruitful = fruitful[b];
-  }
-  // The rays the saved study pruned itself (it was guided too): they led to none of the families it continued
-  // (all, or those it names), so to none of ours if ours are among them.
+  return fruitful;
+}
+
+// The rays the saved study pruned itself (it was guided too), as {u, v} of `layout`'s length: they led to
+// none of the families it continued (all, or those it names), so to none of ours if ours are among them; none
+// where they may have led to a family we continue.
+std::vector<std::pair<Vector, Vector>> PrunedBefore(const std::string& dir, const nlohmann::json& summary,
+                                                    const std::vector<std::string>& families,
+                                                    const ShootingLayout& layout) {
   const nlohmann::json* guided = summary.is_object() && summary.contains("guided") && summary["guided"].is_object() &&
                                          summary["guided"].contains("pruned") && summary["guided"]["pruned"].is_array()
                                      ? &summary["guided"]
                                      : nullptr;
+  if (guided == nullptr) return {};
   std::vector<std::string> theirs;
-  if (guided != nullptr) {
-    try {
-      theirs = JsonTexts(*guided, "families", "summary.json: guided");
-    } catch (const std::invalid_argument& e) {
-      Refuse(dir, e.what());
-    }
+  try {
+    theirs = JsonTexts(*guided, "families", "summary.json: guided");
+  } catch (const std::invalid_argument& e) {
+    Refuse(dir, e.what());
   }
-  if (guided != nullptr && !theirs.empty()) {
+  if (!theirs.empty()) {
     const bool covered = !families.empty() && std::all_of(families.begin(), families.end(), [&](const std::string& f) {
       return std::find(theirs.begin(), theirs.end(), f) != theirs.end();
     });
-    if (!covered) guided = nullptr;  // its pruned rays may have led to families we continue
+    if (!covered) return {};  // its pruned rays may have led to families we continue
   }
-  guide.families_ = families;
-  if (guided != nullptr) {
-    for (std::size_t i = 0; i < (*guided)["pruned"].size(); ++i) {
-      const nlohmann::json& p = (*guided)["pruned"][i];
-      const std::string where = "summary.json: guided.pruned[" + std::to_string(i) + "]";
-      Ray ray;
-      try {
-        ray.u = VectorFrom(JsonField(p, "u", where), where + ".u");
-        ray.v = VectorFrom(JsonField(p, "v", where), where + ".v");
-      } catch (const std::invalid_argument& e) {
-        Refuse(dir, e.what());
-      }
-      if (ray.u.size() != static_cast<Eigen::Index>(layout.num_unknowns()) || ray.v.size() != ray.u.size() ||
-          !ray.u.allFinite() || !ray.v.allFinite()) {
-        Refuse(dir, "summary.json: guided.pruned: a ray of another length or not finite");
-      }
-      guide.rays_.push_back(std::move(ray));
+  std::vector<std::pair<Vector, Vector>> rays;
+  for (std::size_t i = 0; i < (*guided)["pruned"].size(); ++i) {
+    const nlohmann::json& p = (*guided)["pruned"][i];
+    const std::string where = "summary.json: guided.pruned[" + std::to_string(i) + "]";
+    Vector u, v;
+    try {
+      u = VectorFrom(JsonField(p, "u", where), where + ".u");
+      v = VectorFrom(JsonField(p, "v", where), where + ".v");
+    } catch (const std::invalid_argument& e) {
+      Refuse(dir, e.what());
     }
+    if (u.size() != static_cast<Eigen::Index>(layout.num_unknowns()) || v.size() != u.size() || !u.allFinite() ||
+        !v.allFinite()) {
+      Refuse(dir, "summary.json: guided.pruned: a ray of another length or not finite");
+    }
+    rays.emplace_back(std::move(u), std::move(v));
   }
+  return rays;
+}
+
+}  // namespace
+
+FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, const ShootingLayout& layout,
+                              const std::vector<std::string>& families, const nlohmann::json& options) {
+  nlohmann::json summary;
+  const StudyResult saved = CheckedGuide(dir, model, layout, options, &summary);
+  CheckFamilyNames(dir, model, saved, families);
+  const auto wanted = [&](const std::string& family) {
+    return !family.empty() && (families.empty() || std::find(families.begin(), families.end(), family) != families.end());
+  };
+  const std::vector<bool> fruitful = LedToFamilies(saved, summary, wanted);
+  FamilyGuide guide;
+  guide.dir_ = dir;
+  guide.families_ = families;
+  // Each half-branch of the model's own families that leaves a switch point, and whether it led to a family.
+  for (const StudyBranch& b : saved.branches) {
+    if (!b.origin.empty() || b.unknown_names != saved.unknown_names || b.points.size() < 2) continue;
+    if (b.parent_special_point < 0 || b.parent_special_point >= static_cast<int>(saved.special_points.size())) continue;
+    const StudySpecialPoint& from = saved.special_points[b.parent_special_point];
+    Ray ray;
+    ray.u = from.u.size() == b.points[0].u.size() ? from.u : b.points[0].u;
+    ray.v = b.points[1].u - b.points[0].u;
+    if (!ray.u.allFinite() || !ray.v.allFinite() || !(ray.v.norm() > 0)) continue;
+    ray.fruitful = fruitful[b.id];
+    guide.rays_.push_back(std::move(ray));
+  }
+  for (auto& [u, v] : PrunedBefore(dir, summary, families, layout)) guide.rays_.push_back({std::move(u), std::move(v), false});
   return guide;
 }
 
