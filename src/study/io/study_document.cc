@@ -119,6 +119,58 @@ StudySpecialPoint SpecialPointFromSummary(const nlohmann::json& entry, const std
   return p;
 }
 
+namespace {
+
+// The key-frame orbits summary.json lists (their samples are orbit-<k>.csv's: LoadStudy reads them).
+std::vector<StudyOrbit> OrbitsFromSummary(const nlohmann::json& summary) {
+  std::vector<StudyOrbit> out;
+  const nlohmann::json* orbits = FindField(summary, "orbits");
+  if (orbits == nullptr || !orbits->is_array()) return out;
+  for (std::size_t i = 0; i < orbits->size(); ++i) {
+    const std::string at = "orbits[" + std::to_string(i) + "]";
+    StudyOrbit o;
+    o.branch = JsonInt((*orbits)[i], "branch", at);
+    o.index = JsonInt((*orbits)[i], "index", at);
+    o.family = JsonText((*orbits)[i], "label", at, "");
+    o.H = JsonNumber((*orbits)[i], "H", at, kNaN);
+    o.T = JsonNumber((*orbits)[i], "T", at, kNaN);
+    if (const nlohmann::json* m = FindField((*orbits)[i], "monodromy"); m != nullptr && m->is_array()) {
+      const auto n = static_cast<Eigen::Index>(m->size());
+      o.monodromy = Matrix::Constant(n, n, kNaN);
+      for (Eigen::Index row = 0; row < n; ++row) {
+        const nlohmann::json& entries = (*m)[static_cast<std::size_t>(row)];
+        if (!entries.is_array() || static_cast<Eigen::Index>(entries.size()) != n) {
+          throw std::invalid_argument("summary.json: " + at + ".monodromy is not a square matrix");
+        }
+        for (Eigen::Index col = 0; col < n; ++col) {
+          const nlohmann::json& v = entries[static_cast<std::size_t>(col)];
+          if (!v.is_number()) throw std::invalid_argument("summary.json: " + at + ".monodromy holds a non-number");
+          o.monodromy(row, col) = v.get<double>();
+        }
+      }
+    }
+    out.push_back(std::move(o));
+  }
+  return out;
+}
+
+// The record of the study's model (since 0.7.0); a folder without it is rebuilt by the model's name, as then.
+StudyModelSource ModelSourceFromSummary(const nlohmann::json& summary, const std::string& model) {
+  StudyModelSource source{StudyModelSource::Kind::kName, model, "", "", ""};
+  const nlohmann::json* m = FindField(summary, "model_source");
+  if (m == nullptr) return source;
+  if (!m->is_object()) Malformed("model_source", "expected an object");
+  const std::string kind = JsonText(*m, "kind", "model_source");
+  if (!FromString(kind, &source.kind)) Malformed("model_source.kind", "'" + kind + "' is no kind of model source");
+  source.name = JsonText(*m, "name", "model_source", model);
+  source.path = JsonText(*m, "path", "model_source", "");
+  source.sha256 = JsonText(*m, "sha256", "model_source", "");
+  source.text = JsonText(*m, "text", "model_source", "");
+  return source;
+}
+
+}  // namespace
+
 StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::vector<StudyPoint>> points) {
   if (!summary.is_object()) Malformed("summary", "expected an object");
   StudyResult r;
@@ -132,17 +184,7 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
     }
   }
   r.unknown_names = JsonTexts(summary, "unknowns", "summary");
-  // Which model (since 0.7.0); a folder without the record is rebuilt by the model's name, as it was then.
-  r.model_source = {StudyModelSource::Kind::kName, r.model, "", "", ""};
-  if (const nlohmann::json* m = FindField(summary, "model_source")) {
-    if (!m->is_object()) Malformed("model_source", "expected an object");
-    const std::string kind = JsonText(*m, "kind", "model_source");
-    if (!FromString(kind, &r.model_source.kind)) Malformed("model_source.kind", "'" + kind + "' is no kind of model source");
-    r.model_source.name = JsonText(*m, "name", "model_source", r.model);
-    r.model_source.path = JsonText(*m, "path", "model_source", "");
-    r.model_source.sha256 = JsonText(*m, "sha256", "model_source", "");
-    r.model_source.text = JsonText(*m, "text", "model_source", "");
-  }
+  r.model_source = ModelSourceFromSummary(summary, r.model);
   // The continued coordinate: the first free parameter, else H (options.free, summary_json.h).
   std::string continued = "H";
   if (const nlohmann::json* options = FindField(summary, "options"); options != nullptr && options->is_object()) {
@@ -195,33 +237,7 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
     }
     if (r.message.empty()) r.message = JsonText(*e, "message", "exploration", "");
   }
-  if (const nlohmann::json* orbits = FindField(summary, "orbits"); orbits != nullptr && orbits->is_array()) {
-    for (std::size_t i = 0; i < orbits->size(); ++i) {
-      const std::string at = "orbits[" + std::to_string(i) + "]";
-      StudyOrbit o;
-      o.branch = JsonInt((*orbits)[i], "branch", at);
-      o.index = JsonInt((*orbits)[i], "index", at);
-      o.family = JsonText((*orbits)[i], "label", at, "");
-      o.H = JsonNumber((*orbits)[i], "H", at, kNaN);
-      o.T = JsonNumber((*orbits)[i], "T", at, kNaN);
-      if (const nlohmann::json* m = FindField((*orbits)[i], "monodromy"); m != nullptr && m->is_array()) {
-        const auto n = static_cast<Eigen::Index>(m->size());
-        o.monodromy = Matrix::Constant(n, n, kNaN);
-        for (Eigen::Index row = 0; row < n; ++row) {
-          const nlohmann::json& entries = (*m)[static_cast<std::size_t>(row)];
-          if (!entries.is_array() || static_cast<Eigen::Index>(entries.size()) != n) {
-            throw std::invalid_argument("summary.json: " + at + ".monodromy is not a square matrix");
-          }
-          for (Eigen::Index col = 0; col < n; ++col) {
-            const nlohmann::json& v = entries[static_cast<std::size_t>(col)];
-            if (!v.is_number()) throw std::invalid_argument("summary.json: " + at + ".monodromy holds a non-number");
-            o.monodromy(row, col) = v.get<double>();
-          }
-        }
-      }
-      r.orbits.push_back(std::move(o));
-    }
-  }
+  r.orbits = OrbitsFromSummary(summary);
   for (StudySpecialPoint& p : r.special_points) {  // named unknowns in the order of the branch's layout
     if (p.branch < 0 || p.branch >= static_cast<int>(r.branches.size()) || p.named_unknowns.size() < 2) continue;
     const std::vector<std::string>& names = r.branches[p.branch].unknown_names;
