@@ -493,13 +493,11 @@ class Continuation {
 
 }  // namespace hybridcont::python
 
-PYBIND11_MODULE(_hybridcont, m) {
-  using namespace hybridcont;
-  using namespace hybridcont::python;
-  m.doc() = "hybridcont's C++ library (study API, model maps); use the package `hybridcont`, not this module.";
-  m.attr("__version__") = Version();
-  m.def("builtin_model_names", &BuiltinModelNames, "The names of the built-in C++ models.");
+namespace hybridcont::python {
+namespace {
 
+// Models and their maps: NativeModel (a HybridModel shared with Python), MapSpec, and the ways to make one.
+void BindModels(py::module_& m) {
   py::class_<MapSpec>(m, "MapSpec", "Free parameters of a map and the unknowns that hold them.")
       .def(py::init<>())
       .def(py::init<std::vector<std::string>, std::vector<std::pair<std::string, double>>>(), py::arg("free"),
@@ -562,7 +560,10 @@ PYBIND11_MODULE(_hybridcont, m) {
         return Share(LoadModelText(text, source, options));
       },
       py::arg("text"), py::arg("source"), py::arg("compile") = true, "A model from model-file text.");
+}
 
+// Studies: run, load, their models and reports, and the text forms of their options.
+void BindStudies(py::module_& m) {
   m.def("run_study", &RunStudyFromPython, py::arg("options"), py::arg("model") = ModelHandle(),
         py::arg("on_progress") = py::none(), py::arg("on_point") = py::none(), py::arg("on_note") = py::none(),
         py::arg("report_assets") = py::none());
@@ -605,7 +606,10 @@ PYBIND11_MODULE(_hybridcont, m) {
       py::arg("options"), "Validates study options against the model without computing; returns its notes.");
   m.def("report_html", &ReportHtml, py::arg("dir"), py::arg("assets"), py::arg("model") = ModelHandle(),
         py::arg("models_directory") = "");
+}
 
+// Point-by-point continuation of one branch.
+void BindContinuation(py::module_& m) {
   py::class_<Continuation>(m, "NativeContinuation")
       .def(py::init<const ModelHandle&, const std::vector<double>&, const MapSpec&, const py::dict&>(),
            py::arg("model"), py::arg("u0"), py::arg("spec"), py::arg("options"))
@@ -616,4 +620,19 @@ PYBIND11_MODULE(_hybridcont, m) {
       .def_property_readonly("termination", &Continuation::termination)
       .def_property_readonly("message", &Continuation::message)
       .def_property_readonly("unknowns", &Continuation::unknowns);
+}
+
+}  // namespace
+}  // namespace hybridcont::python
+
+PYBIND11_MODULE(_hybridcont, m) {
+  using namespace hybridcont;
+  using namespace hybridcont::python;
+  m.doc() = "hybridcont's C++ library (study API, model maps); use the package `hybridcont`, not this module.";
+  m.attr("__version__") = Version();
+  m.def("builtin_model_names", &BuiltinModelNames, "The names of the built-in C++ models.");
+
+  BindModels(m);
+  BindStudies(m);
+  BindContinuation(m);
 }
