@@ -55,6 +55,36 @@ std::string Multipliers(const FloquetResult& f) {
   return text;
 }
 
+// Where the stability of a branch's physical orbits changes (summary.json's "stability_changes"): at the special
+// point located between the two points, the end of a stable stretch there (family_ranges.h), else between them,
+// not located (the later point's value).
+nlohmann::json StabilityChanges(const std::vector<StudyPoint>& points, const BranchRanges& ranges,
+                                const ShootingLayout& layout) {
+  nlohmann::json changes = nlohmann::json::array();
+  std::optional<bool> previous;  // the stability of the last physical point with multipliers
+  for (size_t i = 0; i < points.size(); ++i) {
+    const OrbitAnalysis& a = points[i].analysis;
+    if (!a.classification.physical || !a.floquet) continue;
+    if (previous && a.stable != *previous) {
+      nlohmann::json change = {{"after_point", i - 1}, {layout.continued_name(), points[i].u(layout.continued_index())},
+                               {"stable", a.stable}, {"located", false}};
+      for (const Range& r : ranges.stable) {  // a stable stretch that begins at point i or ends before it
+        const RangeEnd* end = r.first_point == static_cast<int>(i)      ? &r.from
+                              : r.last_point + 1 == static_cast<int>(i) ? &r.to
+                                                                        : nullptr;
+        if (end == nullptr || end->special_point < 0) continue;
+        change[layout.continued_name()] = end->value;
+        change["located"] = end->located;
+        change["special_point"] = end->special_point;
+        change["how"] = end->how;
+      }
+      changes.push_back(change);
+    }
+    previous = a.stable;
+  }
+  return changes;
+}
+
 }  // namespace
 
 std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridModel& doubled, const RunSetup& setup,
@@ -107,36 +137,14 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
     }
     for (const Branch& b : d.branches) {
       writer.EndBranch(b);
-      // Its family and ranges (families.h), from the typed analysis of its points; where the stability changes:
-      // at the special point located between the two points (family_ranges.h), else between them, not located
-      // (the later point's value).
+      // Its family and ranges (families.h), from the typed analysis of its points, and where its stability changes.
       family_lines += AssignBranchFamily(b, layout, name_of, writer);
-      nlohmann::json changes = nlohmann::json::array();
       const auto analysed = writer.points().find(b.id);
-      const std::vector<StudyPoint> none;
-      const std::vector<StudyPoint>& points = analysed == writer.points().end() ? none : analysed->second;
-      const BranchRanges ranges = FamilyOfBranch(b, points, layout.continued_index(), name_of).ranges;
-      std::optional<bool> previous;  // the stability of the last physical point with multipliers
-      for (size_t i = 0; i < points.size(); ++i) {
-        const OrbitAnalysis& a = points[i].analysis;
-        if (!a.classification.physical || !a.floquet) continue;
-        if (previous && a.stable != *previous) {
-          nlohmann::json change = {{"after_point", i - 1}, {layout.continued_name(), points[i].u(layout.continued_index())},
-                                   {"stable", a.stable}, {"located", false}};
-          for (const Range& r : ranges.stable) {  // a stable stretch that begins at point i or ends before it
-            const RangeEnd* end = r.first_point == static_cast<int>(i)      ? &r.from
-                                  : r.last_point + 1 == static_cast<int>(i) ? &r.to
-                                                                            : nullptr;
-            if (end == nullptr || end->special_point < 0) continue;
-            change[layout.continued_name()] = end->value;
-            change["located"] = end->located;
-            change["special_point"] = end->special_point;
-            change["how"] = end->how;
-          }
-          changes.push_back(change);
-        }
-        previous = a.stable;
-      }
+      const nlohmann::json changes =
+          analysed == writer.points().end()
+              ? nlohmann::json::array()
+              : StabilityChanges(analysed->second,
+                                 FamilyOfBranch(b, analysed->second, layout.continued_index(), name_of).ranges, layout);
       writer.AnnotateBranch(b.id, {{"period_doubled_from", pd_id},
                                    {"model", doubled.name()},
                                    {"unknowns", layout.unknown_names()},
