@@ -744,6 +744,18 @@ TEST(Study, LoadStudyNamesWhatIsWrongInAFolder) {
     EXPECT_NE(std::string(e.what()).find("branch-0.csv: line 2: 8 fields, the header has 9"), std::string::npos)
         << e.what();
   }
+  // A range's end that is no finite number (a hand-edited folder) is refused, not folded into a family.
+  std::ofstream(dir / "summary.json") << "{\"model\": \"slip\", \"unknowns\": [\"H\"], \"branches\": [{\"id\": 0, "
+                                         "\"termination\": \"running\", \"family\": \"a\", \"physical_ranges\": [{\"from\": "
+                                         "null, \"to\": 1, \"first_point\": 0, \"last_point\": 1}]}]}";
+  fs::remove(dir / "branch-0.csv");
+  try {
+    LoadStudy(dir.string());
+    ADD_FAILURE();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("physical_ranges[0].from: expected a finite number"), std::string::npos)
+        << e.what();
+  }
   fs::remove_all(dir);
 }
 

@@ -42,6 +42,9 @@ struct ModelFileOptions {
   std::ostream* log = nullptr;
 };
 
+// The text of a model file: a regular file of at most 4 MB (a folder, a FIFO or a device is refused before it
+// is opened). Throws ModelInputError naming the file.
+std::string ReadModelFileText(const std::filesystem::path& path);
 // Parses and checks the file into a spec (no compilation). Throws ModelInputError.
 ExpressionModelSpec ReadModelFile(const std::filesystem::path& path);
 // The same from text (for tests and fuzzing); `file_name` appears in messages.

@@ -116,7 +116,9 @@ struct StudyOptions {
   std::string models_directory;
   // Model-file text: the study's model is made of it (`model` then only names it), or, with a caller's model
   // (RunStudy(model, options)), the text that model was made of. Recorded in the result (StudyModelSource
-  // kText) so that its folder rebuilds the model, and part of the resume key.
+  // kText) so that its folder rebuilds the model, and part of the resume key. With a caller's model and no
+  // text, `model` may name the built-in model or model file it was made from (recorded as such where the
+  // model made from there has its name; otherwise it is the caller's own, kCaller).
   std::string model_text;
   std::vector<NamedValue> parameters;  // model parameters set before the study (each name once)
   std::vector<NamedValue> until;       // each branch ends exactly where an unknown or observable reaches the value
@@ -384,7 +386,8 @@ HybridModel ModelOfStudy(const StudyResult& study, const std::string& models_dir
 // Validates the options (throws StudyOptionError / ModelInputError), prepares out_dir, runs the study.
 StudyResult RunStudy(const StudyOptions& options, const StudyHooks& hooks = {});
 // The study of a model the caller built (a model of its own, a clone with edited parameters): run on a copy,
-// so `model` need not outlive the call; options.model is not read, options.parameters are set on the copy.
+// so `model` need not outlive the call; options.parameters are set on the copy, and options.model, when set,
+// names what the model was made from (StudyOptions::model_text says how it is recorded).
 StudyResult RunStudy(const HybridModel& model, const StudyOptions& options, const StudyHooks& hooks = {});
 
 // Validates the options against the model without computing or writing anything; returns the notes the

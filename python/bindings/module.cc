@@ -368,7 +368,7 @@ py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& mod
   if (!on_note.is_none()) hooks.on_note = [&](const std::string& line) { call(on_note, line); };
   hooks.stop_requested = [&] { return interrupted() || stop_this.load(); };
   StudyResult result;
-  std::string report_error;
+  std::string report_error, report_note;
   {
     InterruptGuard guard;
     py::gil_scoped_release release;
@@ -377,12 +377,13 @@ py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& mod
       std::string why;
       const std::unique_ptr<HybridModel> built = model ? nullptr : ModelForReport(result, options.models_directory, &why);
       report_error = SaveStudyReport(result, options.out_dir, *assets, model ? model.get() : built.get());
-      if (report_error.empty() && !why.empty()) report_error = "written without the orbits' animations: " + why;
+      if (report_error.empty()) report_note = why;  // written, without the orbits' animations
     }
   }
   if (!callback_error.empty()) throw std::runtime_error("a callback of the study failed: " + callback_error);
   py::dict out;
   out["report_error"] = report_error;
+  out["report_note"] = report_note;
   out["model"] = result.model;
   out["version"] = result.version;
   out["status"] = ToString(result.status);

@@ -140,7 +140,8 @@ def run(model, out=None, progress=True, report=True, **options):
     Bad input raises ValueError with the library's message; a numerical failure is the study's status.
     Ctrl-C ends the study after its current step: status "cancelled", the work so far kept (and warned)."""
     if isinstance(model, Model):
-        native_model, name = model._native, model.name
+        # Its source (a built-in name or a model file) where it has one: the folder then rebuilds it from there.
+        native_model, name = model._native, (model.source if model.text is None and model.source else model.name)
     else:
         native_model, name = None, os.fspath(model)
     temporary = out is None
@@ -163,6 +164,9 @@ def run(model, out=None, progress=True, report=True, **options):
                       "written" % result["write_error"], RuntimeWarning, stacklevel=2)
     if result["report_error"]:
         warnings.warn("report.html not written: %s" % result["report_error"], RuntimeWarning, stacklevel=2)
+    if result["report_note"]:
+        warnings.warn("report.html written without the orbits' animations: %s" % result["report_note"],
+                      RuntimeWarning, stacklevel=2)
     study = Study(opts["out_dir"], model=model if isinstance(model, Model) else None, result=result)
     if result["interrupted"]:
         warnings.warn("the study was interrupted: the work so far is kept (status %s)" % result["status"],
@@ -395,8 +399,8 @@ class Study:
     def continue_from(self, label, as_="auto", out=None, progress=True, **options):
         """A new study from a labelled point of this one ("PD4", "SB1", "B5", "B5:12"; ``as_`` as --as:
         continue, switch, period-doubled, curve, free), with the options of ``run``."""
-        m = self.model if self.model is not None else self.model_name
-        return run(m, out=out, progress=progress, from_=self, at=label, as_=as_, **options)
+        # The study's own model (given, or rebuilt from the folder's record of it): never another of its name.
+        return run(self._model(), out=out, progress=progress, from_=self, at=label, as_=as_, **options)
 
     def save(self, path, overwrite=False):
         """Copies the results folder to path (refused where a folder is, unless overwrite); returns the saved

@@ -79,7 +79,7 @@ ExpressionModelSpec ParseModelText(const std::string& text, const std::string& f
   return internal::Reader(root, file_name).Read();
 }
 
-ExpressionModelSpec ReadModelFile(const std::filesystem::path& path) {
+std::string ReadModelFileText(const std::filesystem::path& path) {
   const auto fail = [&](const std::string& why) { throw ModelInputError(SourceLocation{path.string(), 0, ""}, why); };
   // Checked before opening: a FIFO or a device would block or never end (`z.toml -> /dev/zero`).
   std::error_code ec;
@@ -99,7 +99,11 @@ ExpressionModelSpec ReadModelFile(const std::filesystem::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) fail("cannot read the model file (read error)");
-  return ParseModelText(text.str(), path.string());
+  return text.str();
+}
+
+ExpressionModelSpec ReadModelFile(const std::filesystem::path& path) {
+  return ParseModelText(ReadModelFileText(path), path.string());
 }
 
 namespace {

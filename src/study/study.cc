@@ -506,7 +506,12 @@ nlohmann::json ResultOptionsJson(const StudyOptions& o, const HybridModel& model
                       {"free", o.free},
                       {"fix", o.fix ? nlohmann::json({o.fix->name, o.fix->value}) : nlohmann::json(nullptr)},
                       {"curves", o.curves}};
-  if (o.restart) j["restart"] = {o.restart->Source(), o.restart->label, ToString(o.restart->kind)};
+  if (o.restart) {
+    // A study in memory is identified by its document's digest (two in-memory studies are never taken for one).
+    const std::string from = o.restart->study ? o.restart->Source() + " " + internal::Sha256Hex(o.restart->study->summary_json)
+                                              : o.restart->from;
+    j["restart"] = {from, o.restart->label, ToString(o.restart->kind)};
+  }
   if (!o.families_of.empty()) j["families_of"] = o.families_of;
   if (!o.families.empty()) j["families"] = o.families;
   if (!o.start_must_converge) j["start_must_converge"] = false;
@@ -555,12 +560,8 @@ std::unique_ptr<HybridModel> BuildModel(const StudyOptions& options, const Hybri
   }
   std::unique_ptr<HybridModel> model;
   if (given == nullptr && options.model_text.empty()) {
-    *source = FindStudyModel(options.model, options.models_directory);
-    model = std::make_unique<HybridModel>(MakeStudyModel(options.model, options.parameters, options.models_directory, &log));
-    source->name = model->name();
-    // The model file as read (it has been read whole, so it is a regular file): its digest identifies the model.
-    if (source->kind == StudyModelSource::Kind::kFile) source->sha256 = internal::Sha256OfFile(source->path);
-    return model;
+    return std::make_unique<HybridModel>(MakeStudyModel(options.model, options.parameters, options.models_directory,
+                                                        &log, /*compile=*/true, source));
   }
   if (given != nullptr) {
     model = std::make_unique<HybridModel>(given->Clone());
@@ -574,6 +575,18 @@ std::unique_ptr<HybridModel> BuildModel(const StudyOptions& options, const Hybri
                 ? StudyModelSource{StudyModelSource::Kind::kCaller, model->name(), "", "", ""}
                 : StudyModelSource{StudyModelSource::Kind::kText, model->name(), "",
                                    internal::Sha256Hex(options.model_text), options.model_text};
+  // A caller's model made from a built-in model or a model file (options.model names it: Python's
+  // hc.model("slip")) is recorded as that source when it is that model, so that its folder rebuilds it.
+  if (given != nullptr && options.model_text.empty() && !options.model.empty()) {
+    StudyModelSource made;
+    try {
+      const HybridModel from = MakeStudyModel(options.model, {}, options.models_directory, nullptr,
+                                              /*compile=*/false, &made);
+      if (from.name() == model->name() && from.num_phases() == model->num_phases()) *source = made;
+    } catch (const std::invalid_argument&) {
+      // Not a name or file the library can make: the caller's own model.
+    }
+  }
   SetStudyParameters(options.parameters, model.get());
   return model;
 }

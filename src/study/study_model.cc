@@ -53,7 +53,16 @@ bool FromString(const std::string& text, StudyModelSource::Kind* kind) {
   return false;
 }
 
-StudyModelSource FindStudyModel(const std::string& name, const std::string& models_directory_text) {
+namespace {
+
+// Where a study's model is: a built-in model, or the model file to read (`read`: as the name resolves, relative
+// where it was given so; `source.path`: absolute).
+struct FoundModel {
+  StudyModelSource source;
+  std::filesystem::path read;
+};
+
+FoundModel Find(const std::string& name, const std::string& models_directory_text) {
   const std::filesystem::path models_directory = models_directory_text;
   std::error_code ec;
   std::filesystem::path path;
@@ -66,7 +75,7 @@ StudyModelSource FindStudyModel(const std::string& name, const std::string& mode
     });
     if (!plain || std::find(builtins.begin(), builtins.end(), name) != builtins.end() || models_directory.empty() ||
         !std::filesystem::is_regular_file(models_directory / (name + ".toml"), ec)) {
-      return {StudyModelSource::Kind::kBuiltin, name, "", "", ""};
+      return {{StudyModelSource::Kind::kBuiltin, name, "", "", ""}, {}};
     }
     path = models_directory / (name + ".toml");
   } else {
@@ -79,19 +88,37 @@ StudyModelSource FindStudyModel(const std::string& name, const std::string& mode
     }
   }
   const std::filesystem::path absolute = std::filesystem::absolute(path, ec).lexically_normal();
-  const std::string where = ec ? path.string() : absolute.string();
-  return {StudyModelSource::Kind::kFile, name, where, "", ""};
+  return {{StudyModelSource::Kind::kFile, name, ec ? path.string() : absolute.string(), "", ""}, path};
+}
+
+}  // namespace
+
+StudyModelSource FindStudyModel(const std::string& name, const std::string& models_directory) {
+  return Find(name, models_directory).source;
 }
 
 HybridModel MakeStudyModel(const std::string& name, const std::vector<NamedValue>& parameters,
                            const std::string& models_directory, std::ostream* log, bool compile) {
-  const StudyModelSource source = FindStudyModel(name, models_directory);
+  return MakeStudyModel(name, parameters, models_directory, log, compile, nullptr);
+}
+
+HybridModel MakeStudyModel(const std::string& name, const std::vector<NamedValue>& parameters,
+                           const std::string& models_directory, std::ostream* log, bool compile,
+                           StudyModelSource* source) {
+  FoundModel found = Find(name, models_directory);
   ModelFileOptions options;
   options.log = log;
   options.compile = compile;
-  HybridModel model = source.kind == StudyModelSource::Kind::kBuiltin ? MakeBuiltinModel(name)
-                                                                       : LoadModelFile(source.path, options);
+  HybridModel model = [&] {
+    if (found.source.kind == StudyModelSource::Kind::kBuiltin) return MakeBuiltinModel(name);
+    // The file read once: its digest is that of the very bytes the model is made of.
+    const std::string text = ReadModelFileText(found.read);
+    found.source.sha256 = internal::Sha256Hex(text);
+    return LoadModelText(text, found.read.string(), options);
+  }();
   SetStudyParameters(parameters, &model);
+  found.source.name = model.name();
+  if (source != nullptr) *source = found.source;
   return model;
 }
 
@@ -109,13 +136,15 @@ HybridModel ModelOfStudy(const StudyResult& study, const std::string& models_dir
         if (!std::filesystem::is_regular_file(source.path, ec)) {
           throw std::invalid_argument(what + ": its model file " + source.path + " is gone");
         }
-        const std::string now = internal::Sha256OfFile(source.path);
+        // Read once: the bytes compared with the record are those the model is made of.
+        const std::string text = ReadModelFileText(source.path);
+        const std::string now = internal::Sha256Hex(text);
         if (now != source.sha256) {
           throw std::invalid_argument(what + ": its model file " + source.path + " has changed since the study (SHA-256 " +
                                       source.sha256.substr(0, 12) + "... then, " + now.substr(0, 12) +
                                       "... now): run the study again, or restore the file");
         }
-        return LoadModelFile(source.path, options);
+        return LoadModelText(text, source.path, options);
       }
       case StudyModelSource::Kind::kText:
         if (internal::Sha256Hex(source.text) != source.sha256) {

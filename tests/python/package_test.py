@@ -247,15 +247,30 @@ def test_a_folder_rebuilds_its_own_model_never_another_of_its_name(tmp_path):
     assert "study-data" in page
 
 
+def test_a_model_object_is_rebuilt_from_where_it_was_made(tmp_path):
+    """hc.run(hc.model(NAME)): the folder records the built-in model (or the model file) it was made from, and
+    hc.load rebuilds it there, at the study's parameters."""
+    ball = hc.model("bouncing-ball").with_parameters(g=2.0)
+    hc.run(ball, out=tmp_path / "b", progress=False, max_branches=2)
+    loaded = hc.load(tmp_path / "b")
+    assert loaded.summary["model_source"]["kind"] == "builtin"
+    assert loaded._model().parameters["g"] == 2.0  # at the study's parameters
+    assert loaded.floquet(0, 1)["monodromy"].shape[0] >= 1
+    shipped = hc.model(os.path.join(MODELS, "bouncing-ball.toml"))
+    hc.run(shipped, out=tmp_path / "f", progress=False, max_branches=2)
+    assert hc.load(tmp_path / "f").summary["model_source"]["kind"] == "file"
+
+
 def test_a_rerun_leaves_nothing_of_the_previous_study(tmp_path):
     hc.run("slip", out=tmp_path / "r", progress=False, max_branches=4).plot()
+    (tmp_path / "r" / ".report.html.x1Y2z3").write_text("a report write cut short")
     assert os.path.exists(tmp_path / "r" / "words.png") or os.path.exists(tmp_path / "r" / "figures.txt")
     drawn = (tmp_path / "r" / "figures.txt").read_text().split()
     assert drawn and all(os.path.exists(tmp_path / "r" / f) for f in drawn)
     hc.run("slip", out=tmp_path / "r", progress=False, max_branches=4, report=False)
     assert not [f for f in drawn if os.path.exists(tmp_path / "r" / f)]
     assert not os.path.exists(tmp_path / "r" / "report.html")
-    assert not [f for f in os.listdir(tmp_path / "r") if f.endswith(".tmp")]
+    assert not [f for f in os.listdir(tmp_path / "r") if f.endswith(".tmp") or f.startswith(".report.html.")]
 
 
 def test_continuation_point_by_point():

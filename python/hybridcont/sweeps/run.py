@@ -155,8 +155,9 @@ def _checked_model(model, values, options, curves):
 def _checked_choices(m, values, options, families, curves, strategy):
     """The strategy the sweep takes (``continue`` needs families in H); families, curves and strategy checked."""
     for name in families or []:
-        # A family is named by the model's rules, or (an automaton's family of another word) by its word.
-        if name not in m.families and " > " not in name:
+        # A family is named by the model's rules, by its word (an automaton's family of another word), or as a
+        # period-doubled family of the rules' names.
+        if name not in m.families and " > " not in name and not name.startswith("period-doubled "):
             raise ValueError("family '%s': not a family of model '%s' (families: %s; an automaton's family of "
                              "another word is named by its word, 'stance > flight > ...')"
                              % (name, m.name, ", ".join(m.families) or "none named"))

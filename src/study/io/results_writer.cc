@@ -163,7 +163,7 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
                        ext == ".csv") ||
                       ((ext == ".png" || ext == ".svg") && figures.count(entry.path().stem().string())) ||
                       drawn.count(name) || name == "figures.txt" || name == "report.html" || name == "plot.log" ||
-                      name == "summary.json.tmp";
+                      name == "summary.json.tmp" || name.rfind(".report.html.", 0) == 0;  // a report write cut short
     if (ours && entry.is_regular_file(ec)) fs::remove(entry.path(), ec);
   }
   WriteSummary();

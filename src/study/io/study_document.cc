@@ -18,6 +18,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 RangeEnd EndFromSummary(const nlohmann::json& r, const std::string& side, const std::string& where) {
   RangeEnd end;
   end.value = JsonNumber(r, side, where);
+  if (!std::isfinite(end.value)) Malformed(where + "." + side, "expected a finite number (an end of a range)");
   end.how = JsonText(r, side + "_how", where, "");
   end.special_point = JsonInt(r, side + "_special_point", where, -1);
   // Saved is the end's text; located is what it says (family_ranges.h, RangeEnd::how).

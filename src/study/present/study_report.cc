@@ -341,6 +341,20 @@ std::string StudyReportHtml(const StudyResult& study, const ReportAssets& assets
   return page;
 }
 
+namespace {
+
+// The process's umask, read without changing it (umask(2) would, for every thread): Linux's /proc/self/status;
+// 022 where it cannot be read.
+unsigned ProcessUmask() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("Umask:", 0) == 0) return static_cast<unsigned>(std::strtoul(line.c_str() + 6, nullptr, 8)) & 0777u;
+  }
+  return 022;
+}
+
+}  // namespace
+
 std::string SaveStudyReport(const StudyResult& study, const std::filesystem::path& dir, const ReportAssets& assets,
                             const HybridModel* model) {
   if (const std::string missing = assets.Missing(); !missing.empty()) return "the report's files are missing: " + missing;
@@ -358,8 +372,8 @@ std::string SaveStudyReport(const StudyResult& study, const std::filesystem::pat
       out << html;
       if (!out.flush()) throw std::runtime_error("cannot write " + temporary.string());
     }
-    std::filesystem::permissions(temporary, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write |
-                                                std::filesystem::perms::group_read | std::filesystem::perms::others_read);
+    // mkstemp made it private (0600): the report gets the mode any new file of the user gets (0666 less the umask).
+    std::filesystem::permissions(temporary, static_cast<std::filesystem::perms>(0666 & ~ProcessUmask()));
     std::filesystem::rename(temporary, target);
   } catch (const std::exception& e) {
     std::error_code ec;

@@ -28,9 +28,17 @@ BranchFamily FamilyOfBranch(const Branch& b, const std::vector<StudyPoint>& poin
   f.ranges = RangesOnBranch(b, physical, stable, boundary, coordinate);
   // A stretch is named at its middle point: its ends may be shared with another family (an SB point where
   // hopping in place and forward hopping meet, a fold where two families of a forced system meet).
-  const auto name = [&](Range& r) { r.family = name_of(b.points[(r.first_point + r.last_point + 1) / 2].u); };
-  for (Range& r : f.ranges.physical) name(r);
-  for (Range& r : f.ranges.stable) name(r);
+  const auto middle = [](const Range& r) { return (r.first_point + r.last_point + 1) / 2; };
+  for (Range& r : f.ranges.physical) r.family = name_of(b.points[middle(r)].u);
+  // A stable stretch lies within a physical one: it is that family's (a family is never stable where it is not
+  // physical, whatever the rules say at the stable stretch's own middle).
+  for (Range& r : f.ranges.stable) {
+    const int m = middle(r);
+    const auto within = std::find_if(f.ranges.physical.begin(), f.ranges.physical.end(), [&](const Range& p) {
+      return m >= std::min(p.first_point, p.last_point) && m <= std::max(p.first_point, p.last_point);
+    });
+    r.family = within != f.ranges.physical.end() ? within->family : name_of(b.points[m].u);
+  }
   f.family = f.ranges.physical.front().family;
   return f;
 }
