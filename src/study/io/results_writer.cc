@@ -212,15 +212,7 @@ void ResultsWriter::AnnotateBranch(int branch_id, const nlohmann::json& fields) 
   WriteSummary();
 }
 
-const std::vector<ResultsWriter::ClassifiedPoint>& ResultsWriter::ClassifiedPoints(int branch_id) const {
-  static const std::vector<ClassifiedPoint> kNone;
-  const auto it = classified_.find(branch_id);
-  return it == classified_.end() ? kNone : it->second;
-}
-
 void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
-  const bool stable = p.analysis.classification.physical && p.analysis.floquet && p.analysis.stable;
-  classified_[branch_id].push_back({p.index, p.u, p.classification, stable});
   const auto other = branch_models_.find(branch_id);
   const ShootingLayout& layout = other == branch_models_.end() ? layout_ : other->second.layout;
   std::vector<StudyPoint>& points = points_[branch_id];
@@ -304,7 +296,10 @@ void ResultsWriter::WritePoint(int branch_id, const PointRecord& p, const Shooti
 void ResultsWriter::EndBranch(const Branch& b) {
   auto file = branch_files_.find(b.id);
   if (file != branch_files_.end()) file->second.close();
-  if (!writes_files()) points_per_branch_[b.id] = static_cast<int>(ClassifiedPoints(b.id).size());
+  if (!writes_files()) {
+    const auto listed = points_.find(b.id);
+    points_per_branch_[b.id] = listed == points_.end() ? 0 : static_cast<int>(listed->second.size());
+  }
   nlohmann::json entry = {{"id", b.id},
                           {"file", BranchFileName(b.id)},
                           {"parent", b.parent_special_point},

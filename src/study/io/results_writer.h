@@ -119,14 +119,6 @@ class ResultsWriter {
   // `origin` names the family's kind for the hooks (StudyBranch::origin): "period-doubled", a word's name.
   void SetBranchModel(int branch_id, const HybridModel& model, const std::string& origin = "");
   void AddPoint(int branch_id, const PointRecord& point);
-  // The points added to a branch so far, with their classification (empty for an unknown branch).
-  struct ClassifiedPoint {
-    int index = 0;
-    Vector u;
-    Classification classification;
-    bool stable = false;  // a physical orbit whose Floquet class is stable (asymptotically or neutrally)
-  };
-  const std::vector<ClassifiedPoint>& ClassifiedPoints(int branch_id) const;
   // The family and ranges of branch `branch_id` (families.h), after EndBranch: in the branch's record and its
   // summary entry ("family", "physical_ranges", "stable_ranges").
   void SetBranchFamily(int branch_id, const BranchFamily& family);
@@ -197,7 +189,6 @@ class ResultsWriter {
     std::string origin;
   };
   std::map<int, BranchModel> branch_models_;  // branches of another model (SetBranchModel)
-  std::map<int, std::vector<ClassifiedPoint>> classified_;
   std::map<int, std::vector<StudyPoint>> points_;
   std::map<int, BranchFamily> families_;  // SetBranchFamily
   std::vector<StudyOrbit> orbits_;

@@ -118,16 +118,19 @@ std::vector<PhysicalEnd> PhysicalEnds(const HybridModel& model, const Bifurcatio
   std::vector<PhysicalEnd> ends;
   for (const Branch& b : d.branches) {
     if (b.image_of >= 0) continue;  // an image's ends are the images of its source's
-    const auto& points = writer.ClassifiedPoints(b.id);
+    const auto listed = writer.points().find(b.id);
+    if (listed == writer.points().end()) continue;
+    const std::vector<StudyPoint>& points = listed->second;
     for (std::size_t i = 0; i + 1 < points.size(); ++i) {
-      const bool a = points[i].classification.physical, z = points[i + 1].classification.physical;
+      const bool a = points[i].analysis.classification.physical, z = points[i + 1].analysis.classification.physical;
       if (a == z) continue;
-      const auto& in = a ? points[i] : points[i + 1];
-      const auto& out = a ? points[i + 1] : points[i];
-      const OrbitClass c = out.classification.reason;
+      const StudyPoint& in = a ? points[i] : points[i + 1];
+      const StudyPoint& out = a ? points[i + 1] : points[i];
+      const OrbitClass c = out.analysis.classification.reason;
       if (c != OrbitClass::kMissedEvent && c != OrbitClass::kWrongDirection && c != OrbitClass::kGrazing) continue;
       if (out.index == 0 && b.parent_special_point < 0) continue;  // the start itself (declared or handed over)
-      ends.push_back({b.id, in.u(layout.H_index()), out.u(layout.H_index()), in.index, out.index, out.classification});
+      ends.push_back({b.id, in.u(layout.H_index()), out.u(layout.H_index()), in.index, out.index,
+                      out.analysis.classification});
     }
   }
   return ends;
