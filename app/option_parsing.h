@@ -1,5 +1,5 @@
-// The command line's text forms of the study's options: NAME=VALUE, NAME=LOWER:UPPER and numbers. Each
-// error names the option and the text, e.g. "--set 'k=abc': value 'abc' is not a number".
+// The command line's words for the study's options (study_options.h declares them): each refusal names the
+// flag and the text, e.g. "--set 'k=abc': value 'abc' is not a number".
 #ifndef HYBRIDCONT_APP_OPTION_PARSING_H_
 #define HYBRIDCONT_APP_OPTION_PARSING_H_
 
@@ -18,11 +18,11 @@ namespace hybridcont::app {
 HybridModel MakeModelWithOverrides(const std::string& name, const std::vector<std::string>& assignments,
                                    std::ostream* log = nullptr, bool compile = true);
 
-// The command-line flag of a StudyOptions field ("until" -> "--until").
+// The command-line flag of an option's field (study_options.h: "until" -> "--until"; a restart, "restart" ->
+// "--from/--at/--as"); a field of no flag as it is.
 std::string FlagOf(const std::string& field);
-// A study's message in the command line's words: fields as flags ("bounds[0] " -> "--bound ").
-std::string CommandLineWords(std::string text);
-// A study's refusal as the command line says it: the flag and the value ("--until 'H=5': ...").
+// A study's refusal as the command line says it: the flag, the value, and the options it mentions as flags
+// ("--until 'H=5': ...").
 std::invalid_argument CommandLineError(const StudyOptionError& e);
 
 }  // namespace hybridcont::app

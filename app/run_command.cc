@@ -34,65 +34,18 @@ CLI::Option* NonEmpty(CLI::Option* option) {
 }
 
 void AddRunOptions(CLI::App* run, RunArguments* args) {
-  NonEmpty(run->add_option("model", args->model, "built-in model name (see `hybridcont list`) or model file (.toml)")
-               ->required());
-  NonEmpty(run->add_option("--set", args->assignments, "override a model parameter, NAME=VALUE (repeatable)"));
-  NonEmpty(run->add_option("--until", args->until,
-                           "end every branch exactly where an unknown or an observable of the model reaches a value, "
-                           "NAME=VALUE, e.g. H=2 or speed=1 (repeatable)"));
-  NonEmpty(run->add_option("--monitor", args->monitors,
-                           "locate the points where an observable of the model reaches a value, NAME=VALUE, e.g. "
-                           "speed=0.5, or several values, speed=0.5,0.8 (repeatable; special points UZ)"));
-  NonEmpty(run->add_option("--bound", args->bounds,
-                           "replace the model's bound on an unknown, NAME=LOWER:UPPER (e.g. H=0:2.7; 'period' is the "
-                           "sum of the durations; an empty end is unbounded) (repeatable)"));
-  NonEmpty(run->add_option("--out", args->out_dir, "results folder (default results/MODEL)"));
-  NonEmpty(run->add_option("--rtol", args->rtol, "integrator relative tolerance (default 1e-10)"));
-  NonEmpty(run->add_option("--atol", args->atol, "integrator absolute tolerance (default 1e-10)"));
-  NonEmpty(run->add_option("--max-branches", args->max_branches, "maximum number of half-branches traced"));
-  NonEmpty(run->add_option("--threads", args->threads,
-                           "threads tracing half-branches concurrently (default: the machine's cores; 1 = one after "
-                           "the other); the results do not depend on it"));
-  NonEmpty(run->add_option("--formulation", args->formulation,
-                           "time (default: time-based multiple shooting) or state (event-driven Poincare map)"));
-  NonEmpty(run->add_option("--free", args->free,
-                           "continue the families in a model parameter instead of H, e.g. k (needs --fix)"));
-  NonEmpty(run->add_option("--fix", args->fix,
-                           "the unknown held fixed while --free varies, NAME=VALUE: H=1.5, a state x2_dx=0.8, a "
-                           "duration t2=0 (where that phase vanishes) or an observable speed=1; starts are the physical families' crossings "
-                           "of that value in the ordinary run"));
-  NonEmpty(run->add_option("--curves", args->curves,
-                           "after the run, continue every turning and SB point of the physical families in (H, "
-                           "PARAMETER), e.g. w2 (bounds: --bound PARAMETER=LO:HI)"));
-  run->add_flag("--no-symmetry", args->no_symmetry,
-               "trace every half-branch, also those that are images of traced ones under the model's symmetries");
-  run->add_flag("--overwrite", args->overwrite,
-                "replace the results of another model in --out (without it such a folder is refused)");
-  run->add_flag("--period-doubling", args->period_doubling,
-                "explore the period-doubled family of every located PD point (the phase sequence traversed twice)");
-  run->add_flag("--one-word", args->one_word,
-                "a model given as an automaton: follow the start's phase sequence only, not the words its families "
-                "lead into where a phase vanishes or a competing guard is touched");
-  NonEmpty(run->add_option("--from", args->from,
-                           "restart from a saved study (a results folder) at the point --at names, instead of the "
-                           "model's start; the new families go to --out"));
-  NonEmpty(run->add_option("--at", args->at,
-                           "with --from: a special point's label (PD4, SB36, TP22: its type and id in that study), "
-                           "a branch's end (B5) or one of its points (B5:12)"));
-  NonEmpty(run->add_option("--as", args->as,
-                           "with --from: continue (the family beyond the point), switch (every branch through an SB "
-                           "point), period-doubled (the family born at a PD point), curve (the point in (H, --curves)), "
-                           "free (the family in --free from the orbit); default: what the label's type implies"));
-  NonEmpty(run->add_option("--families-of", args->families_of,
-                           "a saved study of this model at nearby parameter values (a results folder): trace only "
-                           "the half-branches whose counterparts there led to a family, not the whole exploration "
-                           "(what a sweep does from grid point to grid point)"));
-  NonEmpty(run->add_option("--family", args->families,
-                           "with --families-of: continue only this family of it (its name, as the answer names it; "
-                           "repeat for several)"));
-  run->add_flag("--resume", args->resume,
-                "continue the run interrupted in --out (killed, stopped, out of disk): the branches it traced are "
-                "taken as they are, the rest computed; the options must be those of that run");
+  for (const StudyOptionSpec& spec : StudyOptionSpecs()) {
+    const std::string help = SayOptions(spec.help, FlagOf);
+    if (spec.flag.empty()) continue;  // not an option of the command line
+    if (spec.flag.rfind("--", 0) != 0) {  // the positional model
+      NonEmpty(run->add_option(spec.field, args->model, help)->required());
+    } else if (spec.kind == OptionKind::kSwitch) {
+      run->add_flag(spec.flag, args->switches[spec.field], help);
+    } else {
+      // Every occurrence is kept, so that the library refuses an option given twice and names both texts.
+      run->add_option(spec.flag, args->texts[spec.field], help)->option_text(spec.value_name)->allow_extra_args(false);
+    }
+  }
   run->add_flag("--quiet", args->quiet, "no progress");
   run->add_flag("--verbose", args->verbose,
                 "a progress line per accepted point and the full report (every branch, special point and switch) "
@@ -105,72 +58,19 @@ void AddRunOptions(CLI::App* run, RunArguments* args) {
 
 namespace {
 
-Formulation ParseFormulation(const std::string& text) {
-  Formulation formulation;
-  if (!FromString(text, &formulation)) {
-    throw std::invalid_argument("--formulation '" + text + "': expected 'time' or 'state'");
-  }
-  return formulation;
-}
-
-// The study the command line asks for (its text parsed; the study validates the values).
+// The study the command line asks for: each option's text parsed and set by the library's declaration.
 StudyOptions StudyOptionsOf(const RunArguments& args) {
   StudyOptions o;
   o.model = args.model;
   o.models_directory = ModelsDirectory().string();
-  for (const std::string& a : args.assignments) {
-    const auto [name, value] = ParseAssignment("--set", a);
-    o.parameters.push_back({name, value});
-  }
-  for (const std::string& a : args.until) {
-    const auto [name, value] = ParseAssignment("--until", a);
-    o.until.push_back({name, value});
-  }
-  for (const std::string& a : args.bounds) {
-    o.bounds.push_back(ParseBound("--bound", a));
-  }
-  for (const std::string& a : args.monitors) {  // several values of one observable: NAME=V1,V2,...
-    for (const NamedValue& v : ParseAssignments("--monitor", a)) o.monitors.push_back(v);
-  }
-  o.rtol = args.rtol;
-  o.atol = args.atol;
-  o.max_branches = args.max_branches;
   // The command line owns the machine: every core unless --threads says otherwise (the library's default is
   // one thread).
-  o.threads = args.threads ? *args.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  o.formulation = ParseFormulation(args.formulation);
-  o.use_symmetries = !args.no_symmetry;
-  o.follow_word_changes = !args.one_word;
-  o.period_doubling = args.period_doubling;
-  o.free = args.free;
-  if (!args.fix.empty()) {
-    const auto [name, value] = ParseAssignment("--fix", args.fix);
-    o.fix = NamedValue{name, value};
+  o.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  for (const auto& [field, given] : args.switches) {
+    if (given) SetStudyOption(&o, field, true);
   }
-  o.curves = args.curves;
-  o.families_of = args.families_of;
-  o.families = args.families;
-  o.out_dir = args.out_dir;
-  o.overwrite = args.overwrite;
-  o.resume = args.resume;
-  if (args.from.empty() != args.at.empty()) {
-    throw std::invalid_argument(args.from.empty() ? "--at '" + args.at + "': needs --from FOLDER (a saved study)"
-                                                  : "--from '" + args.from + "': needs --at LABEL (e.g. PD4, B5)");
-  }
-  if (!args.from.empty()) {
-    RestartSpec r{args.from, args.at, RestartSpec::Kind::kAuto};
-    bool known = false;
-    for (const RestartSpec::Kind k : {RestartSpec::Kind::kAuto, RestartSpec::Kind::kContinue, RestartSpec::Kind::kSwitch,
-                                      RestartSpec::Kind::kPeriodDoubled, RestartSpec::Kind::kCurve,
-                                      RestartSpec::Kind::kFree}) {
-      if (ToString(k) == args.as) r.kind = k, known = true;
-    }
-    if (!known) {
-      throw std::invalid_argument("--as '" + args.as + "': expected continue, switch, period-doubled, curve or free");
-    }
-    o.restart = r;
-  } else if (args.as != "auto") {
-    throw std::invalid_argument("--as '" + args.as + "': needs --from FOLDER --at LABEL");
+  for (const auto& [field, texts] : args.texts) {
+    if (!texts.empty()) SetStudyOption(&o, field, ParseStudyOption(*FindStudyOption(field), texts));
   }
   return o;
 }
@@ -181,7 +81,8 @@ StudyOptions StudyOptionsOf(const RunArguments& args) {
 // or with --verbose, a line per branch and per accepted point.
 StudyHooks PrintingHooks(const RunArguments& args, bool terminal, std::ostream& out, std::ostream& err) {
   StudyHooks hooks;
-  hooks.on_note = [&err](const std::string& line) { err << "note: " << CommandLineWords(line) << "\n"; };
+  hooks.on_note = [&err](const std::string& line) { err << "note: " << line << "\n"; };
+  hooks.option_words = FlagOf;
   if (args.quiet) return hooks;
   auto current = std::make_shared<int>(-1);
   if (terminal && !args.verbose) {
@@ -257,14 +158,15 @@ std::unique_ptr<HybridModel> ModelForReport(const StudyResult& study, std::ostre
 }  // namespace
 
 int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
-  StudyOptions options = StudyOptionsOf(args);
-  if (options.out_dir.empty()) {
-    // The default folder is named by the model: results/<model name>.
-    options.out_dir = (fs::path("results") / MakeModelWithOverrides(args.model, {}, nullptr, false).name()).string();
-  }
   StudyResult study;
+  StudyOptions options;
   const bool terminal = &out == &std::cout && isatty(STDOUT_FILENO) == 1;
   try {
+    options = StudyOptionsOf(args);
+    if (options.out_dir.empty()) {
+      // The default folder is named by the model: results/<model name>.
+      options.out_dir = (fs::path("results") / MakeModelWithOverrides(args.model, {}, nullptr, false).name()).string();
+    }
     study = RunStudy(options, PrintingHooks(args, terminal, out, err));
   } catch (const StudyOptionError& e) {
     throw CommandLineError(e);

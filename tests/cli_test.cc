@@ -122,6 +122,31 @@ TEST(Cli, BadInputGetsAClearMessageAndNonZeroExit) {
   EXPECT_FALSE(fs::exists(TempDir("bad_rtol")));
 }
 
+// `run`'s options are the library's declaration (study_options.h): every declared flag is in the help with the
+// declared help, and the options a message names are said as flags.
+TEST(Cli, RunTakesEveryDeclaredOptionAndSaysOptionsAsFlags) {
+  const CliResult help = RunTool({"run", "--help"});
+  ASSERT_EQ(help.code, 0);
+  for (const StudyOptionSpec& spec : StudyOptionSpecs()) {
+    if (spec.flag.rfind("--", 0) != 0) continue;
+    EXPECT_NE(help.out.find("  " + spec.flag + " "), std::string::npos) << spec.flag;
+    const std::string said = SayOptions(spec.help, OptionFlag);
+    EXPECT_NE(help.out.find(said.substr(0, 30)), std::string::npos) << spec.flag << ": " << said;
+  }
+  const CliResult note = RunTool({"run", "slip", "--until", "H=2.5", "--max-branches", "1", "--quiet", "--out",
+                                  TempDir("note_words").string()});
+  EXPECT_EQ(note.code, 0) << note.err;
+  EXPECT_NE(note.err.find("note: --until H=2.5 lies outside the bound"), std::string::npos) << note.err;
+  EXPECT_NE(note.err.find("(give --bound H=LOWER:UPPER to keep it)"), std::string::npos) << note.err;
+  const CliResult twice = RunTool({"run", "slip", "--free", "k", "--free", "w2"});
+  EXPECT_EQ(twice.code, 2);
+  EXPECT_NE(twice.err.find("--free 'w2': given twice (first 'k'); give it once"), std::string::npos) << twice.err;
+  const CliResult curves = RunTool({"run", "slip", "--free", "k", "--fix", "H=1.5", "--curves", "w2"});
+  EXPECT_EQ(curves.code, 2);
+  EXPECT_NE(curves.err.find("--curves 'w2': not with --free"), std::string::npos) << curves.err;
+  fs::remove_all(TempDir("note_words"));
+}
+
 TEST(Cli, RunBouncingBallWritesClassifiedBranchesThatMatchTheClosedForm) {
   const fs::path dir = TempDir("ball");
   const CliResult r = RunTool({"run", "bouncing-ball", "--out", dir.string(), "--quiet", "--no-plots"});

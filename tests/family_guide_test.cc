@@ -164,7 +164,7 @@ TEST(FamilyGuide, RefusedGuidesAreNamedAndNothingIsWritten) {
   o.families_of = slip.string();
   o.free = "k";
   o.fix = NamedValue{"H", 1.5};
-  refused(o, "not with a free parameter");
+  refused(o, "not with free 'k'");
   o = SlipAt(30);
   o.families_of = slip.string();
   o.formulation = Formulation::kStateBased;

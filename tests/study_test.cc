@@ -10,6 +10,9 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
+#include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -203,6 +206,96 @@ TEST(Study, AStopRequestEndsTheStudyWithTheWorkSoFar) {
   fs::remove_all(dir);
 }
 
+// Every option is declared once (study_options.h): set from its command-line text, it reads back as that value,
+// every member it names changes from its default, and the roles split the results from how and where a study runs.
+TEST(StudyOptions, EveryDeclaredOptionIsSetFromItsTextAndReadBack) {
+  const std::map<std::string, std::vector<std::string>> texts = {
+      {"model", {"slip.toml"}},     {"parameters", {"k=30", "w2=5"}}, {"until", {"H=1.5"}},
+      {"monitors", {"apex=1,2"}},   {"bounds", {"H=0:", "k=:40"}},     {"rtol", {"1e-9"}},
+      {"atol", {"2e-9"}},           {"max_branches", {"3"}},          {"formulation", {"state"}},
+      {"free", {"k"}},              {"fix", {"H=1.25"}},              {"curves", {"w2"}},
+      {"use_symmetries", {"true"}}, {"period_doubling", {"true"}},    {"follow_word_changes", {"true"}},
+      {"restart.from", {"saved"}},  {"restart.label", {"PD4"}},       {"restart.kind", {"switch"}},
+      {"families_of", {"near"}},    {"families", {"a", "b"}},         {"start_must_converge", {"false"}},
+      {"threads", {"4"}},           {"out_dir", {"out"}},             {"overwrite", {"true"}},
+      {"resume", {"true"}}};
+  StudyOptions o;
+  std::set<std::string> run_settings;
+  for (const StudyOptionSpec& spec : StudyOptionSpecs()) {
+    ASSERT_TRUE(texts.count(spec.field)) << spec.field << ": no text in this test";
+    const StudyOptionValue value = ParseStudyOption(spec, texts.at(spec.field));
+    const StudyOptionValue before = spec.get(o);
+    SetStudyOption(&o, spec.field, value);
+    EXPECT_TRUE(spec.get(o) == value) << spec.field;
+    EXPECT_FALSE(spec.get(o) == before) << spec.field << ": the text sets its default";
+    EXPECT_EQ(OptionFlag(spec.field), spec.flag.empty() ? spec.field : spec.flag);
+    if (spec.role == OptionRole::kRunSetting) run_settings.insert(spec.field);
+  }
+  EXPECT_EQ(texts.size(), StudyOptionSpecs().size());
+  EXPECT_EQ(run_settings, (std::set<std::string>{"threads", "out_dir", "overwrite", "resume"}));
+  EXPECT_EQ(o.model, "slip.toml");
+  EXPECT_EQ(o.parameters, (std::vector<NamedValue>{{"k", 30}, {"w2", 5}}));
+  EXPECT_EQ(o.monitors, (std::vector<NamedValue>{{"apex", 1}, {"apex", 2}}));
+  EXPECT_EQ(o.bounds[0].lower, 0);
+  EXPECT_EQ(o.bounds[0].upper, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(o.bounds[1].lower, -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(*o.rtol, 1e-9);
+  EXPECT_EQ(*o.max_branches, 3);
+  EXPECT_EQ(o.formulation, Formulation::kStateBased);
+  EXPECT_EQ(o.fix->value, 1.25);
+  EXPECT_FALSE(o.use_symmetries);
+  EXPECT_FALSE(o.follow_word_changes);
+  EXPECT_FALSE(o.start_must_converge);
+  ASSERT_TRUE(o.restart);
+  EXPECT_EQ(o.restart->from, "saved");
+  EXPECT_EQ(o.restart->label, "PD4");
+  EXPECT_EQ(o.restart->kind, RestartSpec::Kind::kSwitch);
+  EXPECT_EQ(o.families, (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(o.threads, 4);
+  // Unset: the default again.
+  SetStudyOption(&o, "rtol", std::monostate{});
+  EXPECT_FALSE(o.rtol);
+  SetStudyOption(&o, "use_symmetries", std::monostate{});
+  EXPECT_TRUE(o.use_symmetries);
+}
+
+// The text forms are checked once, for every front end, and a refusal names the option, the occurrence and the
+// text; the options a message mentions are said in the caller's words.
+TEST(StudyOptions, RefusalsNameTheOptionAndTheTextInTheCallersWords) {
+  const auto refusal = [](const std::string& field, const std::vector<std::string>& texts) {
+    try {
+      ParseStudyOption(*FindStudyOption(field), texts);
+    } catch (const StudyOptionError& e) {
+      EXPECT_EQ(e.field(), field);
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  EXPECT_EQ(refusal("parameters", {"k=1", "k=nan"}), "parameters[1] 'k=nan': value 'nan' is not finite");
+  EXPECT_EQ(refusal("parameters", {"=1"}), "parameters[0] '=1': expected NAME=VALUE");
+  EXPECT_EQ(refusal("out_dir", {"a", "b"}), "out_dir[1] 'b': given twice (first 'a'); give it once");
+  EXPECT_EQ(refusal("threads", {"-"}), "threads[0] '-': not a whole number");
+  EXPECT_EQ(refusal("formulation", {"fast"}), "formulation[0] 'fast': expected 'time' or 'state'");
+  EXPECT_EQ(refusal("curves", {""}),
+            "curves[0] '': an empty value (give a value, or leave the option out)");
+  EXPECT_EQ(refusal("monitors", {"apex=1,2", "speed=3"}), "(accepted)");
+  StudyOptions o;
+  o.model = "slip";
+  o.fix = NamedValue{"H", 1.5};
+  try {
+    CheckStudyOptions(o);
+    ADD_FAILURE() << "fix without free accepted";
+  } catch (const StudyOptionError& e) {
+    EXPECT_EQ(std::string(e.what()), "fix 'H=1.5': needs free PARAMETER (the parameter that varies)");
+    EXPECT_EQ(e.Say(OptionFlag), "--fix 'H=1.5': needs --free PARAMETER (the parameter that varies)");
+    EXPECT_EQ(e.Say(OptionKeyword), "fix 'H=1.5': needs free PARAMETER (the parameter that varies)");
+  }
+  EXPECT_EQ(SayOptions("give " + MentionOption("bounds") + " H=0:1", OptionFlag), "give --bound H=0:1");
+  EXPECT_EQ(SayOptions("give " + MentionOption("bounds") + " H=0:1", OptionKeyword), "give bound H=0:1");
+  EXPECT_EQ(OptionFlag("restart"), "--from/--at");
+  EXPECT_EQ(OptionKeyword("restart"), "from_/at");
+}
+
 TEST(Study, OptionErrorsNameTheFieldAndWriteNothing) {
   const fs::path dir = Scratch("bad");
   const auto refused = [&](StudyOptions o, const std::string& field, const std::string& text) {
@@ -219,7 +312,7 @@ TEST(Study, OptionErrorsNameTheFieldAndWriteNothing) {
   StudyOptions o = Slip();
   o.until = {{"H", 2.5}};
   o.bounds = {{"H", 0, 2}};
-  refused(o, "until", "until[0] 'H=2.5' lies outside bounds[0] 'H=0:2'");
+  refused(o, "until", "until[0] 'H=2.5' lies outside bounds 'H=0:2'");
   o = Slip();
   o.threads = 0;
   refused(o, "threads", "threads 0: must be >= 1");
@@ -228,7 +321,7 @@ TEST(Study, OptionErrorsNameTheFieldAndWriteNothing) {
   refused(o, "parameters", "parameters[1] 'k=30': 'k' is given twice");
   o = Slip();
   o.fix = NamedValue{"H", 1.5};
-  refused(o, "fix", "needs a free parameter");
+  refused(o, "fix", "needs free PARAMETER");
   o = Slip();
   o.bounds = {{"H", 2, 1}};
   refused(o, "bounds", "the lower end must be below the upper end");

@@ -43,50 +43,12 @@
 #include "hybridcont/model.h"
 #include "hybridcont/orbit_analysis.h"
 #include "hybridcont/special_point.h"
+#include "hybridcont/study_options.h"
 
 namespace hybridcont {
 
 // The version of the library, the tool and the results folders they write.
 std::string Version();
-
-struct NamedValue {
-  std::string name;
-  double value = 0;
-};
-struct NamedInterval {
-  std::string name;
-  double lower = -std::numeric_limits<double>::infinity();
-  double upper = std::numeric_limits<double>::infinity();
-};
-
-// Time-based multiple shooting (the default) or the state-based Poincaré map.
-enum class Formulation { kTimeBased, kStateBased };
-std::string ToString(Formulation f);
-// "time" / "state"; false for anything else.
-bool FromString(const std::string& text, Formulation* f);
-
-// Where a restarted study begins: a labelled point of a saved study (docs/results-format.md, "Labels").
-//   label "PD4"  (a special point: its code and id)  — kind kPeriodDoubled: the period-doubled family born there;
-//                                                      kind kSwitch: every branch through the SB/BP point;
-//                                                      kind kCurve: the point continued in (H, curve_parameter);
-//   label "B5"   (a branch: its last point)          — kind kContinue: the branch continued beyond its end;
-//   label "B5:12" (point 12 of branch 5)             — kind kContinue (both directions) or kFree (--free P).
-// kAuto picks what the label's type implies: PD → kPeriodDoubled, SB/BP → kSwitch, TP → kCurve (with
-// curves set), a branch or point → kContinue (kFree with free set).
-// The study restarted from is a saved one (`from`, its folder) or one in memory (`study`, e.g. the result of
-// an earlier RunStudy: no folder needed on either side). The restart's record (summary.json's restarted_from)
-// names the folder, or "(a study in memory)".
-struct StudyResult;
-struct RestartSpec {
-  enum class Kind { kAuto, kContinue, kSwitch, kPeriodDoubled, kCurve, kFree };
-  std::string from;  // the saved study's folder (read when `study` is null)
-  std::string label;
-  Kind kind = Kind::kAuto;
-  std::shared_ptr<const StudyResult> study;  // a study in memory; `from` is not read then
-  // The study restarted from, as a label's message names it: the folder, or "(a study in memory)".
-  std::string Source() const { return study ? std::string("(a study in memory)") : from; }
-};
-std::string ToString(RestartSpec::Kind kind);
 
 // Which model a study was computed on, recorded in its result and its folder ("model_source") so that a
 // study read back later draws and evaluates exactly that model, or says why it cannot (ModelOfStudy).
@@ -106,72 +68,6 @@ struct StudyModelSource {
 };
 std::string ToString(StudyModelSource::Kind kind);
 bool FromString(const std::string& text, StudyModelSource::Kind* kind);
-
-// Everything `hybridcont run` accepts, as plain data (no callbacks): copyable, comparable field by field,
-// and written into summary.json as the study's effective options.
-struct StudyOptions {
-  // A built-in model's name or a model file (.toml); a relative file name that does not exist is looked up in
-  // models_directory.
-  std::string model;
-  std::string models_directory;
-  // Model-file text: the study's model is made of it (`model` then only names it), or, with a caller's model
-  // (RunStudy(model, options)), the text that model was made of. Recorded in the result (StudyModelSource
-  // kText) so that its folder rebuilds the model, and part of the resume key. With a caller's model and no
-  // text, `model` may name the built-in model or model file it was made from (recorded as such where the
-  // model made from there has its name; otherwise it is the caller's own, kCaller).
-  std::string model_text;
-  std::vector<NamedValue> parameters;  // model parameters set before the study (each name once)
-  std::vector<NamedValue> until;       // each branch ends exactly where an unknown or observable reaches the value
-  std::vector<NamedInterval> bounds;   // replace the model's bound on an unknown ("period": sum of durations)
-  std::vector<NamedValue> monitors;    // observables whose values are located (UZ points)
-  std::optional<double> rtol, atol;    // integrator tolerances (unset: the library's 1e-10)
-  std::optional<int> max_branches;     // half-branches traced at most (unset: the model's scenario)
-  int threads = 1;                     // half-branches traced concurrently
-  Formulation formulation = Formulation::kTimeBased;
-  bool use_symmetries = true;          // map half-branches that are images under the model's symmetries
-  bool follow_word_changes = true;     // an automaton: explore the words its families lead into
-  bool period_doubling = false;        // explore the period-doubled family of every located PD point
-  std::string free;                    // a parameter continued as an unknown instead of H
-  std::optional<NamedValue> fix;       // the unknown held fixed while `free` varies (H=1.5, t2=0, speed=1)
-  std::string curves;                  // a parameter: special points continued in (H, it) after the run
-  std::optional<RestartSpec> restart;  // begin at a labelled point of a saved study instead of the model's start
-  // A saved study of the same model at nearby parameter values (a sweep's neighbouring grid point): trace only
-  // the half-branches whose counterpart there led to a family; the others, which found no physical orbit
-  // there, are not traced (src/study/stages/family_guide.h says how counterparts are matched). The saved study's
-  // families are continued to these parameter values without repeating its whole exploration. Empty: the
-  // whole exploration. summary.json's "guided" says what was pruned.
-  std::string families_of;
-  // The model's start (a guess Newton must correct, a singular start that must be an orbit) failing is bad input
-  // (true: ModelInputError before anything runs — the model file's start is wrong where it was written) or the
-  // study's status (false: status start-failed for the families from it, the model's starts in other words still
-  // explored — a sweep's grid point far from where the start was written).
-  bool start_must_converge = true;
-  // With families_of: only the half-branches that led to these of its families (by name, as its branches are
-  // named) are traced. Empty: every family.
-  std::vector<std::string> families;
-  // The results folder (docs/results-format.md), written as the study grows; empty: nothing is written.
-  std::string out_dir;
-  bool overwrite = false;  // replace another model's results in out_dir (refused otherwise)
-  // Continue the study saved (possibly interrupted) in out_dir (src/study/io/resume_store.h): branches traced there are taken as they
-  // are, the rest computed. The options must be those of the saved study.
-  bool resume = false;
-};
-
-// A value of StudyOptions the study refuses. field() is the member's name ("until", "bounds", "fix"), index()
-// the entry of a list (-1 otherwise); what() begins with both, e.g. "until[0] 'H=5': ...".
-class StudyOptionError : public std::invalid_argument {
- public:
-  StudyOptionError(std::string field, int index, const std::string& message);
-  const std::string& field() const { return field_; }
-  int index() const { return index_; }
-  // The message without its leading field, e.g. "'H=5': ...".
-  const std::string& detail() const { return detail_; }
-
- private:
-  std::string field_;
-  int index_;
-  std::string detail_;
-};
 
 // One accepted point of a family, analysed.
 struct StudyPoint {
@@ -362,6 +258,9 @@ struct StudyHooks {
   std::function<void(const std::string& line)> on_note;
   // True ends the study at the next step (status kCancelled).
   std::function<bool()> stop_requested;
+  // How the notes say the options they mention (study_options.h, SayOptions): the command line's flags,
+  // Python's keywords; unset: by field.
+  std::function<std::string(const std::string& field)> option_words;
 };
 
 // The model a study of `model` runs on (StudyOptions::model, parameters, models_directory): a built-in model, a
@@ -391,8 +290,9 @@ StudyResult RunStudy(const StudyOptions& options, const StudyHooks& hooks = {});
 StudyResult RunStudy(const HybridModel& model, const StudyOptions& options, const StudyHooks& hooks = {});
 
 // Validates the options against the model without computing or writing anything; returns the notes the
-// study would say (bound widened to a target, no bound).
-std::vector<std::string> CheckStudyOptions(const StudyOptions& options);
+// study would say (bound widened to a target, no bound), the options they mention said in `words`.
+std::vector<std::string> CheckStudyOptions(const StudyOptions& options,
+                                           const std::function<std::string(const std::string& field)>& words = {});
 
 // The study saved in a results folder (docs/results-format.md; a folder of an interrupted study too): its
 // branches with their analysed points, special points, families, curves and key-frame orbits with their

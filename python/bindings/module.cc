@@ -15,6 +15,10 @@
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <cmath>
+#include <limits>
+#include <tuple>
+#include <variant>
 #include <csignal>
 #include <mutex>
 #include <filesystem>
@@ -33,7 +37,6 @@
 #include "hybridcont/orbit_trace.h"
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/shooting_layout.h"
-#include "hybridcont/option_text.h"
 #include "hybridcont/study.h"
 #include "hybridcont/study_answer.h"
 #include "hybridcont/study_report.h"
@@ -81,74 +84,168 @@ class InterruptGuard {
   static inline bool installed_ = false;
 };
 
-// ---- options: a dict of plain values (the package's keyword arguments, already named as StudyOptions')
+// ---- options: Python's keyword arguments, converted by the library's declaration (study_options.h)
+
 template <class T>
 T Get(const py::dict& d, const char* key, T fallback) {
   return d.contains(key) && !d[key].is_none() ? d[key].cast<T>() : fallback;
 }
 
-std::vector<NamedValue> NamedValues(const py::dict& d, const char* key) {
-  std::vector<NamedValue> out;
-  if (!d.contains(key) || d[key].is_none()) return out;
-  for (const py::handle item : d[key]) {
-    const auto pair = item.cast<std::pair<std::string, double>>();
-    out.push_back({pair.first, pair.second});
+// A Python value of the option's kind (the forms study_options.h lists per OptionKind) as the library's value.
+// A value of another shape or a number that is not finite: StudyOptionError naming the option.
+StudyOptionValue OptionValueOf(const StudyOptionSpec& spec, const py::handle& v) {
+  if (v.is_none()) return std::monostate{};
+  const auto refuse = [&](const std::string& expected) {
+    return StudyOptionError(spec.field, -1, py::repr(v).cast<std::string>() + ": expected " + expected);
+  };
+  const auto number = [&](const py::handle x, bool infinite_allowed) {
+    if (py::isinstance<py::bool_>(x) || py::isinstance<py::str>(x)) throw refuse("numbers");
+    double value;
+    try {
+      value = py::float_(py::reinterpret_borrow<py::object>(x)).cast<double>();
+    } catch (const py::error_already_set&) {
+      throw refuse("numbers");
+    }
+    if (std::isnan(value) || (!infinite_allowed && !std::isfinite(value))) throw refuse("finite numbers");
+    return value;
+  };
+  const auto text = [&](const py::handle x) {
+    if (py::isinstance<py::str>(x)) return x.cast<std::string>();
+    if (py::hasattr(x, "__fspath__")) return py::module_::import("os").attr("fspath")(x).cast<std::string>();
+    throw refuse("a string");
+  };
+  const auto is_dict = py::isinstance<py::dict>(v);
+  const auto items = [&]() -> py::list {  // (name, value) pairs of a dict or a sequence of pairs
+    if (is_dict) return py::list(v.cast<py::dict>().attr("items")());
+    if (py::isinstance<py::str>(v) || !py::isinstance<py::sequence>(v)) throw refuse("{name: value} or [(name, value)]");
+    return py::list(py::reinterpret_borrow<py::object>(v));
+  };
+  const auto pair = [&](const py::handle item) {
+    if (py::isinstance<py::str>(item) || !py::isinstance<py::sequence>(item) || py::len(item) != 2) {
+      throw refuse("{name: value} or [(name, value)]");
+    }
+    return std::make_pair(text(item[py::int_(0)]), py::object(item[py::int_(1)]));
+  };
+  switch (spec.kind) {
+    case OptionKind::kText:
+    case OptionKind::kChoice: return text(v);
+    case OptionKind::kTexts: {
+      if (py::isinstance<py::str>(v)) return std::vector<std::string>{text(v)};
+      std::vector<std::string> out;
+      for (const py::handle x : v) out.push_back(text(x));
+      return out;
+    }
+    case OptionKind::kNumber: return number(v, false);
+    case OptionKind::kCount:
+      if (py::isinstance<py::bool_>(v) || !py::isinstance<py::int_>(v)) throw refuse("a whole number");
+      return v.cast<int>();
+    case OptionKind::kSwitch:
+      if (!py::isinstance<py::bool_>(v) && !py::hasattr(v, "dtype")) throw refuse("True or False");
+      return v.cast<bool>();
+    case OptionKind::kValue:
+      if (!is_dict && py::isinstance<py::sequence>(v) && py::len(v) == 2 && py::isinstance<py::str>(v[py::int_(0)])) {
+        const auto [name, value] = pair(v);
+        return std::vector<NamedValue>{{name, number(value, false)}};
+      }
+      [[fallthrough]];
+    case OptionKind::kValues: {
+      std::vector<NamedValue> out;
+      for (const py::handle item : items()) {
+        const auto [name, value] = pair(item);
+        out.push_back({name, number(value, false)});
+      }
+      return out;
+    }
+    case OptionKind::kValueLists: {  // {name: value or [values]}
+      std::vector<NamedValue> out;
+      for (const py::handle item : items()) {
+        const auto [name, values] = pair(item);
+        if (py::isinstance<py::sequence>(values) || py::hasattr(values, "__array__")) {
+          for (const py::handle x : values) out.push_back({name, number(x, false)});
+        } else {
+          out.push_back({name, number(values, false)});
+        }
+      }
+      return out;
+    }
+    case OptionKind::kIntervals: {  // {name: (lower, upper)}, None for an open end; or [(name, lower, upper)]
+      std::vector<NamedInterval> out;
+      const auto end = [&](const py::handle x, double open) { return x.is_none() ? open : number(x, true); };
+      const double inf = std::numeric_limits<double>::infinity();
+      for (const py::handle item : items()) {
+        py::object name, interval;
+        if (is_dict) {
+          std::tie(name, interval) = std::make_pair(py::object(item[py::int_(0)]), py::object(item[py::int_(1)]));
+        } else if (py::isinstance<py::sequence>(item) && py::len(item) == 3) {
+          name = item[py::int_(0)];
+          interval = py::make_tuple(item[py::int_(1)], item[py::int_(2)]);
+        } else {
+          throw refuse("{name: (lower, upper)}");
+        }
+        if (py::isinstance<py::str>(interval) || !py::isinstance<py::sequence>(interval) || py::len(interval) != 2) {
+          throw refuse("{name: (lower, upper)}, None for an open end");
+        }
+        out.push_back({text(name), end(interval[py::int_(0)], -inf), end(interval[py::int_(1)], inf)});
+      }
+      return out;
+    }
   }
-  return out;
+  return std::monostate{};
 }
 
+// The library's value of an option as Python's keyword takes it: {name: value} for values (ParseStudyOption
+// gives each name once), {name: [values]} for value lists, {name: (lower, upper)} (None: open) for intervals.
+py::object PythonOf(const StudyOptionSpec& spec, const StudyOptionValue& value) {
+  return std::visit(
+      [&](const auto& v) -> py::object {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, std::monostate>) {
+          return py::none();
+        } else if constexpr (std::is_same_v<T, std::vector<NamedValue>>) {
+          py::dict out;
+          for (const NamedValue& x : v) {
+            const py::str name(x.name);
+            if (spec.kind != OptionKind::kValueLists) {
+              out[name] = x.value;
+              continue;
+            }
+            if (!out.contains(name)) out[name] = py::list();
+            out[name].cast<py::list>().append(x.value);
+          }
+          return out;
+        } else if constexpr (std::is_same_v<T, std::vector<NamedInterval>>) {
+          py::dict out;
+          const auto end = [](double x) { return std::isfinite(x) ? py::object(py::float_(x)) : py::none(); };
+          for (const NamedInterval& x : v) out[py::str(x.name)] = py::make_tuple(end(x.lower), end(x.upper));
+          return out;
+        } else {
+          return py::cast(v);
+        }
+      },
+      value);
+}
+
+// The options of a study from Python's keyword arguments (and the package's own: model, models_directory,
+// model_text). An unknown keyword: TypeError naming it and the known ones.
 StudyOptions OptionsOf(const py::dict& d) {
   StudyOptions o;
-  o.model = Get<std::string>(d, "model", "");
-  o.models_directory = Get<std::string>(d, "models_directory", "");
-  o.model_text = Get<std::string>(d, "model_text", "");
-  o.parameters = NamedValues(d, "parameters");
-  o.until = NamedValues(d, "until");
-  o.monitors = NamedValues(d, "monitors");
-  if (d.contains("bounds") && !d["bounds"].is_none()) {
-    for (const py::handle item : d["bounds"]) {
-      const auto b = item.cast<std::tuple<std::string, double, double>>();
-      o.bounds.push_back({std::get<0>(b), std::get<1>(b), std::get<2>(b)});
+  for (const auto& [key_handle, value] : d) {
+    const std::string key = key_handle.cast<std::string>();
+    if (key == "models_directory" || key == "model_text") {
+      (key == "model_text" ? o.model_text : o.models_directory) = value.is_none() ? "" : value.cast<std::string>();
+      continue;
     }
-  }
-  if (d.contains("rtol") && !d["rtol"].is_none()) o.rtol = d["rtol"].cast<double>();
-  if (d.contains("atol") && !d["atol"].is_none()) o.atol = d["atol"].cast<double>();
-  if (d.contains("max_branches") && !d["max_branches"].is_none()) o.max_branches = d["max_branches"].cast<int>();
-  o.threads = Get<int>(d, "threads", 1);
-  const std::string formulation = Get<std::string>(d, "formulation", "time");
-  if (!FromString(formulation, &o.formulation)) {
-    throw std::invalid_argument("formulation '" + formulation + "': expected 'time' or 'state'");
-  }
-  o.use_symmetries = Get<bool>(d, "use_symmetries", true);
-  o.follow_word_changes = Get<bool>(d, "follow_word_changes", true);
-  o.period_doubling = Get<bool>(d, "period_doubling", false);
-  o.free = Get<std::string>(d, "free", "");
-  if (d.contains("fix") && !d["fix"].is_none()) {
-    const auto fix = d["fix"].cast<std::pair<std::string, double>>();
-    o.fix = NamedValue{fix.first, fix.second};
-  }
-  o.curves = Get<std::string>(d, "curves", "");
-  o.families_of = Get<std::string>(d, "families_of", "");
-  o.start_must_converge = Get<bool>(d, "start_must_converge", true);
-  if (d.contains("families") && !d["families"].is_none()) o.families = d["families"].cast<std::vector<std::string>>();
-  if (d.contains("restart") && !d["restart"].is_none()) {
-    const auto r = d["restart"].cast<std::tuple<std::string, std::string, std::string>>();
-    RestartSpec spec{std::get<0>(r), std::get<1>(r), RestartSpec::Kind::kAuto};
-    bool known = false;
-    for (const RestartSpec::Kind k : {RestartSpec::Kind::kAuto, RestartSpec::Kind::kContinue, RestartSpec::Kind::kSwitch,
-                                      RestartSpec::Kind::kPeriodDoubled, RestartSpec::Kind::kCurve,
-                                      RestartSpec::Kind::kFree}) {
-      if (ToString(k) == std::get<2>(r)) spec.kind = k, known = true;
+    const StudyOptionSpec* spec = nullptr;
+    for (const StudyOptionSpec& s : StudyOptionSpecs()) {
+      if (s.keyword == key) spec = &s;
     }
-    if (!known) {
-      throw std::invalid_argument("as_ '" + std::get<2>(r) +
-                                  "': expected auto, continue, switch, period-doubled, curve or free");
+    if (spec == nullptr) {
+      std::string known;
+      for (const StudyOptionSpec& s : StudyOptionSpecs()) known += (known.empty() ? "" : ", ") + s.keyword;
+      throw py::type_error("unexpected keyword argument '" + key + "' (the options of a study: " + known + ")");
     }
-    o.restart = spec;
+    SetStudyOption(&o, spec->field, OptionValueOf(*spec, value));
   }
-  o.out_dir = Get<std::string>(d, "out_dir", "");
-  o.overwrite = Get<bool>(d, "overwrite", false);
-  o.resume = Get<bool>(d, "resume", false);
   return o;
 }
 
@@ -366,6 +463,7 @@ py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& mod
     };
   }
   if (!on_note.is_none()) hooks.on_note = [&](const std::string& line) { call(on_note, line); };
+  hooks.option_words = OptionKeyword;
   hooks.stop_requested = [&] { return interrupted() || stop_this.load(); };
   StudyResult result;
   std::string report_error, report_note;
@@ -570,22 +668,43 @@ void BindStudies(py::module_& m) {
         py::arg("report_assets") = py::none());
   m.def("load_study", &LoadStudyFromPython, py::arg("dir"));
   m.def(
-      "parse_assignments",
-      [](const std::string& option, const std::string& text) {
-        std::vector<std::pair<std::string, double>> out;
-        for (const NamedValue& v : ParseAssignments(option, text)) out.emplace_back(v.name, v.value);
+      "study_options",
+      [] {
+        py::list out;
+        for (const StudyOptionSpec& spec : StudyOptionSpecs()) {
+          py::dict d;
+          d["field"] = spec.field;
+          d["flag"] = spec.flag;
+          d["keyword"] = spec.keyword;
+          d["value_name"] = spec.value_name;
+          d["help"] = SayOptions(spec.help, OptionKeyword);
+          d["flag_help"] = SayOptions(spec.help, OptionFlag);
+          d["choices"] = spec.choices;
+          d["switch"] = spec.kind == OptionKind::kSwitch;
+          d["repeatable"] = IsRepeatable(spec.kind);
+          d["decides_results"] = spec.role == OptionRole::kResult;
+          d["sweep"] = spec.sweep;
+          d["default"] = PythonOf(spec, spec.get(StudyOptions{}));
+          out.append(d);
+        }
         return out;
       },
-      py::arg("option"), py::arg("text"),
-      "NAME=VALUE or NAME=V1,V2,... as [(name, value)], checked as the command line checks it (ValueError naming "
-      "the option and the text: an empty name, a value that is not a finite decimal number).");
+      "The options of a study as the library declares them: field, flag, keyword, value_name, help (in keywords), "
+      "flag_help (in flags), choices, switch, repeatable, decides_results, sweep, default.");
   m.def(
-      "parse_bound",
-      [](const std::string& option, const std::string& text) {
-        const NamedInterval b = ParseBound(option, text);
-        return std::make_tuple(b.name, b.lower, b.upper);
+      "parse_option",
+      [](const std::string& field, const std::vector<std::string>& texts) {
+        const StudyOptionSpec* spec = FindStudyOption(field);
+        if (spec == nullptr) throw std::invalid_argument("'" + field + "': not an option of a study");
+        try {
+          return PythonOf(*spec, ParseStudyOption(*spec, texts));
+        } catch (const StudyOptionError& e) {
+          throw std::invalid_argument(e.Say(OptionFlag));  // a command line's text: said with its flags
+        }
       },
-      py::arg("option"), py::arg("text"), "NAME=LOWER:UPPER as (name, lower, upper), checked as the command line checks it.");
+      py::arg("field"), py::arg("texts"),
+      "An option's value from its command-line texts (one per occurrence) in the form its keyword takes, checked "
+      "as `hybridcont run` checks it (ValueError naming the flag and the text).");
   m.def(
       "model_of_study",
       [](const std::string& dir, const std::string& models_directory) {
@@ -602,7 +721,7 @@ void BindStudies(py::module_& m) {
       [](const py::dict& options) {
         const StudyOptions o = OptionsOf(options);
         py::gil_scoped_release release;  // builds (compiles) the model
-        return CheckStudyOptions(o);
+        return CheckStudyOptions(o, OptionKeyword);
       },
       py::arg("options"), "Validates study options against the model without computing; returns its notes.");
   m.def("report_html", &ReportHtml, py::arg("dir"), py::arg("assets"), py::arg("model") = ModelHandle(),
@@ -633,6 +752,14 @@ PYBIND11_MODULE(_hybridcont, m) {
   m.attr("__version__") = Version();
   m.def("builtin_model_names", &BuiltinModelNames, "The names of the built-in C++ models.");
 
+  // A refused option in Python's words: its keyword and the keywords it mentions ("fix {'H': 1}: needs ...").
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const StudyOptionError& e) {
+      PyErr_SetString(PyExc_ValueError, e.Say(OptionKeyword).c_str());
+    }
+  });
   BindModels(m);
   BindStudies(m);
   BindContinuation(m);

@@ -37,70 +37,32 @@ def _remove_temporary_folders():
         shutil.rmtree(path, ignore_errors=True)
 
 
-def _pairs(value, what):
-    """{name: value} or [(name, value)] as [(name, float)]."""
-    if value is None:
-        return []
-    items = value.items() if isinstance(value, dict) else value
-    out = []
-    for item in items:
-        try:
-            name, v = item
-        except (TypeError, ValueError):
-            raise ValueError("%s: expected {name: value} or [(name, value)], got %r" % (what, item))
-        out.append((str(name), float(v)))
-    return out
-
-
-def _bounds(value):
-    """{name: (lower, upper)} (None: unbounded) as [(name, lower, upper)]."""
-    out = []
-    for name, interval in (value or {}).items():
-        try:
-            lo, hi = interval
-        except (TypeError, ValueError):
-            raise ValueError("bound: expected {name: (lower, upper)}, got %s=%r" % (name, interval))
-        out.append((str(name), -np.inf if lo is None else float(lo), np.inf if hi is None else float(hi)))
-    return out
-
-
-def _monitors(value):
-    """{name: value or [values]} as [(name, value)]."""
-    out = []
-    for name, values in (value or {}).items():
-        for v in (values if isinstance(values, (list, tuple, np.ndarray)) else [values]):
-            out.append((str(name), float(v)))
-    return out
-
-
-def _options(model_name, out, set=None, until=None, bound=None, monitor=None, rtol=None, atol=None,
-             max_branches=None, threads=None, formulation="time", no_symmetry=False, one_word=False,
-             period_doubling=False, free=None, fix=None, curves=None, overwrite=False, resume=False,
-             from_=None, at=None, as_="auto", families_of=None, families=None, start_must_converge=True):
-    if (from_ is None) != (at is None):
-        raise ValueError("from_ and at go together: a saved study (its folder or Study) and a label in it "
-                         "(PD4, B5, B5:12)")
-    fix_pairs = _pairs(fix, "fix")
-    if len(fix_pairs) > 1:
-        raise ValueError("fix: one unknown is held while `free` varies, got %d" % len(fix_pairs))
-    restart = None
-    if from_ is not None:
-        restart = (from_.path if isinstance(from_, Study) else os.fspath(from_), str(at), str(as_))
-    return {
-        "model": model_name, "models_directory": _paths.MODELS, "parameters": _pairs(set, "set"),
-        "until": _pairs(until, "until"), "bounds": _bounds(bound), "monitors": _monitors(monitor),
-        "rtol": rtol, "atol": atol, "max_branches": max_branches,
+def _options(model_name, out, **options):
+    """The keyword arguments of ``run`` as the library takes them: each is an option the library declares
+    (``native.study_options()``: keyword, kind, help) and converts and checks itself; a study or a path where a
+    folder is named."""
+    opts = {"model": model_name, "models_directory": _paths.MODELS, "out": out}
+    for key, value in options.items():
+        if isinstance(value, Study):  # from_, families_of: a saved study
+            value = value.path
+        opts[key] = value
+    if opts.get("threads") is None:
         # As the command line: every core unless threads says otherwise (the result does not depend on it).
-        "threads": int(threads) if threads is not None else max(1, os.cpu_count() or 1),
-        "formulation": formulation, "use_symmetries": not no_symmetry, "follow_word_changes": not one_word,
-        "period_doubling": bool(period_doubling), "free": free or "", "fix": fix_pairs[0] if fix_pairs else None,
-        "curves": curves or "", "restart": restart, "out_dir": out, "overwrite": bool(overwrite),
-        "resume": bool(resume),
-        "families_of": (families_of.path if isinstance(families_of, Study) else os.fspath(families_of))
-        if families_of is not None else "",
-        "families": [families] if isinstance(families, str) else list(families or []),
-        "start_must_converge": bool(start_must_converge),
-    }
+        opts["threads"] = max(1, os.cpu_count() or 1)
+    return opts
+
+
+def _options_help():
+    """The options of ``run`` as the library declares them, one paragraph each (its docstring)."""
+    import textwrap
+    lines = []
+    for spec in native.study_options():
+        if spec["keyword"] in ("model", "out"):
+            continue
+        default = "" if spec["default"] in (None, False, "", [], {}) else " (default %r)" % (spec["default"],)
+        lines.append(textwrap.fill("%s%s: %s" % (spec["keyword"], default, spec["help"]), width=100,
+                                   initial_indent="      ", subsequent_indent="          "))
+    return "\n".join(lines)
 
 
 def check(model, **options):
@@ -115,24 +77,11 @@ def check(model, **options):
 def run(model, out=None, progress=True, report=True, **options):
     """Runs a study of ``model`` (a name, a model file's path, or a Model) and returns its Study.
 
-    Keyword arguments are the options of ``hybridcont run``:
-      set={"k": 60}                   model parameters (--set)
-      until={"H": 1.8}                end every branch there (--until)
-      bound={"H": (0, 2)}             bounds of unknowns, None for an open side (--bound)
-      monitor={"H": [1.2, 1.5]}       locate where an observable takes these values, UZ points (--monitor)
-      rtol, atol                      integrator tolerances (default 1e-10)
-      max_branches, threads           half-branches at most; threads (default: every core)
-      formulation="time" | "state"    the shooting formulation
-      no_symmetry, one_word, period_doubling
-      free="k", fix={"H": 1.5}        continue in a parameter at a fixed value of an unknown
-      curves="k"                      special points continued in (H, k)
-      from_=study or folder, at="PD4", as_="auto"   restart from a labelled point (--from/--at/--as)
-      families_of=study or folder     trace only the half-branches that led to a family in that saved study
-                                      of the model at nearby parameters (--families-of)
-      families=["hopping in place"]   with families_of: only these of its families (--family)
-      start_must_converge=False       a start that does not converge is the status start-failed, not a
-                                      ValueError (the model's starts in other words still explored)
-      out="results/slip", overwrite, resume         the results folder (default: a temporary one)
+    Keyword arguments are the options of ``hybridcont run`` (the library declares them; values as
+    set={"k": 60}, until={"H": 1.8}, bound={"H": (0, None)}, monitor={"speed": [0.5, 0.8]}, fix={"H": 1.5},
+    from_=a Study or a folder, families_of=a Study or a folder; threads default to every core):
+{options}
+      out="results/slip"              the results folder (default: a temporary one)
     progress: True shows a bar (tqdm where installed, else lines), False nothing, or a callable
     f(stage, branches, points, message) called as the study goes.
     report: write report.html into the folder (2 MB: a sweep's grid points do without).
@@ -167,11 +116,14 @@ def run(model, out=None, progress=True, report=True, **options):
     if result["report_note"]:
         warnings.warn("report.html written without the orbits' animations: %s" % result["report_note"],
                       RuntimeWarning, stacklevel=2)
-    study = Study(opts["out_dir"], model=model if isinstance(model, Model) else None, result=result)
+    study = Study(opts["out"], model=model if isinstance(model, Model) else None, result=result)
     if result["interrupted"]:
         warnings.warn("the study was interrupted: the work so far is kept (status %s)" % result["status"],
                       RuntimeWarning, stacklevel=2)
     return study
+
+
+run.__doc__ = run.__doc__.replace("{options}", _options_help())
 
 
 def load(path, model=None):

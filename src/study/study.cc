@@ -473,48 +473,44 @@ void CheckConservationAtStart(const HybridModel& model, const std::string& argum
 }
 
 
-// The options that decide a study's results, with the model's parameter values and, for a model file, the
-// digest of its text: a resumed study must have the same (threads, the folder and how it is written do not
-// change the results).
+// A value of an option in the resume key (exact: JSON numbers round-trip).
+nlohmann::json OptionValueJson(const StudyOptionValue& value) {
+  const auto bound = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  return std::visit(
+      [&](const auto& v) -> nlohmann::json {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, std::monostate>) {
+          return nullptr;
+        } else if constexpr (std::is_same_v<T, std::vector<NamedValue>>) {
+          nlohmann::json a = nlohmann::json::array();
+          for (const NamedValue& x : v) a.push_back({x.name, x.value});
+          return a;
+        } else if constexpr (std::is_same_v<T, std::vector<NamedInterval>>) {
+          nlohmann::json a = nlohmann::json::array();
+          for (const NamedInterval& x : v) a.push_back({x.name, bound(x.lower), bound(x.upper)});
+          return a;
+        } else {
+          return v;
+        }
+      },
+      value);
+}
+
+// The resume key: every option whose role is to decide the results (study_options.h), and the model's identity
+// (its name, the digest of its text, its parameter values). How and where the study runs (threads, the folder,
+// overwrite, resume) is not part of it.
 nlohmann::json ResultOptionsJson(const StudyOptions& o, const HybridModel& model, const StudyModelSource& source) {
-  const auto values = [](const std::vector<NamedValue>& list) {
-    nlohmann::json a = nlohmann::json::array();
-    for (const NamedValue& v : list) a.push_back({v.name, v.value});
-    return a;
-  };
-  nlohmann::json bounds = nlohmann::json::array();
-  for (const NamedInterval& b : o.bounds) {
-    bounds.push_back({b.name, std::isfinite(b.lower) ? nlohmann::json(b.lower) : nlohmann::json(nullptr),
-                      std::isfinite(b.upper) ? nlohmann::json(b.upper) : nlohmann::json(nullptr)});
+  nlohmann::json j = nlohmann::json::object();
+  for (const StudyOptionSpec& spec : StudyOptionSpecs()) {
+    if (spec.role == OptionRole::kResult) j[spec.field] = OptionValueJson(spec.get(o));
   }
   nlohmann::json parameters = nlohmann::json::object();
   for (const ParameterInfo& info : model.parameters()) parameters[info.name] = model.parameter(info.name);
-  nlohmann::json j = {{"model", o.model},
-                      {"model_name", model.name()},
-                      {"model_text_sha256", source.sha256},
-                      {"parameters", parameters},
-                      {"until", values(o.until)},
-                      {"bounds", bounds},
-                      {"monitors", values(o.monitors)},
-                      {"rtol", o.rtol ? nlohmann::json(*o.rtol) : nlohmann::json(nullptr)},
-                      {"atol", o.atol ? nlohmann::json(*o.atol) : nlohmann::json(nullptr)},
-                      {"max_branches", o.max_branches ? nlohmann::json(*o.max_branches) : nlohmann::json(nullptr)},
-                      {"formulation", ToString(o.formulation)},
-                      {"use_symmetries", o.use_symmetries},
-                      {"follow_word_changes", o.follow_word_changes},
-                      {"period_doubling", o.period_doubling},
-                      {"free", o.free},
-                      {"fix", o.fix ? nlohmann::json({o.fix->name, o.fix->value}) : nlohmann::json(nullptr)},
-                      {"curves", o.curves}};
-  if (o.restart) {
-    // A study in memory is identified by its document's digest (two in-memory studies are never taken for one).
-    const std::string from = o.restart->study ? o.restart->Source() + " " + internal::Sha256Hex(o.restart->study->summary_json)
-                                              : o.restart->from;
-    j["restart"] = {from, o.restart->label, ToString(o.restart->kind)};
-  }
-  if (!o.families_of.empty()) j["families_of"] = o.families_of;
-  if (!o.families.empty()) j["families"] = o.families;
-  if (!o.start_must_converge) j["start_must_converge"] = false;
+  j["model.name"] = model.name();
+  j["model.text_sha256"] = source.sha256;
+  j["model.parameters"] = parameters;
+  // A study in memory is identified by its document's digest (two in-memory studies are never taken for one).
+  if (o.restart && o.restart->study) j["restart.study"] = internal::Sha256Hex(o.restart->study->summary_json);
   return j;
 }
 
@@ -594,21 +590,37 @@ std::unique_ptr<HybridModel> BuildModel(const StudyOptions& options, const Hybri
 // Options that contradict each other, whatever the model.
 void CheckOptionPairs(const StudyOptions& options) {
   if (options.resume && options.out_dir.empty()) {
-    throw StudyOptionError("resume", -1, ": needs the results folder to resume in (out_dir)");
+    throw StudyOptionError("resume", -1, ": needs the results folder to resume in (" + MentionOption("out_dir") + ")");
   }
   if (!options.free.empty() && options.formulation == Formulation::kStateBased) {
-    throw StudyOptionError("formulation", -1, "state: free '" + options.free +
+    throw StudyOptionError("formulation", -1, "state: " + MentionOption("free") + " '" + options.free +
                            "' needs the time-based formulation (the state-based map has no free parameters)");
   }
   if (!options.monitors.empty() && options.formulation == Formulation::kStateBased) {
     throw StudyOptionError("monitors", -1, "needs the time-based formulation");
   }
   if (!options.free.empty() && options.period_doubling) {
-    throw StudyOptionError("period_doubling", -1, ": not with a free parameter (free '" + options.free + "')");
+    throw StudyOptionError("period_doubling", -1, ": not with " + MentionOption("free") + " '" + options.free + "'");
+  }
+  if (options.restart && !options.restart->study) {
+    // The parts of a restart go together (--from FOLDER --at LABEL [--as KIND]).
+    const RestartSpec& r = *options.restart;
+    if (r.from.empty() && r.label.empty()) {
+      throw StudyOptionError("restart.kind", -1, "'" + ToString(r.kind) + "': needs " + MentionOption("restart.from") +
+                             " FOLDER " + MentionOption("restart.label") + " LABEL");
+    }
+    if (r.from.empty()) {
+      throw StudyOptionError("restart.label", -1, "'" + r.label + "': needs " + MentionOption("restart.from") +
+                             " FOLDER (a saved study)");
+    }
+    if (r.label.empty()) {
+      throw StudyOptionError("restart.from", -1, "'" + r.from + "': needs " + MentionOption("restart.label") +
+                             " LABEL (e.g. PD4, B5)");
+    }
   }
   if (!options.families.empty() && options.families_of.empty()) {
     throw StudyOptionError("families", 0, "'" + options.families[0] + "': needs the saved study whose families are "
-                           "continued (families_of, --families-of)");
+                           "continued (" + MentionOption("families_of") + ")");
   }
 }
 
@@ -649,7 +661,7 @@ void AttachGuide(const StudyOptions& options, PreparedStudy* p) {
     throw StudyOptionError("families_of", -1, "'" + options.families_of + "': " + why);
   };
   if (options.restart) refuse("not with a restart (a restart traces from its point; families_of from the model's start)");
-  if (!options.free.empty()) refuse("not with a free parameter (free '" + options.free + "')");
+  if (!options.free.empty()) refuse("not with " + MentionOption("free") + " '" + options.free + "'");
   if (options.formulation != Formulation::kTimeBased) refuse("needs the time-based formulation");
   p->guide = std::make_unique<FamilyGuide>(FamilyGuide::Load(options.families_of, *p->model,
                                                              p->exploration->shooting().layout(), options.families,
@@ -709,29 +721,6 @@ namespace hybridcont {
 
 std::string Version() { return HYBRIDCONT_VERSION; }
 
-std::string ToString(RestartSpec::Kind kind) {
-  switch (kind) {
-    case RestartSpec::Kind::kAuto: return "auto";
-    case RestartSpec::Kind::kContinue: return "continue";
-    case RestartSpec::Kind::kSwitch: return "switch";
-    case RestartSpec::Kind::kPeriodDoubled: return "period-doubled";
-    case RestartSpec::Kind::kCurve: return "curve";
-    case RestartSpec::Kind::kFree: return "free";
-  }
-  return "?";
-}
-
-namespace {
-std::string FieldText(const std::string& field, int index) {
-  return index >= 0 ? field + "[" + std::to_string(index) + "]" : field;
-}
-}  // namespace
-
-StudyOptionError::StudyOptionError(std::string field, int index, const std::string& message)
-    : std::invalid_argument(FieldText(field, index) + (message.rfind(":", 0) == 0 ? "" : " ") + message),
-      field_(std::move(field)), index_(index),
-      detail_(message) {}
-
 const StudySpecialPoint* StudyResult::FindSpecialPoint(const std::string& label) const {
   for (const StudySpecialPoint& p : special_points) {
     if (p.Label() == label) return &p;
@@ -747,9 +736,12 @@ const StudyBranch& StudyResult::branch(int id) const {
   return branches[id];
 }
 
-std::vector<std::string> CheckStudyOptions(const StudyOptions& options) {
+std::vector<std::string> CheckStudyOptions(const StudyOptions& options,
+                                           const std::function<std::string(const std::string&)>& words) {
   const study::PreparedStudy p = study::Prepare(options, {});
-  return p.setup.notes;
+  std::vector<std::string> notes;
+  for (const std::string& note : p.setup.notes) notes.push_back(SayOptions(note, words));
+  return notes;
 }
 
 StudyResult RunStudy(const StudyOptions& options, const StudyHooks& hooks) {
@@ -777,7 +769,7 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
   std::optional<RestartPlan> restart;
   if (options.restart) restart = PlanRestart(*options.restart, options, model);
   for (const std::string& note : p.setup.notes) {
-    if (hooks.on_note) hooks.on_note(note);
+    if (hooks.on_note) hooks.on_note(SayOptions(note, hooks.option_words));
   }
   const nlohmann::json options_json = OptionsJson(options, p.setup);
   const std::filesystem::path dir = options.out_dir;

@@ -79,7 +79,7 @@ def test_bad_input_is_a_value_error_with_the_command_lines_message(tmp_path):
     assert detail in err, (str(e.value), err)
     with pytest.raises(ValueError, match="unknown model 'nosuch'"):
         hc.run("nosuch", progress=False)
-    with pytest.raises(ValueError, match="bound: expected"):
+    with pytest.raises(ValueError, match=r"bound \{'H': 2\}: expected \{name: \(lower, upper\)\}"):
         hc.run("slip", bound={"H": 2}, progress=False)
     with pytest.raises(ValueError, match=r"<text>:4: phases\[0\].name: expected a string"):  # line and field
         hc.model(text="hybridcont = 1\nname = 'x'\n[[phases]]\nname = 3\n")
@@ -87,6 +87,42 @@ def test_bad_input_is_a_value_error_with_the_command_lines_message(tmp_path):
         hc.ModelBuilder("x").family("f", when=sp.gamma(sp.Symbol("a")))
     with pytest.raises(ValueError, match="a string where an expression belongs"):
         hc.ModelBuilder("x").definition("l", "a + b")
+
+
+def test_the_options_are_the_librarys_declaration_in_pythons_words(capsys):
+    import argparse
+    from hybridcont import _hybridcont as native
+    from hybridcont.sweeps import cli as sweep_cli
+    specs = native.study_options()
+    for spec in specs:  # run's docstring is the declaration
+        if spec["keyword"] not in ("model", "out"):
+            assert "\n      %s" % spec["keyword"] in hc.run.__doc__, spec["keyword"]
+    with pytest.raises(TypeError, match="unexpected keyword argument 'untill'"):
+        hc.run("slip", untill={"H": 1}, progress=False)
+    with pytest.raises(ValueError, match=r"^fix 'H=1.5': needs free PARAMETER"):
+        hc.run("slip", fix={"H": 1.5}, progress=False)
+    with pytest.raises(ValueError, match=r"^set \{'k': nan\}: expected finite numbers"):
+        hc.run("slip", set={"k": float("nan")}, progress=False)
+    with pytest.raises(ValueError, match=r"^threads 2.5: expected a whole number"):
+        hc.run("slip", threads=2.5, progress=False)
+    from hybridcont.study import check
+    notes = check("slip", until={"H": 2.5})
+    assert notes == ["until H=2.5 lies outside the bound [0, 2] of H: the bound is widened to [0, 2.5] (give "
+                     "bound H=LOWER:UPPER to keep it)"], notes
+    # The sweep's command line: the declared options a sweep applies at every grid point, checked by the library
+    # as `run` checks them (several values of --monitor, a value that is not finite refused).
+    parser = argparse.ArgumentParser()
+    sweep_cli._add_study_options(parser)
+    args = parser.parse_args(["--monitor", "apex=1,2", "--set", "k=30", "--bound", "H=0:", "--no-symmetry"])
+    assert sweep_cli._study_keywords(args, parser) == {
+        "monitor": {"apex": [1.0, 2.0]}, "set": {"k": 30.0}, "bound": {"H": (0.0, None)}, "no_symmetry": True}
+    for bad, said in ((["--set", "k=nan"], "--set 'k=nan': value 'nan' is not finite"),
+                      (["--set", "=1"], "--set '=1': expected NAME=VALUE"),
+                      (["--set", "k=1", "--set", "k=2"], "--set 'k=2': 'k' is given twice")):
+        with pytest.raises(SystemExit) as e:
+            sweep_cli._study_keywords(parser.parse_args(bad), parser)
+        assert e.value.code == 2
+        assert said in capsys.readouterr().err
 
 
 def test_a_model_file_from_python():

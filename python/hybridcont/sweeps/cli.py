@@ -23,30 +23,40 @@ def _parse_grid(text):
     return name, (start, stop, count)
 
 
-def _parse_bound(text):
-    """NAME=LO:HI (either side may be empty) as (name, (lo, hi)), None for an open side; checked by the library."""
+def _study_options():
+    """The options of `hybridcont run` a sweep applies at every grid point, as the library declares them."""
     from .. import _hybridcont as native
-    try:
-        name, lower, upper = native.parse_bound("--bound", text)
-    except ValueError as e:
-        raise argparse.ArgumentTypeError(str(e))
-    return name, (None if np.isinf(lower) else lower, None if np.isinf(upper) else upper)
+    return [spec for spec in native.study_options() if spec["sweep"]]
 
 
-def _parse_pairs(text, option):
-    """NAME=VALUE or NAME=V1,V2,... as [(name, value)], checked by the library as `hybridcont run` checks it."""
+def _add_study_options(parser):
+    """Each option of `hybridcont run` that a sweep applies at every grid point, as `run` takes it (its flag,
+    help and value form from the library's declaration; the texts checked by the library as `run` checks them)."""
+    for spec in _study_options():
+        if spec["switch"]:
+            parser.add_argument(spec["flag"], action="store_true", dest=spec["field"], help=spec["flag_help"])
+        else:
+            parser.add_argument(spec["flag"], action="append", dest=spec["field"], metavar=spec["value_name"],
+                                help=spec["flag_help"])
+
+
+def _study_keywords(args, parser):
+    """The parsed study options as `hybridcont.run`'s keyword arguments; a refused text ends the command with
+    the library's message (exit 2)."""
     from .. import _hybridcont as native
-    try:
-        return native.parse_assignments(option, text)
-    except ValueError as e:
-        raise argparse.ArgumentTypeError(str(e))
-
-
-def _parse_pair(text, option):
-    pairs = _parse_pairs(text, option)
-    if len(pairs) != 1:
-        raise argparse.ArgumentTypeError("%s '%s': expected NAME=VALUE (one value)" % (option, text))
-    return pairs[0]
+    options = {}
+    for spec in _study_options():
+        value = getattr(args, spec["field"])
+        if value in (None, False):
+            continue
+        if spec["switch"]:
+            options[spec["keyword"]] = True
+            continue
+        try:
+            options[spec["keyword"]] = native.parse_option(spec["field"], value)
+        except ValueError as e:
+            parser.error(str(e))
+    return options
 
 
 def main(argv=None):
@@ -64,38 +74,16 @@ def main(argv=None):
     p.add_argument("--strategy", choices=("explore", "continue"), default="explore",
                    help="explore (the default): every grid point explored whole; continue: each grid point "
                         "continues its neighbour's families (faster; check it against explore on a coarse grid)")
-    p.add_argument("--set", action="append", default=[], type=lambda t: _parse_pair(t, "--set"))
-    p.add_argument("--until", action="append", default=[], type=lambda t: _parse_pair(t, "--until"))
-    p.add_argument("--bound", action="append", default=[], type=_parse_bound, help="NAME=LO:HI")
-    p.add_argument("--rtol", type=float)
-    p.add_argument("--atol", type=float)
-    p.add_argument("--max-branches", type=int)
-    p.add_argument("--formulation", default="time")
-    p.add_argument("--no-symmetry", action="store_true")
     p.add_argument("--family", action="append", dest="families",
                    help="map only this family (its name; repeatable): the table has its rows, each grid point "
                         "traces only what led to it")
     p.add_argument("--curves", help="a grid parameter P: on every grid line along P, one grid point continues its "
                                     "families' special points in (H, P); the report draws them over the ranges")
-    p.add_argument("--monitor", action="append", default=[], type=lambda t: _parse_pairs(t, "--monitor"),
-                   help="NAME=VALUE or NAME=V1,V2,...: locate where an observable takes the values (repeatable)")
-    p.add_argument("--period-doubling", action="store_true")
-    p.add_argument("--one-word", action="store_true")
-    p.add_argument("--free", help="a parameter continued instead of H (with --fix; every grid point explored whole)")
-    p.add_argument("--fix", type=lambda t: _parse_pair(t, "--fix"), help="NAME=VALUE held while --free varies")
+    _add_study_options(p)
     args = p.parse_args(argv)
     import warnings  # the command line says the sweep's warnings as notes, without Python's file and line
     warnings.showwarning = lambda message, *rest, **named: print("note: %s" % message, file=sys.stderr)
-    monitors = {}
-    for pairs in args.monitor:
-        for name, value in pairs:
-            monitors.setdefault(name, []).append(value)
-    options = {"set": dict(args.set), "until": dict(args.until), "bound": dict(args.bound), "monitor": monitors,
-               "rtol": args.rtol, "atol": args.atol, "max_branches": args.max_branches,
-               "formulation": args.formulation, "no_symmetry": args.no_symmetry,
-               "period_doubling": args.period_doubling, "one_word": args.one_word, "free": args.free,
-               "fix": dict([args.fix]) if args.fix else None}
-    options = {k: v for k, v in options.items() if not (v is None or v is False or (isinstance(v, dict) and not v))}
+    options = _study_keywords(args, p)
     out = args.out or os.path.join("results", os.path.basename(args.model).replace(".toml", "") + "-sweep")
     try:
         table = sweep(args.model, dict(args.grid), out, scheduler=args.scheduler, workers=args.workers,

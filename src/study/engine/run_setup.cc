@@ -78,7 +78,7 @@ void ApplyTargetsAndBounds(const StudyOptions& args, const HybridModel& model, C
       const NamedValue& t = args.until[k];
       if (t.name == b.name && !(t.value >= b.lower && t.value <= b.upper)) {
         Refuse("until", static_cast<int>(k),
-               fmt::format("{} lies outside bounds[{}] {}: no branch could reach it", Text(t), i, Text(b)));
+               fmt::format("{} lies outside {} {}: no branch could reach it", Text(t), MentionOption("bounds"), Text(b)));
       }
     }
     if (b.name == "period") {
@@ -103,9 +103,10 @@ void WidenBoundsToTargets(const StudyOptions& args, ContinuationOptions* c, std:
       const double lower = b.lower, upper = b.upper;
       b.lower = std::min(b.lower, t.value);
       b.upper = std::max(b.upper, t.value);
-      notes->push_back(fmt::format("until {}={:g} lies outside the bound [{:g}, {:g}] of {}: the bound is widened "
-                                   "to [{:g}, {:g}] (give the bound {}=LOWER:UPPER to keep it)",
-                                   t.component, t.value, lower, upper, t.component, b.lower, b.upper, t.component));
+      notes->push_back(fmt::format("{} {}={:g} lies outside the bound [{:g}, {:g}] of {}: the bound is widened "
+                                   "to [{:g}, {:g}] (give {} {}=LOWER:UPPER to keep it)",
+                                   MentionOption("until"), t.component, t.value, lower, upper, t.component, b.lower,
+                                   b.upper, MentionOption("bounds"), t.component));
     }
   }
 }
@@ -187,8 +188,8 @@ void ApplyFreeParameter(const StudyOptions& args, const HybridModel& model, RunS
     return;
   }
   if (args.free.empty() && !args.fix) return;
-  if (args.free.empty()) Refuse("fix", -1, Text(*args.fix) + ": needs a free parameter (free)");
-  if (!args.fix) Refuse("free", -1, "'" + args.free + "': needs an unknown held fixed (fix NAME=VALUE, e.g. H=1.5)");
+  if (args.free.empty()) Refuse("fix", -1, Text(*args.fix) + ": needs " + MentionOption("free") + " PARAMETER (the parameter that varies)");
+  if (!args.fix) Refuse("free", -1, "'" + args.free + "': needs " + MentionOption("fix") + " NAME=VALUE (the unknown held fixed, e.g. H=1.5)");
   RequireParameter("free", model, args.free);
   if (!model.has_parameter_derivatives()) {
     Refuse("free", -1, fmt::format("'{}': model '{}' has no parameter derivatives", args.free, model.name()));
@@ -267,7 +268,7 @@ void ApplyCurveParameter(const StudyOptions& args, const HybridModel& model, Stu
     Refuse("curves", -1, fmt::format("'{}': model '{}' has no parameter derivatives", args.curves,
                                             model.name()));
   }
-  if (!args.free.empty()) Refuse("curves", -1, "'" + args.curves + "': not with a free parameter (free)");
+  if (!args.free.empty()) Refuse("curves", -1, "'" + args.curves + "': not with " + MentionOption("free"));
   setup->curve_parameter = args.curves;
   setup->curve_bound = DefaultParameterBound(model, args.curves);
   std::erase_if(run_args->bounds, [&](const NamedInterval& b) {
@@ -312,9 +313,9 @@ RunSetup MakeRunSetup(const StudyOptions& given, const HybridModel& model) {
   if (!continued.empty() && std::none_of(bounds.begin(), bounds.end(), [&](const ComponentBound& b) {
         return b.component == continued && std::isfinite(b.lower) && std::isfinite(b.upper);
       })) {
-    setup.notes.push_back(fmt::format("{} has no bound (run.bounds or the bound {}=LOWER:UPPER): each branch ends after "
+    setup.notes.push_back(fmt::format("{} has no bound (run.bounds or {} {}=LOWER:UPPER): each branch ends after "
                                       "{} points (run.max_points)",
-                                      continued, continued, setup.exploration.continuation.max_points));
+                                      continued, MentionOption("bounds"), continued, setup.exploration.continuation.max_points));
   }
   return setup;
 }
