@@ -208,6 +208,58 @@ TEST(Study, AStopRequestEndsTheStudyWithTheWorkSoFar) {
 
 // Every option is declared once (study_options.h): set from its command-line text, it reads back as that value,
 // every member it names changes from its default, and the roles split the results from how and where a study runs.
+// An automaton's words and every change of word considered, and a free parameter's starts, are typed in the
+// result; the folder read back holds the same, field by field.
+TEST(Study, WordChangesAndParameterStartsAreTypedAndReadBackEqual) {
+  const auto same = [](double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; };
+  const fs::path dir = Scratch("typed_words"), free_dir = Scratch("typed_starts");
+  StudyOptions o;
+  o.model = (fs::path(HYBRIDCONT_SOURCE_DIR) / "models" / "slip.toml").string();
+  o.out_dir = dir.string();
+  o.threads = 2;
+  const StudyResult study = RunStudy(o);
+  ASSERT_GE(study.words.size(), 2u);
+  ASSERT_FALSE(study.word_changes.empty());
+  EXPECT_EQ(study.words[0].branches.front(), 0);
+  const StudyResult loaded = LoadStudy(dir.string());
+  EXPECT_EQ(loaded.words, study.words);
+  ASSERT_EQ(loaded.word_changes.size(), study.word_changes.size());
+  int accepted = 0;
+  for (std::size_t i = 0; i < study.word_changes.size(); ++i) {
+    const StudyWordChange &a = study.word_changes[i], &b = loaded.word_changes[i];
+    EXPECT_EQ(a.from_word, b.from_word);
+    EXPECT_EQ(a.from_branch, b.from_branch);
+    EXPECT_EQ(a.at, b.at);
+    EXPECT_EQ(a.rule, b.rule);
+    EXPECT_EQ(a.to_word, b.to_word);
+    EXPECT_EQ(a.accepted, b.accepted);
+    EXPECT_EQ(a.reason, b.reason);
+    EXPECT_EQ(a.detail, b.detail);
+    EXPECT_EQ(a.to_branches, b.to_branches);
+    for (const auto& [x, y] : {std::pair{a.H, b.H}, {a.H_physical, b.H_physical}, {a.H_beyond, b.H_beyond},
+                               {a.residual, b.residual}, {a.state_difference, b.state_difference},
+                               {a.period_difference, b.period_difference}}) {
+      EXPECT_TRUE(same(x, y)) << i << ": " << x << " vs " << y;
+    }
+    accepted += a.accepted;
+    for (const int to : a.to_branches) {  // a family explored from the change is handed over from it
+      ASSERT_LT(to, static_cast<int>(study.branches.size()));
+      if (study.branches[to].handed_over_from >= 0) EXPECT_EQ(study.branches[to].handed_over_from, static_cast<int>(i));
+    }
+  }
+  EXPECT_GT(accepted, 0);
+  o.out_dir = free_dir.string();
+  o.free = "k";
+  o.fix = NamedValue{"H", 1.5};
+  const StudyResult free = RunStudy(o);
+  ASSERT_TRUE(free.parameter_starts);
+  EXPECT_GT(free.parameter_starts->crossings, 0);
+  EXPECT_EQ(LoadStudy(free_dir.string()).parameter_starts, free.parameter_starts);
+  EXPECT_FALSE(study.parameter_starts);
+  fs::remove_all(dir);
+  fs::remove_all(free_dir);
+}
+
 TEST(StudyOptions, EveryDeclaredOptionIsSetFromItsTextAndReadBack) {
   const std::map<std::string, std::vector<std::string>> texts = {
       {"model", {"slip.toml"}},     {"parameters", {"k=30", "w2=5"}}, {"until", {"H=1.5"}},

@@ -164,6 +164,46 @@ struct StudyCurve {
   std::vector<Vector> points;        // in curve order, each in `columns` order
 };
 
+// A change of an automaton's phase sequence the study considered (word_change.h): where a physical family of
+// a word reached a zero duration, touched a competing guard's surface or ended; the rule that builds the new
+// word, accepted or refused with the reason, and the branches it leads to (summary.json's "word_changes").
+struct StudyWordChange {
+  std::vector<std::string> from_word;  // the modes of the word the family belongs to
+  int from_branch = -1;
+  std::string at;                      // "t2 = 0", "guard of <transition> touched", "end of a physical family (...)"
+  double H = std::numeric_limits<double>::quiet_NaN();  // NaN without a first integral
+  // Where an end was only bracketed: the last physical point's H̄ and the first beyond; NaN otherwise.
+  double H_physical = std::numeric_limits<double>::quiet_NaN(), H_beyond = std::numeric_limits<double>::quiet_NaN();
+  std::string detail;                  // what the first point beyond an end is
+  std::string rule;                    // the rule that builds the new word; empty where none was offered
+  std::vector<std::string> to_word;    // the new word's modes (with a rule)
+  double residual = std::numeric_limits<double>::quiet_NaN();           // the orbit as an orbit of the new word
+  double state_difference = std::numeric_limits<double>::quiet_NaN();   // the new word's orbit against the old:
+  double period_difference = std::numeric_limits<double>::quiet_NaN();  //   state at the section, period
+  bool accepted = false;
+  std::string reason;                  // why it was refused, or why an accepted change was not followed
+  std::vector<int> to_branches;        // the branches it leads to (explored there, or traced before)
+  bool operator==(const StudyWordChange&) const = default;
+};
+
+// A word of an automaton the study explored, with its branches (summary.json's "words").
+struct StudyWord {
+  std::string name;                 // HybridAutomaton::WordName
+  std::vector<std::string> modes;
+  std::vector<int> branches;
+  bool operator==(const StudyWord&) const = default;
+};
+
+// How a study in a free parameter found its starts (options.free with fix): the physical families' crossings of
+// the fixed value in the ordinary run (summary.json's "starts").
+struct StudyParameterStarts {
+  int crossings = 0;               // crossings found
+  int distinct = 0;                // distinct orbits among them
+  int on_traced_branches = 0;      // starts that lay on branches traced from earlier ones
+  int ordinary_half_branches = 0;  // half-branches of the ordinary run searched
+  bool operator==(const StudyParameterStarts&) const = default;
+};
+
 // A stretch of the continued coordinate: from <= to, each end said as the answer says it — a special point's
 // label ("PD4"; ", not located" where it was only bracketed) or how the end is known ("end of the branch,
 // bound-reached").
@@ -217,13 +257,15 @@ struct StudyResult {
   // Non-empty when a file of out_dir could not be written (a full disk): the folder keeps what was written,
   // marked as not complete; the result holds the whole study.
   std::string write_error;
+  std::vector<StudyWord> words;                 // an automaton's words explored (the study's own first)
+  std::vector<StudyWordChange> word_changes;    // every change of word considered; index: handed_over_from
+  std::optional<StudyParameterStarts> parameter_starts;  // a study in a free parameter
   std::vector<StudyOrbit> orbits;    // key frames
   std::string curve_parameter;       // p of the curves (options.curves); empty without
   std::vector<StudyCurve> curves;    // id == index
   StudyWork work;
-  // The whole saved document (summary.json, docs/results-format.md): the effective options, word changes
-  // ("word_changes", "words"), curves ("curves"), starts, presentation. The typed fields above are read from
-  // it and the point tables.
+  // The whole saved document (summary.json, docs/results-format.md): beside the typed fields above, the
+  // effective options and the model's presentation.
   std::string summary_json;
   // The exploration of the study's own families as the engine gives it (time-based layout, model units): every
   // branch's ContinuationPoint and SpecialPoint with tangents, interval widths and test values, the branch

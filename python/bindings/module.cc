@@ -419,12 +419,140 @@ py::list FamiliesOf(const StudyResult& study) {
   return out;
 }
 
-// The special points' labels by id (StudySpecialPoint::Label: what --at and continue_from name).
-py::dict LabelsOf(const StudyResult& study) {
+// ---- a study's tables, from its typed result (study.h): the rows Python's DataFrames are made of
+
+// One row per special point that is no duplicate: label (the library's one rule), the record's fields, each
+// named unknown (a free parameter, an observable) as a column, the observables as a dict.
+py::list SpecialPointRows(const StudyResult& study) {
+  py::list rows;
+  for (const StudySpecialPoint& sp : study.special_points) {
+    if (sp.duplicate_of >= 0) continue;
+    py::dict row;
+    row["label"] = sp.Label();
+    row["id"] = sp.id;
+    row["type"] = sp.code;
+    row["branch"] = sp.branch;
+    row["index"] = sp.index;
+    row["H"] = sp.H;
+    row["T"] = sp.T;
+    row["status"] = sp.status;
+    row["precision"] = sp.precision;
+    row["precision_arclength"] = sp.precision_arclength;
+    row["precision_H"] = sp.precision_H;
+    row["residual"] = sp.residual;
+    row["component"] = sp.component;
+    row["duplicate_of"] = sp.duplicate_of;
+    row["message"] = sp.message;
+    row["u"] = ToArray(sp.u);
+    for (const NamedValue& v : sp.named_unknowns) row[py::str(v.name)] = v.value;
+    if (!sp.word.empty()) row["word"] = sp.word;
+    if (sp.period_doubled_from >= 0) row["period_doubled_from"] = sp.period_doubled_from;
+    if (!sp.observables.empty()) {
+      py::dict observables;
+      for (const NamedValue& v : sp.observables) observables[py::str(v.name)] = v.value;
+      row["observables"] = observables;
+    }
+    rows.append(row);
+  }
+  return rows;
+}
+
+// One row per branch: id, family, parent (the special point it starts at), direction, depth, points (how
+// many), termination, word (its modes joined by " > "), image_of, symmetry, file, and the rest of its record.
+py::list BranchRows(const StudyResult& study) {
+  py::list rows;
+  for (const StudyBranch& b : study.branches) {
+    py::dict row;
+    row["id"] = b.id;
+    row["family"] = b.family;
+    row["parent"] = b.parent_special_point;
+    row["direction"] = b.direction;
+    row["depth"] = b.depth;
+    row["points"] = b.points.size();
+    row["termination"] = b.termination;
+    std::string word;
+    for (const std::string& mode : b.word) word += (word.empty() ? "" : " > ") + mode;
+    row["word"] = b.word.empty() ? py::object(py::none()) : py::object(py::str(word));
+    row["image_of"] = b.image_of;
+    row["symmetry"] = b.symmetry;
+    row["file"] = "branch-" + std::to_string(b.id) + ".csv";
+    row["message"] = b.message;
+    row["model"] = b.model;
+    row["origin"] = b.origin;
+    row["continued"] = b.continued;
+    row["reflected_from"] = b.reflected_from;
+    row["period_doubled_from"] = b.period_doubled_from;
+    row["handed_over_from"] = b.handed_over_from;
+    rows.append(row);
+  }
+  return rows;
+}
+
+// One row per change of word considered (StudyWordChange), NaN for what a change does not have.
+py::list WordChangeRows(const StudyResult& study) {
+  py::list rows;
+  for (const StudyWordChange& c : study.word_changes) {
+    py::dict row;
+    row["from_word"] = c.from_word;
+    row["from_branch"] = c.from_branch;
+    row["at"] = c.at;
+    row["H"] = c.H;
+    row["H_physical"] = c.H_physical;
+    row["H_beyond"] = c.H_beyond;
+    row["detail"] = c.detail;
+    row["rule"] = c.rule;
+    row["to_word"] = c.to_word;
+    row["residual"] = c.residual;
+    row["state_difference"] = c.state_difference;
+    row["period_difference"] = c.period_difference;
+    row["accepted"] = c.accepted;
+    row["reason"] = c.reason;
+    row["to_branches"] = c.to_branches;
+    rows.append(row);
+  }
+  return rows;
+}
+
+// One row per point of every two-parameter curve: curve (its id), type, name, special_point, status, then the
+// curve's columns ("H", the parameter, its other unknowns).
+py::list CurveRows(const StudyResult& study) {
+  py::list rows;
+  for (const StudyCurve& c : study.curves) {
+    for (const Vector& point : c.points) {
+      py::dict row;
+      row["curve"] = c.id;
+      row["type"] = c.type;
+      row["name"] = c.name;
+      row["special_point"] = c.special_point;
+      row["status"] = c.status;
+      for (std::size_t k = 0; k < c.columns.size() && static_cast<Eigen::Index>(k) < point.size(); ++k) {
+        row[py::str(c.columns[k])] = point(static_cast<Eigen::Index>(k));
+      }
+      rows.append(row);
+    }
+  }
+  return rows;
+}
+
+// What Python's Study holds of a study: status, answer, its families' fold, labels and tables.
+py::dict StudyDict(const StudyResult& study) {
   py::dict out;
-  for (const StudySpecialPoint& sp : study.special_points) out[py::int_(sp.id)] = sp.Label();
+  out["status"] = ToString(study.status);
+  out["message"] = study.message;
+  out["model"] = study.model;
+  out["version"] = study.version;
+  out["answer"] = OneScreenAnswer(study, study.work.wall_seconds);
+  out["families"] = FamiliesOf(study);
+  out["unknowns"] = study.unknown_names;
+  out["special_points"] = SpecialPointRows(study);
+  out["branches"] = BranchRows(study);
+  out["word_changes"] = WordChangeRows(study);
+  out["curves"] = CurveRows(study);
+  out["model_source"] = py::dict(py::arg("kind") = ToString(study.model_source.kind), py::arg("name") = study.model_source.name,
+                                 py::arg("path") = study.model_source.path, py::arg("text") = study.model_source.text);
   return out;
 }
+
 
 py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& model, const py::object& on_progress,
                             const py::object& on_point, const py::object& on_note, const py::object& report_assets) {
@@ -479,40 +607,24 @@ py::dict RunStudyFromPython(const py::dict& options_dict, const ModelHandle& mod
     }
   }
   if (!callback_error.empty()) throw std::runtime_error("a callback of the study failed: " + callback_error);
-  py::dict out;
+  py::dict out = StudyDict(result);
   out["report_error"] = report_error;
   out["report_note"] = report_note;
-  out["model"] = result.model;
-  out["version"] = result.version;
-  out["status"] = ToString(result.status);
-  out["message"] = result.message;
   out["interrupted"] = interrupted();
   out["write_error"] = result.write_error;
   out["wall_seconds"] = result.work.wall_seconds;
-  out["answer"] = OneScreenAnswer(result, result.work.wall_seconds);
   out["report"] = result.report;
-  out["families"] = FamiliesOf(result);
-  out["labels"] = LabelsOf(result);
   return out;
 }
 
-// The saved study's answer, status and model (the folder checked as LoadStudy checks it).
+// The saved study as Python's Study holds it (StudyDict; the folder checked as LoadStudy checks it).
 py::dict LoadStudyFromPython(const std::string& dir) {
   std::unique_ptr<StudyResult> study_ptr;
   {
     py::gil_scoped_release release;
     study_ptr = std::make_unique<StudyResult>(LoadStudy(dir));
   }
-  const StudyResult& study = *study_ptr;
-  py::dict out;
-  out["status"] = ToString(study.status);
-  out["message"] = study.message;
-  out["model"] = study.model;
-  out["version"] = study.version;
-  out["answer"] = OneScreenAnswer(study, study.work.wall_seconds);
-  out["families"] = FamiliesOf(study);
-  out["labels"] = LabelsOf(study);
-  return out;
+  return StudyDict(*study_ptr);
 }
 
 std::string ReportHtml(const std::string& dir, const py::dict& assets, const ModelHandle& model,

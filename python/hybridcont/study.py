@@ -9,9 +9,11 @@
     pd4 = study.continue_from("PD4")              # the period-doubled family born at PD4
     study.save("results/slip"); hc.load("results/slip")
 
-A study is a results folder (docs/results-format.md): the library writes it as it computes, and the
-DataFrames are its files, so Python and the command line see the same columns and numbers. Without ``out``
-the folder is a temporary one, removed when the interpreter exits unless ``save``d.
+A study is the library's typed result (study.h) and its results folder (docs/results-format.md), the one
+serialization of it. ``families``, ``special_points``, ``branches``, ``word_changes`` and ``curves`` are the typed
+result's (of the run in memory, or of the folder read back by the library's LoadStudy: the same rows); ``points``
+and ``orbits`` are the folder's branch and orbit files, whose columns also hold what the model's presentation
+computes. Without ``out`` the folder is a temporary one, removed when the interpreter exits unless ``save``d.
 """
 import atexit
 import html
@@ -168,7 +170,11 @@ class Study:
         self.version = info["version"]
         self._answer = info["answer"]
         self._families = list(info["families"])
-        self._labels = dict(info["labels"])  # special point id -> label, the library's one rule
+        # The typed study's tables (the library's record, as summary.json serializes it): rows of the special
+        # points (labels by the library's one rule), branches and changes of word.
+        self._rows = {key: list(info[key]) for key in ("special_points", "branches", "word_changes", "curves")}
+        self._unknowns = list(info["unknowns"])
+        self._model_source = dict(info["model_source"])
         self.interrupted = bool(result and result["interrupted"])
         self.write_error = result["write_error"] if result else ""
         self.wall_seconds = result["wall_seconds"] if result else None
@@ -185,27 +191,14 @@ class Study:
     @property
     def unknowns(self):
         """The names of u's entries (the layout of the branch files' unknowns and special points' u)."""
-        return list(self.summary.get("unknowns") or [])
+        return list(self._unknowns)
 
     @property
     def branches(self):
-        """One row per branch: id, family, parent special point, termination, points, word, image_of, ..."""
-        def make():
-            rows = []
-            for b in self.summary.get("branches") or []:
-                row = {k: v for k, v in b.items() if k not in ("physical_ranges", "stable_ranges")}
-                if isinstance(row.get("word"), list):
-                    row["word"] = " > ".join(row["word"])
-                row.setdefault("family", "")
-                rows.append(row)
-            first = ["id", "family", "parent", "direction", "depth", "points", "termination", "word", "image_of",
-                     "symmetry", "file"]
-            frame = pd.DataFrame(rows)
-            for column in first:
-                if column not in frame.columns:
-                    frame[column] = pd.Series(dtype=object)
-            return frame[first + [c for c in frame.columns if c not in first]]
-        return self._table("branches", make)
+        """One row per branch: id, family, parent special point, direction, depth, points, termination, word,
+        image_of, symmetry, file, then message, model, origin, continued, reflected_from, period_doubled_from and
+        handed_over_from."""
+        return self._table("branches", lambda: pd.DataFrame(self._rows["branches"]))
 
     @property
     def points(self):
@@ -214,8 +207,8 @@ class Study:
         quantities and observables."""
         def make():
             frames = []
-            for b in self.summary.get("branches") or []:
-                path = os.path.join(self.path, b.get("file") or "branch-%d.csv" % b["id"])
+            for b in self._rows["branches"]:
+                path = os.path.join(self.path, b["file"])
                 if not os.path.exists(path):
                     continue
                 frame = pd.read_csv(path, keep_default_na=True)
@@ -232,22 +225,11 @@ class Study:
 
     @property
     def special_points(self):
-        """One row per located (or bracketed) special point: label, type, branch, index, H, T, status,
-        precision, residual, component, message, and u (the point in the study's unknowns)."""
-        def make():
-            rows = []
-            for sp in self.summary.get("special_points") or []:
-                if sp.get("duplicate_of", -1) >= 0:
-                    continue
-                row = dict(sp)
-                row["label"] = self._labels[sp["id"]]
-                row["u"] = np.array(sp.get("u") or [], dtype=float)
-                rows.append(row)
-            frame = pd.DataFrame(rows)
-            if not frame.empty:
-                frame = frame[["label"] + [c for c in frame.columns if c != "label"]]
-            return frame
-        return self._table("special_points", make)
+        """One row per located (or bracketed) special point: label, id, type, branch, index, H, T, status,
+        precision (also along the branch and in H), residual, component, message, u (the point in the study's
+        unknowns), each free parameter or observable among the unknowns by name, and where they apply word,
+        period_doubled_from and observables."""
+        return self._table("special_points", lambda: pd.DataFrame(self._rows["special_points"]))
 
     @property
     def families(self):
@@ -262,26 +244,17 @@ class Study:
 
     @property
     def word_changes(self):
-        """An automaton's changes of phase sequence (summary "word_changes"), one row each."""
-        return self._table("word_changes", lambda: pd.DataFrame(self.summary.get("word_changes") or []))
+        """An automaton's changes of phase sequence, one row each: from_word, from_branch, at, H (H_physical and
+        H_beyond where an end was only bracketed), detail, rule, to_word, residual, state_difference,
+        period_difference, accepted, reason, to_branches."""
+        return self._table("word_changes", lambda: pd.DataFrame(self._rows["word_changes"]))
 
     @property
     def curves(self):
-        """The two-parameter curves (``curves=p``): every curve file's columns (H, p, the other unknowns),
-        one row per point, with the curve's id, type and the special point it continues."""
-        def make():
-            frames = []
-            for c in self.summary.get("curves") or []:
-                path = os.path.join(self.path, c["file"])
-                if not os.path.exists(path):
-                    continue
-                frame = pd.read_csv(path)
-                frame.insert(0, "special_point", c.get("special_point"))
-                frame.insert(0, "type", c.get("type"))
-                frame.insert(0, "curve", c["id"])
-                frames.append(frame)
-            return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
-        return self._table("curves", make)
+        """The two-parameter curves (``curves=p``), one row per point: curve (its id), type, name (a boundary's
+        quantity), special_point (the one it continues, -1 for a boundary), status, then H, p and the curve's
+        other unknowns."""
+        return self._table("curves", lambda: pd.DataFrame(self._rows["curves"]))
 
     @property
     def orbits(self):
@@ -311,9 +284,9 @@ class Study:
         """The study's own model at its parameter values: the one given, else rebuilt from the folder's record of
         it (ValueError where it cannot be: never another model of the same name)."""
         if self.model is None:
-            source = self.summary.get("model_source") or {}
+            source = self._model_source
             self.model = Model(native.model_of_study(self.path, _paths.MODELS),
-                               source=source.get("path") or source.get("name"), text=source.get("text"))
+                               source=source["path"] or source["name"], text=source["text"] or None)
         return self.model
 
     def _map(self):
@@ -407,5 +380,5 @@ class Study:
     def __repr__(self):
         n_families = len({row["family"] for row in self._families})
         return "<hybridcont.Study %s: %d branches, %d families, %d special points, %s; %s>" % (
-            self.model_name, len(self.summary.get("branches") or []), n_families,
-            len(self.summary.get("special_points") or []), self.status, self.path)
+            self.model_name, len(self._rows["branches"]), n_families, len(self._rows["special_points"]),
+            self.status, self.path)

@@ -275,6 +275,7 @@ struct ExploredFamilies {
   // curves); empty otherwise.
   BifurcationDiagram restart_points;
   std::string starts_report;  // where the exploration began, in words
+  std::optional<StudyParameterStarts> parameter_starts;  // a study in a free parameter
 };
 
 using PointSink = std::function<void(const ProgressInfo& info, const Vector& u_problem)>;
@@ -332,10 +333,9 @@ ExploredFamilies ExploreFamilies(const HybridModel& model, const RunSetup& setup
     diagram = exploration.RunFromStarts(starts.points, on_point, &skipped);
     out.starts_report = starts.report + fmt::format("  {} of them on branches traced from earlier starts\n", skipped);
     say("start", out.starts_report);
-    writer.Annotate("starts", {{"crossings", starts.crossings},
-                               {"distinct", starts.points.size()},
-                               {"on_traced_branches", skipped},
-                               {"ordinary_half_branches", starts.ordinary_branches}});
+    out.parameter_starts = StudyParameterStarts{starts.crossings, static_cast<int>(starts.points.size()), skipped,
+                                                starts.ordinary_branches};
+    writer.Annotate("starts", ParameterStartsJson(*out.parameter_starts));
   }
   if (formulation == Formulation::kStateBased) ConvertToTimeBased(exploration, layout, &diagram);
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
@@ -365,7 +365,10 @@ std::string RunLaterStages(const StudyOptions& options, const HybridModel& model
   }
   if (options.follow_word_changes && !stopped()) {
     say("words", "");
-    report += ExploreWordChanges(model, setup, explored.diagram, special_points, writer, hooks);
+    WordRecord words;
+    report += ExploreWordChanges(model, setup, explored.diagram, special_points, &words, writer, hooks);
+    result->words = std::move(words.words);
+    result->word_changes = std::move(words.changes);
   }
   if (!setup.curve_parameter.empty() && !stopped()) {
     say("curves", "");
@@ -411,6 +414,7 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   result->status = diagram.status;
   result->message = diagram.message;
   result->diagram = diagram;
+  result->parameter_starts = explored.parameter_starts;
   if (writer.failed()) return;  // the failed write is the result's write_error
   std::vector<StudySpecialPoint> special_points = RecordSpecialPoints(diagram, layout, &model, setup.integrator);
   const std::unique_ptr<HybridModel> at_point = setup.free.empty() ? nullptr : std::make_unique<HybridModel>(model.Clone());
@@ -830,6 +834,9 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
   typed.work = result.work;
   typed.orbits = writer.orbits();
   typed.curves = std::move(result.curves);
+  typed.words = std::move(result.words);
+  typed.word_changes = std::move(result.word_changes);
+  typed.parameter_starts = result.parameter_starts;
   typed.curve_parameter = p.setup.curve_parameter;
   typed.diagram = std::move(result.diagram);
   typed.write_error = writer.write_error();

@@ -294,21 +294,29 @@ StudyOptionValue ParseOne(const StudyOptionSpec& spec, int index, const std::str
 }
 
 // Appends the entries of `more` to the list `into` (both of the option's kind).
+template <class List>
+bool AppendTo(StudyOptionValue* into, const StudyOptionValue& more) {
+  List* list = std::get_if<List>(into);
+  const List* tail = std::get_if<List>(&more);
+  if (list == nullptr || tail == nullptr) return false;
+  list->insert(list->end(), tail->begin(), tail->end());
+  return true;
+}
 void Append(StudyOptionValue* into, StudyOptionValue more) {
   if (std::holds_alternative<std::monostate>(*into)) {
     *into = std::move(more);
     return;
   }
-  std::visit(
-      [&more](auto& list) {
-        using T = std::decay_t<decltype(list)>;
-        if constexpr (std::is_same_v<T, std::vector<std::string>> || std::is_same_v<T, std::vector<NamedValue>> ||
-                      std::is_same_v<T, std::vector<NamedInterval>>) {
-          const T& tail = std::get<T>(more);
-          list.insert(list.end(), tail.begin(), tail.end());
-        }
-      },
-      *into);
+  AppendTo<std::vector<std::string>>(into, more) || AppendTo<std::vector<NamedValue>>(into, more) ||
+      AppendTo<std::vector<NamedInterval>>(into, more);
+}
+
+// How many entries of a list of names (values or intervals) are named `name`.
+template <class List>
+int CountNamed(const StudyOptionValue& value, const std::string& name) {
+  const List* list = std::get_if<List>(&value);
+  if (list == nullptr) return 0;
+  return static_cast<int>(std::count_if(list->begin(), list->end(), [&](const auto& e) { return e.name == name; }));
 }
 
 bool HoldsKind(OptionKind kind, const StudyOptionValue& v) {
@@ -411,17 +419,9 @@ StudyOptionValue ParseStudyOption(const StudyOptionSpec& spec, const std::vector
     if (spec.kind == OptionKind::kValues || spec.kind == OptionKind::kIntervals) {
       const std::string name = spec.kind == OptionKind::kValues ? std::get<std::vector<NamedValue>>(value).back().name
                                                                  : std::get<std::vector<NamedInterval>>(value).back().name;
-      const auto same = [&name](const auto& entry) { return entry.name == name; };
-      const std::size_t count = std::visit(
-          [&same](const auto& list) -> std::size_t {
-            if constexpr (std::is_same_v<std::decay_t<decltype(list)>, std::vector<NamedValue>> ||
-                          std::is_same_v<std::decay_t<decltype(list)>, std::vector<NamedInterval>>) {
-              return std::count_if(list.begin(), list.end(), same);
-            }
-            return 0;
-          },
-          value);
-      if (count > 1) throw StudyOptionError(spec.field, static_cast<int>(i), "'" + texts[i] + "': '" + name + "' is given twice");
+      if (CountNamed<std::vector<NamedValue>>(value, name) + CountNamed<std::vector<NamedInterval>>(value, name) > 1) {
+        throw StudyOptionError(spec.field, static_cast<int>(i), "'" + texts[i] + "': '" + name + "' is given twice");
+      }
     }
   }
   return value;

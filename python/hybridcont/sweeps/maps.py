@@ -5,7 +5,7 @@ import os
 import numpy as np
 import pandas as pd
 
-from .grid import _read_json, read_definition
+from .grid import read_definition
 
 
 def _finite(x):
@@ -29,24 +29,21 @@ def curve_lines(out):
         folder = os.path.join(out, "points", pid)
         if pid.startswith(".") or not os.path.exists(os.path.join(folder, "summary.json")):
             continue
-        head = _read_json(os.path.join(folder, "summary.json"), "a saved study's summary")
-        if not isinstance(head, dict) or not head.get("curves"):
-            continue  # a grid point without curves (all but one per line)
         study = load(folder)  # the library reads the folder back: a damaged one is a ValueError naming its file
-        summary = study.summary
-        special = {sp["id"]: sp for sp in summary.get("special_points") or []}
-        families = {b["id"]: b.get("family") or "" for b in summary.get("branches") or []}
-        labels = study._labels
         frames = study.curves
+        if frames.empty:
+            continue  # a grid point without curves (all but one per line)
+        special = study.special_points.set_index("id") if len(study.special_points) else None
+        families = dict(zip(study.branches["id"], study.branches["family"]))
         drawn = []
-        for c in summary["curves"]:
-            frame = frames[frames.curve == c["id"]] if len(frames) else frames
-            if c.get("status") != "traced" or frame.empty or parameter not in frame.columns or "H" not in frame.columns:
+        for curve_id, frame in frames.groupby("curve", sort=True):
+            first = frame.iloc[0]
+            if first["status"] != "traced" or parameter not in frame.columns or "H" not in frame.columns:
                 continue
-            sp = special.get(c.get("special_point"), {})
-            drawn.append({"id": c["id"], "type": c.get("type", ""),
-                          "label": labels.get(sp["id"], "") if sp else c.get("name", ""),
-                          "family": families.get(sp.get("branch"), "") if sp else "",
+            sp = special.loc[first["special_point"]] if special is not None and first["special_point"] in special.index else None
+            drawn.append({"id": int(curve_id), "type": first["type"],
+                          "label": sp["label"] if sp is not None else first["name"],
+                          "family": families.get(int(sp["branch"]), "") if sp is not None else "",
                           "p": [_finite(x) for x in frame[parameter]], "H": [_finite(x) for x in frame["H"]]})
         index = pid.split("_")
         index[axis] = "*"

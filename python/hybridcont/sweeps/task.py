@@ -59,15 +59,15 @@ def orbits_near_starts(study, document, previous):
     (a branch of the start's word whose file has every unknown the start gives, the point nearest its H);
     `previous` where the study has none (it failed, or lost the family)."""
     found = dict(previous or {})
-    summary = study.summary
-    main_word = None
-    for b in summary.get("branches") or []:
-        main_word = main_word or b.get("word")
+    branches = study.branches
+    words = [w for w in branches["word"] if isinstance(w, str) and w]
+    main_word = words[0] if words else None  # the study's own word: its first branch's (" > "-joined modes)
     points = study.points
     for i, start in guess_starts(document).items():
-        word = start.get("word") or main_word
+        word = start.get("word")
+        word = " > ".join(word) if isinstance(word, list) else word or main_word
         keys = list(start["values"])
-        ids = [b["id"] for b in summary.get("branches") or [] if b.get("word") == word and b.get("family")]
+        ids = [int(b.id) for b in branches.itertuples() if b.word == word and b.family]
         if points.empty or not ids or not set(keys) <= set(points.columns):
             continue
         rows = points[points.branch.isin(ids) & (points.physical == 1)]

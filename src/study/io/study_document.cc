@@ -170,6 +170,55 @@ StudyModelSource ModelSourceFromSummary(const nlohmann::json& summary, const std
   return source;
 }
 
+// summary.json's "words" and "word_changes" (summary_json.h, WordsJson and WordChangesJson).
+void WordsFromSummary(const nlohmann::json& summary, StudyResult* r) {
+  if (const nlohmann::json* words = FindField(summary, "words")) {
+    if (!words->is_array()) Malformed("words", "expected a list");
+    for (std::size_t i = 0; i < words->size(); ++i) {
+      const std::string where = "words[" + std::to_string(i) + "]";
+      const nlohmann::json& w = (*words)[i];
+      StudyWord word{JsonText(w, "name", where), JsonTexts(w, "word", where), {}};
+      for (const nlohmann::json& id : JsonField(w, "branches", where)) {
+        word.branches.push_back(static_cast<int>(JsonNumberValue(id, where + ".branches[]")));
+      }
+      r->words.push_back(std::move(word));
+    }
+  }
+  const nlohmann::json* changes = FindField(summary, "word_changes");
+  if (changes == nullptr) return;
+  if (!changes->is_array()) Malformed("word_changes", "expected a list");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < changes->size(); ++i) {
+    const std::string where = "word_changes[" + std::to_string(i) + "]";
+    const nlohmann::json& j = (*changes)[i];
+    StudyWordChange c;
+    c.from_word = JsonTexts(j, "from_word", where);
+    c.from_branch = JsonInt(j, "from_branch", where);
+    c.at = JsonText(j, "at", where);
+    c.H = JsonNumber(j, "H", where, nan);
+    if (const nlohmann::json* bracket = FindField(j, "H_bracket")) {
+      if (!bracket->is_array() || bracket->size() != 2) Malformed(where + ".H_bracket", "expected two numbers");
+      c.H_physical = JsonNumberValue((*bracket)[0], where + ".H_bracket[0]");
+      c.H_beyond = JsonNumberValue((*bracket)[1], where + ".H_bracket[1]");
+    }
+    c.detail = JsonText(j, "detail", where, "");
+    c.rule = JsonText(j, "rule", where, "");
+    c.to_word = JsonTexts(j, "to_word", where);
+    c.residual = JsonNumber(j, "residual", where, nan);
+    c.state_difference = JsonNumber(j, "state_difference", where, nan);
+    c.period_difference = JsonNumber(j, "period_difference", where, nan);
+    const nlohmann::json& accepted = JsonField(j, "accepted", where);
+    if (!accepted.is_boolean()) Malformed(where + ".accepted", "expected true or false");
+    c.accepted = accepted.get<bool>();
+    c.reason = JsonText(j, "reason", where, "");
+    if (const nlohmann::json* to = FindField(j, "to_branches")) {
+      if (!to->is_array()) Malformed(where + ".to_branches", "expected a list");
+      for (const nlohmann::json& id : *to) c.to_branches.push_back(static_cast<int>(JsonNumberValue(id, where + ".to_branches[]")));
+    }
+    r->word_changes.push_back(std::move(c));
+  }
+}
+
 }  // namespace
 
 StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::vector<StudyPoint>> points) {
@@ -239,6 +288,12 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
     if (r.message.empty()) r.message = JsonText(*e, "message", "exploration", "");
   }
   r.orbits = OrbitsFromSummary(summary);
+  WordsFromSummary(summary, &r);
+  if (const nlohmann::json* starts = FindField(summary, "starts")) {
+    r.parameter_starts = StudyParameterStarts{JsonInt(*starts, "crossings", "starts"), JsonInt(*starts, "distinct", "starts"),
+                                              JsonInt(*starts, "on_traced_branches", "starts"),
+                                              JsonInt(*starts, "ordinary_half_branches", "starts")};
+  }
   for (StudySpecialPoint& p : r.special_points) {  // named unknowns in the order of the branch's layout
     if (p.branch < 0 || p.branch >= static_cast<int>(r.branches.size()) || p.named_unknowns.size() < 2) continue;
     const std::vector<std::string>& names = r.branches[p.branch].unknown_names;

@@ -116,4 +116,43 @@ nlohmann::json ModelSourceJson(const StudyModelSource& source) {
   return j;
 }
 
+nlohmann::json WordsJson(const std::vector<StudyWord>& words) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const StudyWord& w : words) list.push_back({{"word", w.modes}, {"name", w.name}, {"branches", w.branches}});
+  return list;
+}
+
+nlohmann::json WordChangesJson(const std::vector<StudyWordChange>& changes) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const StudyWordChange& c : changes) {
+    // NaN is written as null (JSON has no NaN): H without a first integral.
+    nlohmann::json j = {{"from_word", c.from_word}, {"from_branch", c.from_branch}, {"at", c.at},
+                        {"H", c.H},                 {"accepted", c.accepted}};
+    if (!std::isnan(c.H_physical)) {  // an end: where it was bracketed, and what lies beyond
+      j["H_bracket"] = {c.H_physical, c.H_beyond};
+      j["detail"] = c.detail;
+    }
+    if (!c.rule.empty()) {
+      j["rule"] = c.rule;
+      j["to_word"] = c.to_word;
+      j["residual"] = c.residual;
+    }
+    if (!c.reason.empty() || !c.accepted) j["reason"] = c.reason;
+    if (!std::isnan(c.state_difference)) {
+      j["state_difference"] = c.state_difference;
+      j["period_difference"] = c.period_difference;
+    }
+    if (!c.to_branches.empty()) j["to_branches"] = c.to_branches;
+    list.push_back(std::move(j));
+  }
+  return list;
+}
+
+nlohmann::json ParameterStartsJson(const StudyParameterStarts& s) {
+  return {{"crossings", s.crossings},
+          {"distinct", s.distinct},
+          {"on_traced_branches", s.on_traced_branches},
+          {"ordinary_half_branches", s.ordinary_half_branches}};
+}
+
 }  // namespace hybridcont::study

@@ -31,6 +31,16 @@ nlohmann::json SpecialPointsJson(const std::vector<StudySpecialPoint>& points);
 //     "special_points": [labels]}]
 nlohmann::json FamiliesJson(const std::vector<StudyFamily>& families);
 
+// An automaton's words and the changes of word considered, summary.json's "words" ([{"word": modes, "name",
+// "branches"}]) and "word_changes" ([{"from_word", "from_branch", "at", "H", and as the change has them: "H_bracket"
+// and "detail" (an end), "rule", "to_word", "residual" (a candidate), "accepted", "reason", "state_difference",
+// "period_difference", "to_branches"}]).
+nlohmann::json WordsJson(const std::vector<StudyWord>& words);
+nlohmann::json WordChangesJson(const std::vector<StudyWordChange>& changes);
+// A free-parameter study's starts, summary.json's "starts": {"crossings", "distinct", "on_traced_branches",
+// "ordinary_half_branches"}.
+nlohmann::json ParameterStartsJson(const StudyParameterStarts& starts);
+
 // The study's model_source (study.h, StudyModelSource): {"kind", "name", "path", "sha256", "text"}, the
 // fields its kind has.
 nlohmann::json ModelSourceJson(const StudyModelSource& source);

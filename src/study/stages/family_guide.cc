@@ -84,8 +84,7 @@ void CheckFamilyNames(const std::string& dir, const HybridModel& model, const St
 // at its special points, the period-doubled families born at its PD points, the families of other words its
 // orbits were handed over to; a branch and its image under a symmetry lead to the images of each other's
 // families. A fixed point of these relations.
-std::vector<bool> LedToFamilies(const StudyResult& saved, const nlohmann::json& summary,
-                                const std::function<bool(const std::string&)>& wanted) {
+std::vector<bool> LedToFamilies(const StudyResult& saved, const std::function<bool(const std::string&)>& wanted) {
   const int n = static_cast<int>(saved.branches.size());
   std::vector<bool> fruitful(n, false);
   for (const StudyBranch& b : saved.branches) fruitful[b.id] = wanted(b.family);
@@ -101,14 +100,10 @@ std::vector<bool> LedToFamilies(const StudyResult& saved, const nlohmann::json& 
     }
     if (b.image_of >= 0 && b.image_of < n) children[b.id].push_back(b.image_of);
   }
-  if (summary.is_object() && summary.contains("word_changes") && summary["word_changes"].is_array()) {
-    for (const nlohmann::json& change : summary["word_changes"]) {
-      if (!change.is_object() || !change.contains("from_branch") || !change["from_branch"].is_number_integer()) continue;
-      const int from = change["from_branch"].get<int>();
-      if (from < 0 || from >= n || !change.contains("to_branches") || !change["to_branches"].is_array()) continue;
-      for (const nlohmann::json& to : change["to_branches"]) {
-        if (to.is_number_integer() && to.get<int>() >= 0 && to.get<int>() < n) children[from].push_back(to.get<int>());
-      }
+  for (const StudyWordChange& change : saved.word_changes) {
+    if (change.from_branch < 0 || change.from_branch >= n) continue;
+    for (const int to : change.to_branches) {
+      if (to >= 0 && to < n) children[change.from_branch].push_back(to);
     }
   }
   for (bool changed = true; changed;) {
@@ -176,7 +171,7 @@ FamilyGuide FamilyGuide::Load(const std::string& dir, const HybridModel& model, 
   const auto wanted = [&](const std::string& family) {
     return !family.empty() && (families.empty() || std::find(families.begin(), families.end(), family) != families.end());
   };
-  const std::vector<bool> fruitful = LedToFamilies(saved, summary, wanted);
+  const std::vector<bool> fruitful = LedToFamilies(saved, wanted);
   FamilyGuide guide;
   guide.dir_ = dir;
   guide.families_ = families;

@@ -1,5 +1,7 @@
 #include "study/stages/word_families.h"
 
+#include "study/io/summary_json.h"
+
 #include <fmt/format.h>
 
 #include <cmath>
@@ -184,12 +186,13 @@ ExplorationOptions WordOptions(const ExplorationOptions& run, const ShootingLayo
 // ones explored in their word, until no family is left to scan (or kMaxWords words).
 class WordExplorer {
  public:
-  WordExplorer(const HybridModel& model, const RunSetup& setup, std::vector<StudySpecialPoint>* special_points, ResultsWriter& writer,
-               const StudyHooks& hooks)
+  WordExplorer(const HybridModel& model, const RunSetup& setup, std::vector<StudySpecialPoint>* special_points,
+               WordRecord* record, ResultsWriter& writer, const StudyHooks& hooks)
       : model_(model), setup_(setup), integrator_(setup.integrator), replay_(ReplayOptionsFor(setup.integrator)),
-        automaton_(*model.automaton()), special_points_(special_points), writer_(writer), hooks_(hooks) {}
+        automaton_(*model.automaton()), special_points_(special_points), words_out_(&record->words),
+        changes_(&record->changes), writer_(writer), hooks_(hooks) {}
 
-  // The report section; the words and changes annotated into the summary.
+  // The report section; the words and changes recorded and annotated into the summary.
   std::string Run(const BifurcationDiagram& diagram) {
     words_.push_back({model_.word(), nullptr, &model_, nullptr, diagram});
     words_.back().exploration = std::make_unique<ModelExploration>(model_, setup_.scenario, integrator_, setup_.exploration);
@@ -201,15 +204,14 @@ class WordExplorer {
       to_scan_.pop_front();
       Scan(entry, scan);
     }
-    nlohmann::json words_json = nlohmann::json::array();
     for (const WordEntry& w : words_) {
-      nlohmann::json ids = nlohmann::json::array();
-      for (const Branch& b : w.branches.branches) ids.push_back(b.id);
-      words_json.push_back({{"word", w.model->WordModeNames()}, {"name", automaton_.WordName(w.word)}, {"branches", ids}});
+      StudyWord word{automaton_.WordName(w.word), w.model->WordModeNames(), {}};
+      for (const Branch& b : w.branches.branches) word.branches.push_back(b.id);
+      words_out_->push_back(std::move(word));
     }
-    writer_.Annotate("words", words_json);
-    writer_.Annotate("word_changes", changes_);
-    if (changes_.empty()) report_ += "  none (no physical family reaches a zero duration or a competing guard)\n";
+    writer_.Annotate("words", WordsJson(*words_out_));
+    writer_.Annotate("word_changes", WordChangesJson(*changes_));
+    if (changes_->empty()) report_ += "  none (no physical family reaches a zero duration or a competing guard)\n";
     if (!word_ranges_.empty()) {
       report_ += "Physical families of the other words (where their orbits are physical and where stable, in H):\n" +
                  word_ranges_;
@@ -224,11 +226,12 @@ class WordExplorer {
   const ReplayOptions replay_;
   const HybridAutomaton& automaton_;
   std::vector<StudySpecialPoint>* special_points_;
+  std::vector<StudyWord>* words_out_;        // the words explored, in the order of words_
+  std::vector<StudyWordChange>* changes_;    // every change considered (summary.json's "word_changes")
   ResultsWriter& writer_;
   const StudyHooks& hooks_;
   std::deque<WordEntry> words_;
   std::deque<std::pair<int, BifurcationDiagram>> to_scan_;  // (word entry, its families still to scan)
-  nlohmann::json changes_ = nlohmann::json::array();        // summary.json's "word_changes"
   std::vector<std::pair<int, Vector>> handled_;             // (word entry, orbit) of the degeneracies seen
   std::string report_ = "Phase-sequence changes (words of the automaton):\n";
   std::string word_ranges_;  // the answer per family of the other words (families.h)
@@ -354,14 +357,16 @@ class WordExplorer {
                              automaton_.WordName(words_[entry].word), at, std::min(e.H_physical, e.H_beyond),
                              std::max(e.H_physical, e.H_beyond), e.branch, std::min(e.index_physical, e.index_beyond),
                              std::max(e.index_physical, e.index_beyond), e.beyond.detail, EndReason(e.beyond.reason));
-      changes_.push_back({{"from_word", word_model.WordModeNames()},
-                          {"from_branch", e.branch},
-                          {"at", at},
-                          {"H", 0.5 * (e.H_physical + e.H_beyond)},
-                          {"H_bracket", {e.H_physical, e.H_beyond}},
-                          {"detail", e.beyond.detail},
-                          {"accepted", false},
-                          {"reason", EndReason(e.beyond.reason)}});
+      StudyWordChange end;
+      end.from_word = word_model.WordModeNames();
+      end.from_branch = e.branch;
+      end.at = at;
+      end.H = 0.5 * (e.H_physical + e.H_beyond);
+      end.H_physical = e.H_physical;
+      end.H_beyond = e.H_beyond;
+      end.detail = e.beyond.detail;
+      end.reason = EndReason(e.beyond.reason);
+      changes_->push_back(std::move(end));
     }
     for (const Degeneracy& g : found) {
       if (!Seen(entry, g.u)) Follow(entry, g);
@@ -382,37 +387,43 @@ class WordExplorer {
     report_ += fmt::format("  word {}: {} at H = {:.10f} ({}):\n", automaton_.WordName(words_[entry].word), kind, H, g.where);
     if (candidates.empty()) {
       report_ += "    refused: " + why + "\n";
-      changes_.push_back({{"from_word", word_model.WordModeNames()}, {"from_branch", g.branch}, {"at", kind},
-                          {"H", H}, {"accepted", false}, {"reason", why}});
+      StudyWordChange none;
+      none.from_word = word_model.WordModeNames();
+      none.from_branch = g.branch;
+      none.at = kind;
+      none.H = H;
+      none.reason = why;
+      changes_->push_back(std::move(none));
       return;
     }
     for (const WordChange& c : candidates) {
-      nlohmann::json j = {{"from_word", word_model.WordModeNames()},
-                          {"from_branch", g.branch},
-                          {"at", kind},
-                          {"H", H},
-                          {"rule", c.rule},
-                          {"to_word", automaton_.ModeNames(c.word)},
-                          {"residual", c.residual},
-                          {"accepted", c.accepted}};
+      StudyWordChange change;
+      change.from_word = word_model.WordModeNames();
+      change.from_branch = g.branch;
+      change.at = kind;
+      change.H = H;
+      change.rule = c.rule;
+      change.to_word = automaton_.ModeNames(c.word);
+      change.residual = c.residual;
+      change.accepted = c.accepted;
       if (!c.accepted) {
-        j["reason"] = c.reason;
+        change.reason = c.reason;
         report_ += fmt::format("    {}: refused, {}\n", c.rule, c.reason);
       } else {
-        Take(c, &j);
+        Take(c, &change);
       }
-      changes_.push_back(j);
+      changes_->push_back(std::move(change));
     }
   }
 
   // An accepted change: the orbit on a branch of its word traced already (the connection), or its family
-  // explored in its word (a word entry made for it), unless that cannot be. Completes the change's record j.
-  void Take(const WordChange& c, nlohmann::json* j) {
-    (*j)["state_difference"] = c.state_difference;
-    (*j)["period_difference"] = c.period_difference;
-    const int id = static_cast<int>(changes_.size());
+  // explored in its word (a word entry made for it), unless that cannot be. Completes the change's record.
+  void Take(const WordChange& c, StudyWordChange* change) {
+    change->state_difference = c.state_difference;
+    change->period_difference = c.period_difference;
+    const int id = static_cast<int>(changes_->size());
     const auto refuse = [&](const std::string& reason) {
-      (*j)["reason"] = reason;
+      change->reason = reason;
       report_ += fmt::format("    {}: {}\n", c.rule, reason);
     };
     int target = -1;  // the word's entry, or a new one
@@ -422,7 +433,7 @@ class WordExplorer {
     if (target >= 0) {
       const int through = words_[target].exploration->BranchThrough(words_[target].branches, c.u);
       if (through >= 0) {
-        (*j)["to_branches"] = {through};
+        change->to_branches = {through};
         report_ += fmt::format("    {}: the orbit continues on branch {} of word {} (already traced); same orbit to "
                                "{:.1e} (state at the section), {:.1e} (period)\n",
                                c.rule, through, automaton_.WordName(c.word), c.state_difference, c.period_difference);
@@ -430,7 +441,7 @@ class WordExplorer {
       }
     }
     if (c.singular) {
-      (*j)["accepted"] = false;
+      change->accepted = false;
       return refuse("the orbit is a singular point (a branch point) of the new word's map, on no branch of it traced "
                     "so far: not followed from there");
     }
@@ -440,12 +451,10 @@ class WordExplorer {
     Say(fmt::format("word {} from {}:", automaton_.WordName(c.word), c.rule));
     BifurcationDiagram d = Explore(target, c.u);
     if (d.status == ExplorationStatus::kStartFailed) return refuse("not explored: " + d.message);
-    nlohmann::json ids = nlohmann::json::array();
     for (const Branch& b : d.branches) {
       writer_.AnnotateBranch(b.id, {{"handed_over_from", id}});
-      ids.push_back(b.id);
+      change->to_branches.push_back(b.id);
     }
-    (*j)["to_branches"] = ids;
     report_ += fmt::format("    {}: accepted, same orbit to {:.1e} (state at the section), {:.1e} (period); word {}: "
                            "{} branches ({} to {}), {} special points\n",
                            c.rule, c.state_difference, c.period_difference, automaton_.WordName(c.word),
@@ -458,7 +467,8 @@ class WordExplorer {
 }  // namespace
 
 std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
-                               std::vector<StudySpecialPoint>* special_points, ResultsWriter& writer, const StudyHooks& hooks) {
+                               std::vector<StudySpecialPoint>* special_points, WordRecord* record,
+                               ResultsWriter& writer, const StudyHooks& hooks) {
   if (!model.automaton()) return "";
   const std::string heading = "Phase-sequence changes (words of the automaton):\n";
   if (!setup.free.empty()) return heading + "  not followed in a run with free parameters\n";
@@ -466,7 +476,7 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
     return heading + "  not followed in a run with observables among the unknowns (--until, --bound or --fix on an "
                      "observable)\n";
   }
-  return WordExplorer(model, setup, special_points, writer, hooks).Run(diagram);
+  return WordExplorer(model, setup, special_points, record, writer, hooks).Run(diagram);
 }
 
 }  // namespace hybridcont::study

@@ -7,16 +7,16 @@
 // directions: RunFromStarts), unless the orbit lies on a branch already traced in that word, which is then
 // recorded as the connection and not traced again. The new word's families are scanned in turn, up to
 // kMaxWords words. Branch and special-point ids continue the run's; each branch's summary entry says its
-// "word" (ResultsWriter), each explored family "handed_over_from" (the change's index), and summary.json's
-// "word_changes" lists every change considered: where, the rule, accepted or refused with the reason, the
+// "word" (ResultsWriter), each explored family "handed_over_from" (the change's index), and the record
+// (StudyResult::word_changes, summary.json's "word_changes") lists every change considered: where, the rule, accepted or refused with the reason, the
 // new word's orbit compared with the old (state at the section and period), and the branches it leads to.
-//   std::string report = ExploreWordChanges(model, setup, diagram, &special_points, writer, hooks);
+//   std::string report = ExploreWordChanges(model, setup, diagram, &special_points, &record, writer, hooks);
 #ifndef HYBRIDCONT_STUDY_WORD_FAMILIES_H_
 #define HYBRIDCONT_STUDY_WORD_FAMILIES_H_
 
-#include <nlohmann/json.hpp>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "hybridcont/exploration.h"
 #include "hybridcont/model.h"
@@ -29,12 +29,19 @@ namespace hybridcont::study {
 // diagram's hand-overs are few.
 inline constexpr int kMaxWords = 8;
 
+// What the stage records of the words (study.h): the words explored and every change of word considered.
+struct WordRecord {
+  std::vector<StudyWord> words;
+  std::vector<StudyWordChange> changes;
+};
+
 // `diagram` and `special_points` are the run's (time-based layout of `model`, a word of an automaton).
-// Appends the new families' special points to special_points, writes their branches through `writer` and
-// annotates summary.json; returns the report section ("" for a model without an automaton).
+// Appends the new families' special points to special_points, the words and changes to `record`, writes their
+// branches through `writer` and annotates summary.json; returns the report section ("" for a model without an
+// automaton).
 std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
-                               std::vector<StudySpecialPoint>* special_points, ResultsWriter& writer,
-                               const StudyHooks& hooks);
+                               std::vector<StudySpecialPoint>* special_points, WordRecord* record,
+                               ResultsWriter& writer, const StudyHooks& hooks);
 
 }  // namespace hybridcont::study
 
