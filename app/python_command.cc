@@ -1,7 +1,9 @@
 #include "python_command.h"
 
-#include <spawn.h>
+#include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstdlib>
@@ -46,11 +48,21 @@ int RunPythonModule(const std::string& module, const std::vector<std::string>& a
   argv.push_back(nullptr);
   for (std::string& e : environment) envp.push_back(e.data());
   envp.push_back(nullptr);
-  pid_t pid = 0;
-  const int spawned = posix_spawnp(&pid, python.c_str(), nullptr, nullptr, argv.data(), envp.data());
-  if (spawned != 0) {
-    err << "error: cannot start " << python << ": " << std::strerror(spawned) << "\n";
+  // A child that ends with this process: killed or interrupted, the command takes its Python process (and, through
+  // it, the sweep's workers) down with it (PR_SET_PDEATHSIG), instead of leaving it computing unseen.
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid < 0) {
+    err << "error: cannot start " << python << ": " << std::strerror(errno) << "\n";
     return 127;
+  }
+  if (pid == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(128 + SIGTERM);  // the parent ended before the request took effect
+    execvpe(python.c_str(), argv.data(), envp.data());
+    const std::string message = "error: cannot start " + python + ": " + std::strerror(errno) + "\n";
+    [[maybe_unused]] const ssize_t written = write(STDERR_FILENO, message.data(), message.size());
+    _exit(127);
   }
   int status = 0;
   pid_t waited;

@@ -8,6 +8,8 @@
 // files the line), exit code 2, nothing written; a numerical failure → exit 1 with a status in the result.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/mount.h>
@@ -377,6 +379,8 @@ const std::vector<BadInputCase>& Cases() {
       {"UntilTwice", Run("slip", {"--until", "H=1", "--until", "H=1.5"}), 2, "--until 'H=1.5': 'H' is given twice"},
       {"BoundTwice", Run("slip", {"--bound", "H=0:1", "--bound", "H=0:2"}), 2, "--bound 'H=0:2': 'H' is given twice"},
       {"MonitorValueTwice", Run("slip.toml", {"--monitor", "apex=1.2,1.2"}), 2, "--monitor 'apex=1.2': is given twice"},
+      {"UntilFarBeyondTheBound", Run("slip", {"--until", "H=1e300"}), 2,
+       "--until 'H=1e+300' lies 1e+300 beyond the model's bound [0, 2] of H, more than 100 times its width"},
       {"UntilOutsideBound", Run("slip", {"--until", "H=2", "--bound", "H=0:1"}), 2, "--until 'H=2' lies outside --bound 'H=0:1'"},
       {"FormulationFoo", Run("slip", {"--formulation", "foo"}), 2, "--formulation 'foo': expected 'time' or 'state'"},
       {"FormulationUpperCase", Run("slip", {"--formulation", "TIME"}), 2, "--formulation 'TIME'"},
@@ -597,6 +601,22 @@ const std::vector<BadInputCase>& Cases() {
       {"BoundReversedInTheFile", Cli({"run", "m.toml", "--quiet", "--no-plots"}), 2,
        "m.toml:34: run.bounds.H: the lower end 1 is not below the upper end -1", BallFile("m.toml", "H = [-1, 1]", "H = [1, -1]")},
       // a phase's let named like a definition would hide it in that phase only
+      // definitions and let quantities each using the next, 1,200 deep (named so that the first read uses the
+      // second): refused naming the limit and the chain (10,001 overflowed the stack while they were resolved)
+      {"LetChainTooDeep", Cli({"list", "m.toml"}), 2,
+       "more than 1000 deep: 'q0000' uses 'q0001' uses 'q0002' uses ... (995 more) uses", File("m.toml", [] {
+         std::string lets = "let.q1199 = \"dy\"\n";
+         for (int i = 0; i < 1199; ++i) lets += fmt::format("let.q{:04d} = \"q{:04d} + 1\"\n", i, i + 1);
+         return Replace(Ball(), "ode = { y = \"dy\", dy = \"-g\" }",
+                        lets + "ode = { y = \"dy\", dy = \"-g + 0*q0000\" }");
+       })},
+      {"DefinitionChainTooDeep", Cli({"list", "m.toml"}), 2,
+       "definitions and let quantities that use one another more than 1000 deep: 'd0000' uses", File("m.toml", [] {
+         std::string definitions = "[definitions]\nd1199 = \"g\"\n";
+         for (int i = 0; i < 1199; ++i) definitions += fmt::format("d{:04d} = \"d{:04d} + 1\"\n", i, i + 1);
+         return Replace(Replace(Ball(), "[[phases]]", definitions + "\n[[phases]]"), "dy = \"-g\" }",
+                        "dy = \"-g + 0*d0000\" }");
+       })},
       {"LetShadowsADefinition", Cli({"check", "m.toml"}), 2,
        "phases.flight.let.gg: 'gg' is also a definition ([definitions]); name it otherwise", File("m.toml", [] {
          return Replace(Replace(Ball(), "[[phases]]", "[definitions]\ngg = \"2*g\"\n\n[[phases]]"),
@@ -718,6 +738,27 @@ TEST(BadInputTable, DISABLED_WriteMarkdown) {
          << "` → exit " << c.exit_code << (message.empty() ? "" : ": `" + message + "`") << "\n";
     }
   }
+  // What a row of one command cannot show: a state made by an earlier command, a process killed. Each has its test.
+  md << "\n## Cases of more than one command\n\n"
+     << "- **A run into the study it reads** (`run slip --from results/slip --at PD4`, its default `--out` being "
+        "`results/slip`; `--families-of` the same folder): exit 2, `--out 'results/slip': is the study read by "
+        "--from, which this one would replace; name another folder for its results`; the study is kept "
+        "(`Cli.ARunNeverReplacesTheStudyItReadsNorWaitsOnAFifo`).\n"
+     << "- **A FIFO named summary.json** in the folder restarted from, or in `--out`: refused before it is opened "
+        "(`summary.json: not a regular file`, or `holds a summary.json that is not the results of a hybridcont "
+        "run`), exit 2, never a blocked process (same test).\n"
+     << "- **A resume store changed after it was written** (one stored point moved by 1e-3): exit 2, `--resume "
+        "'.../.resume/branch-2.json: the stored branch does not match its digest ...; remove .../.resume to run the "
+        "study afresh`; nothing written (`Study.ResumeRefusesAStoredBranchThatChanged`).\n"
+     << "- **`sweep --overwrite` over a folder with the user's own files**: only what a sweep writes (sweep.json, "
+        "points/, table.csv, sweep-report.html, map-*/plane-* figures) is removed "
+        "(`test_overwrite_replaces_what_a_sweep_wrote_and_keeps_the_users_files`).\n"
+     << "- **`sweep --grid k=1:2:100000000`**: exit 2, `grid: 100,000,000 grid points (k: 100000000), each a whole "
+        "study: more than 10000; a mistyped count? (max_grid_points=N, --max-grid-points N, lifts the limit)`; "
+        "`--grid k` given twice and `--workers` below 1 refused too "
+        "(`test_the_tool_runs_a_sweep_and_refuses_a_bad_grid`).\n"
+     << "- **`hybridcont sweep` killed**: its Python process gets SIGTERM (it was started with PR_SET_PDEATHSIG) "
+        "and ends the sweep as Ctrl-C does, closing its workers; the grid points finished are kept for `--resume`.\n";
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The command-line tool as a user meets it: exit codes, messages, files.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <cmath>
@@ -145,6 +146,43 @@ TEST(Cli, RunTakesEveryDeclaredOptionAndSaysOptionsAsFlags) {
   EXPECT_EQ(curves.code, 2);
   EXPECT_NE(curves.err.find("--curves 'w2': not with --free"), std::string::npos) << curves.err;
   fs::remove_all(TempDir("note_words"));
+}
+
+// A run never replaces a study it reads (the folder restarted from, the guide's), and a FIFO where a results
+// folder's file belongs is refused, never opened (opening it would block until someone writes it).
+TEST(Cli, ARunNeverReplacesTheStudyItReadsNorWaitsOnAFifo) {
+  const fs::path saved = TempDir("read_saved"), fifo_folder = TempDir("read_fifo");
+  ASSERT_EQ(RunTool({"run", "slip", "--quiet", "--out", saved.string()}).code, 0);
+  const std::string before = [&] {
+    std::ifstream f(saved / "summary.json");
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  }();
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"run", "slip", "--from", saved.string(), "--at", "PD4", "--out", saved.string()},
+        std::vector<std::string>{"run", "slip", "--from", (saved / ".." / saved.filename()).string(), "--at", "PD4",
+                                 "--out", saved.string()},
+        std::vector<std::string>{"run", "slip", "--families-of", saved.string(), "--out", saved.string()}}) {
+    const CliResult r = RunTool(args);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("is the study read by --"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("which this one would replace; name another folder for its results"), std::string::npos);
+  }
+  std::ifstream f(saved / "summary.json");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(f), {}), before);  // the study read is kept
+  fs::create_directories(fifo_folder);
+  ASSERT_EQ(mkfifo((fifo_folder / "summary.json").c_str(), 0600), 0);
+  const CliResult restart = RunTool({"run", "slip", "--from", fifo_folder.string(), "--at", "PD4", "--out",
+                                     TempDir("read_fifo_out").string()});
+  EXPECT_EQ(restart.code, 2);
+  EXPECT_NE(restart.err.find("summary.json: not a regular file"), std::string::npos) << restart.err;
+  const CliResult into = RunTool({"run", "slip", "--quiet", "--out", fifo_folder.string()});
+  EXPECT_EQ(into.code, 2);
+  EXPECT_NE(into.err.find("holds a summary.json that is not the results of a hybridcont run"), std::string::npos)
+      << into.err;
+  const CliResult plot = RunTool({"plot", fifo_folder.string()});
+  EXPECT_NE(plot.code, 0);
+  fs::remove_all(saved);
+  fs::remove_all(fifo_folder);
 }
 
 TEST(Cli, RunBouncingBallWritesClassifiedBranchesThatMatchTheClosedForm) {

@@ -770,7 +770,7 @@ TEST(Study, ResumeRefusesOtherOptions) {
   }
   EXPECT_EQ(Contents(dir / "summary.json"), before);
   // A damaged stored branch is named.
-  std::ofstream(dir / ".resume" / "branch-0.json") << "{\"format\": 1, \"branch\": {\"id\": \"x\"}}";
+  std::ofstream(dir / ".resume" / "branch-0.json") << "{\"format\": 2, \"branch\": {\"id\": \"x\"}}";
   o.until.clear();
   try {
     RunStudy(o);
@@ -809,6 +809,38 @@ TEST(Study, ResumeTakesOnlyTheBranchesItGaveBefore) {
     }
   }
   for (const fs::path& d : {dir, reference}) fs::remove_all(d);
+}
+
+// A stored branch whose content changed after it was stored (one point moved by 1e-3) is refused with the file's
+// name: never resumed from, so never a study whose files are off by the change.
+TEST(Study, ResumeRefusesAStoredBranchThatChanged) {
+  const fs::path dir = Scratch("resume_moved");
+  std::atomic<int> points{0};
+  StudyHooks stop;
+  stop.on_point = [&](const StudyPoint&, const StudyBranch&) { ++points; };
+  stop.stop_requested = [&] { return points.load() >= 200; };
+  StudyOptions o = Slip();
+  o.out_dir = dir.string();
+  RunStudy(o, stop);
+  const fs::path stored = dir / ".resume" / "branch-2.json";
+  ASSERT_TRUE(fs::exists(stored));
+  nlohmann::json j = nlohmann::json::parse(Contents(stored));
+  nlohmann::json& u = j["branch"]["points"][3]["u"];
+  ASSERT_TRUE(u.is_array());
+  u[0] = u[0].get<double>() + 1e-3;
+  std::ofstream(stored) << j.dump();
+  const std::string before = Contents(dir / "summary.json");
+  o.resume = true;
+  try {
+    RunStudy(o);
+    ADD_FAILURE() << "resumed from a stored branch that changed";
+  } catch (const StudyOptionError& e) {
+    EXPECT_EQ(e.field(), "resume");
+    EXPECT_NE(std::string(e.what()).find("branch-2.json: the stored branch does not match its digest"),
+              std::string::npos) << e.what();
+  }
+  EXPECT_EQ(Contents(dir / "summary.json"), before);  // nothing written
+  fs::remove_all(dir);
 }
 
 // A stop while the period-doubled families are explored ends the study as cancelled, resumable.

@@ -350,7 +350,12 @@ py::dict Trace(const ModelHandle& model, const std::vector<double>& u, int sampl
     throw std::invalid_argument("u has " + std::to_string(u.size()) + " entries; the orbit's unknowns (the model's own "
                                 "layout, no free parameters) are " + std::to_string(expected));
   }
-  if (samples < 2) throw std::invalid_argument("samples must be at least 2, got " + std::to_string(samples));
+  // A sample is a row of Python objects (~1 kB with its states): a million is a fine curve; more is a mistake.
+  constexpr int kMaxSamples = 1000000;
+  if (samples < 2 || samples > kMaxSamples) {
+    throw std::invalid_argument("samples must lie in [2, " + std::to_string(kMaxSamples) + "], got " +
+                                std::to_string(samples));
+  }
   std::unique_ptr<OrbitTrace> trace;
   {
     py::gil_scoped_release release;
@@ -870,6 +875,9 @@ PYBIND11_MODULE(_hybridcont, m) {
       if (p) std::rethrow_exception(p);
     } catch (const StudyOptionError& e) {
       PyErr_SetString(PyExc_ValueError, e.Say(OptionKeyword).c_str());
+    } catch (const py::cast_error& e) {
+      // An argument of another type than the function takes (a string where a number belongs): bad input.
+      PyErr_SetString(PyExc_ValueError, (std::string("an argument of the wrong type: ") + e.what()).c_str());
     }
   });
   BindModels(m);

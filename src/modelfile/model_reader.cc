@@ -192,13 +192,32 @@ ExprPtr Reader::Definition(const std::string& name) {
   if (!resolving_.insert("definitions." + name).second) {
     Fail(src->second, "definitions." + name, "'" + name + "' is defined in terms of itself");
   }
+  BeginResolving(src->second, "definitions." + name, name);
   const ExprPtr e = ParseExpression(ExpressionText(*src->second, "definitions." + name),
                                     [this](const std::string& s) { return GlobalSymbol(s); },
                                     At(src->second, "definitions." + name));
   if (DependsOnInputs(e)) Fail(src->second, "definitions." + name, "definitions may use parameters only");
   resolving_.erase("definitions." + name);
+  resolving_chain_.pop_back();
   definitions_[name] = e;
   return e;
+}
+
+void Reader::BeginResolving(const toml::node* n, const std::string& field, const std::string& name) {
+  if (resolving_chain_.size() >= kMaxSymbolNesting) {
+    std::string chain;
+    for (std::size_t i = 0; i < resolving_chain_.size(); ++i) {
+      if (i == 3 && resolving_chain_.size() > 5) {
+        chain += " uses ... (" + std::to_string(resolving_chain_.size() - 5) + " more)";
+        i = resolving_chain_.size() - 2;
+      }
+      chain += (i == 0 ? "'" : " uses '") + resolving_chain_[i] + "'";
+    }
+    Fail(n, field, "definitions and let quantities that use one another more than " +
+                       std::to_string(kMaxSymbolNesting) + " deep: " + chain + " uses '" + name +
+                       "'; a chain that long is refused (resolving it recurses that deep)");
+  }
+  resolving_chain_.push_back(name);
 }
 
 ExprPtr Reader::PhaseSymbol(int phase, const std::string& name) {
@@ -228,10 +247,12 @@ ExprPtr Reader::PhaseSymbol(int phase, const std::string& name) {
       const std::string field = (let == transition_let ? TransitionField(phase) : "phases." + spec_.phases[phase].name) +
                                 ".let." + name;
       if (!resolving_.insert(field).second) Fail(n, field, "'" + name + "' is defined in terms of itself");
+      BeginResolving(n, field, name);
       const ExprPtr e = ParseExpression(ExpressionText(*n, field),
                                         [this, phase](const std::string& s) { return PhaseSymbol(phase, s); },
                                         At(n, field));
       resolving_.erase(field);
+      resolving_chain_.pop_back();
       lets_[key] = e;
       return e;
     }

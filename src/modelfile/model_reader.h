@@ -66,6 +66,9 @@ class Reader {
   ExprPtr Definition(const std::string& name);
   // A phase's states, its `let` quantities, then the global symbols.
   ExprPtr PhaseSymbol(int phase, const std::string& name);
+  // A definition or let quantity `name` (at node n, field) begins to be resolved: refused, naming the chain, when
+  // the definitions and quantities being resolved already use one another kMaxSymbolNesting deep.
+  void BeginResolving(const toml::node* n, const std::string& field, const std::string& name);
   ExprPtr ParsePhaseExpression(int phase, const toml::node& n, const std::string& field);
   // Checks a set-up value against its symbols now, so that a typo is reported before anything runs.
   void CheckSetupValue(const SetupValue& v, const std::vector<std::string>& extra_symbols);
@@ -203,6 +206,11 @@ class Reader {
   std::map<std::string, ExprPtr> definitions_;
   std::map<std::string, ExprPtr> lets_;
   std::set<std::string> resolving_;
+  // The definitions and let quantities being resolved, each using the next (resolving recurses through them).
+  std::vector<std::string> resolving_chain_;
+  // The longest such chain: each level is a nested parse (about a kilobyte of stack), so a hostile file's chain
+  // of 10,000 would overflow it; a model's real chains are a few dozen long.
+  static constexpr std::size_t kMaxSymbolNesting = 1000;
   std::vector<const toml::table*> phase_tables_;
   std::vector<const toml::table*> phase_lets_;
   // An automaton: per catalogue phase its transition's table and let, the phase it resets into.

@@ -277,7 +277,7 @@ void Reader::ReadRun() {
   }
   run.max_branches = OptionalInteger(*t, "max_branches", "run", run.max_branches, 1, 100000);
   run.max_depth = OptionalInteger(*t, "max_depth", "run", run.max_depth, 0, 100);
-  run.max_points = OptionalInteger(*t, "max_points", "run", run.max_points, 2, 1000000);
+  run.max_points = OptionalInteger(*t, "max_points", "run", run.max_points, 2, 100000);
   run.initial_step = OptionalNumber(*t, "initial_step", "run", run.initial_step);
   run.max_step = OptionalNumber(*t, "max_step", "run", run.max_step);
   if (!(run.initial_step > 0)) Fail(t->get("initial_step"), "run.initial_step", "must be positive");

@@ -591,8 +591,29 @@ std::unique_ptr<HybridModel> BuildModel(const StudyOptions& options, const Hybri
   return model;
 }
 
+// Whether two folder names name the same folder (neither need exist).
+bool SameFolder(const std::string& a, const std::string& b) {
+  std::error_code ec_a, ec_b;
+  const std::filesystem::path x = std::filesystem::weakly_canonical(a, ec_a), y = std::filesystem::weakly_canonical(b, ec_b);
+  return !ec_a && !ec_b && x == y;
+}
+
+// A study never writes over a study it reads: the folder restarted from, the one whose families guide it.
+void CheckFoldersRead(const StudyOptions& options) {
+  if (options.out_dir.empty()) return;
+  const auto refuse = [&](const std::string& field) {
+    throw StudyOptionError("out_dir", -1, "'" + options.out_dir + "': is the study read by " + MentionOption(field) +
+                           ", which this one would replace; name another folder for its results");
+  };
+  if (options.restart && !options.restart->study && SameFolder(options.restart->from, options.out_dir)) {
+    refuse("restart.from");
+  }
+  if (!options.families_of.empty() && SameFolder(options.families_of, options.out_dir)) refuse("families_of");
+}
+
 // Options that contradict each other, whatever the model.
 void CheckOptionPairs(const StudyOptions& options) {
+  CheckFoldersRead(options);
   if (options.resume && options.out_dir.empty()) {
     throw StudyOptionError("resume", -1, ": needs the results folder to resume in (" + MentionOption("out_dir") + ")");
   }

@@ -141,6 +141,21 @@ def test_the_tool_runs_a_sweep_and_refuses_a_bad_grid(tmp_path):
                               capture_output=True, text=True)
         assert proc.returncode == 2 and said in proc.stderr, (bad, proc.stderr)
         assert not os.path.exists(tmp_path / "nan")
+    # Requests that cannot finish, refused before anything runs: a grid of a hundred million studies, a grid
+    # parameter given twice, no worker process.
+    for bad, said in ((["--grid", "k=1:2:100000000"], "grid: 100,000,000 grid points (k: 100000000), each a whole "
+                                                      "study: more than 10000"),
+                      (["--grid", "k=20:40:2", "--grid", "k=1:2:2"], "--grid k: given twice"),
+                      (["--grid", "k=20:40:2", "--workers", "-1"], "argument --workers: '-1': at least 1"),
+                      (["--grid", "k=20:40:2", "--workers", "0"], "argument --workers: '0': at least 1")):
+        proc = subprocess.run([tool, "sweep", "slip", *bad, "--out", str(tmp_path / "big")], capture_output=True,
+                              text=True, timeout=60)
+        assert proc.returncode == 2 and said in proc.stderr, (bad, proc.stderr)
+        assert not os.path.exists(tmp_path / "big")
+    with pytest.raises(ValueError, match="more than 3; a mistyped count"):
+        hc.sweep("slip", {"k": (20, 40, 2), "w2": (4, 5, 2)}, str(tmp_path / "big"), max_grid_points=3)
+    with pytest.raises(ValueError, match="workers 0: a whole number of processes, at least 1"):
+        hc.sweep("slip", {"k": (20, 40, 2)}, str(tmp_path / "big"), workers=0)
     # Families in a free parameter at each grid point: explored whole (a guide continues families in H), said.
     out = str(tmp_path / "free")
     proc = subprocess.run([tool, "sweep", "slip", "--grid", "w2=5:6:2", "--free", "k", "--fix", "H=1.5", "--workers",
@@ -331,3 +346,64 @@ def test_damaged_sweep_files_are_named_and_a_resume_refuses_them(tmp_path):
     proc = subprocess.run(args + ["--resume"], capture_output=True, text=True)
     assert proc.returncode == 2 and "sweep.json" in proc.stderr, proc.stderr
     assert subprocess.run(args + ["--overwrite"], capture_output=True, text=True).returncode == 0  # replaced whole
+
+
+def test_overwrite_replaces_what_a_sweep_wrote_and_keeps_the_users_files(tmp_path):
+    from hybridcont.sweeps import run as sweep_run
+    out = tmp_path / "sweep"
+    (out / "points" / "0_0").mkdir(parents=True)
+    for name in ("sweep.json", "table.csv", "sweep-report.html", "map-hopping.png", "plane-a.svg"):
+        (out / name).write_text("{}")
+    (out / "points" / "0_0" / "rows.json").write_text("[]")
+    (out / "notes.txt").write_text("the user's own notes")
+    (out / "mine").mkdir()
+    (out / "mine" / "data.csv").write_text("1,2\n")
+    definition = {"format": 1, "model": "slip", "grid": {"k": [20.0]}, "options": {}}
+    sweep_run._prepare_folder(str(out), definition, "explore", [("0", {"k": 20.0})], None, resume=False,
+                              overwrite=True)
+    assert sorted(os.listdir(out)) == ["mine", "notes.txt", "points", "sweep.json"]
+    assert os.listdir(out / "points") == [] and (out / "notes.txt").read_text() == "the user's own notes"
+    assert (out / "mine" / "data.csv").exists() and json.loads((out / "sweep.json").read_text()) == definition
+
+
+
+def _children(pid):
+    """The live processes whose parent is `pid` (zombies count as gone)."""
+    out = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open("/proc/%s/stat" % entry) as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid and fields[0] != "Z":
+            out.append(int(entry))
+    return out
+
+
+def _alive(pid):
+    try:
+        with open("/proc/%d/stat" % pid) as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def test_killing_the_sweep_command_takes_its_python_process_down(tmp_path):
+    tool = os.environ.get("HYBRIDCONT_BIN", "build/hybridcont")
+    proc = subprocess.Popen([tool, "sweep", "slip", "--grid", "k=20:40:8", "--workers", "1", "--quiet", "--no-maps",
+                             "--out", str(tmp_path / "killed")], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + 60
+    while time.time() < deadline and not _children(proc.pid):
+        time.sleep(0.2)
+    python = _children(proc.pid)
+    assert python, "the sweep command started no Python process"
+    time.sleep(2)  # the sweep under way
+    proc.kill()
+    proc.wait()
+    deadline = time.time() + 60
+    while time.time() < deadline and any(_alive(p) for p in python):
+        time.sleep(0.2)
+    assert not any(_alive(p) for p in python), "the Python process outlived the killed command"

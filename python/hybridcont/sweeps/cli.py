@@ -6,7 +6,18 @@ import sys
 
 import numpy as np
 
+from .grid import MAX_GRID_POINTS
 from .run import sweep
+
+
+def _positive_count(text):
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError("'%s' is not a whole number" % text)
+    if value < 1:
+        raise argparse.ArgumentTypeError("'%s': at least 1" % text)
+    return value
 
 
 def _parse_grid(text):
@@ -66,7 +77,10 @@ def main(argv=None):
     p.add_argument("--grid", action="append", required=True, type=_parse_grid, help="NAME=START:STOP:COUNT")
     p.add_argument("--out", help="the sweep's folder (default results/MODEL-sweep)")
     p.add_argument("--scheduler", help="a Dask scheduler's address, tcp://HOST:PORT (default: a local cluster)")
-    p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    p.add_argument("--workers", type=_positive_count, help="local worker processes (default: one per core)")
+    p.add_argument("--max-grid-points", type=_positive_count, default=MAX_GRID_POINTS,
+                   help="the most grid points the sweep computes, each a whole study (default %d): a larger grid "
+                        "is refused before anything runs" % MAX_GRID_POINTS)
     p.add_argument("--resume", action="store_true")
     p.add_argument("--overwrite", action="store_true")
     p.add_argument("--quiet", action="store_true")
@@ -81,6 +95,15 @@ def main(argv=None):
                                     "families' special points in (H, P); the report draws them over the ranges")
     _add_study_options(p)
     args = p.parse_args(argv)
+    import signal  # a SIGTERM (the `hybridcont sweep` command killed) ends the sweep as Ctrl-C does: workers closed
+
+    def _terminate(signum, frame):
+        raise KeyboardInterrupt
+    signal.signal(signal.SIGTERM, _terminate)
+    names = [name for name, _ in args.grid]
+    for name in names:
+        if names.count(name) > 1:
+            p.error("--grid %s: given twice; give each grid parameter once" % name)
     import warnings  # the command line says the sweep's warnings as notes, without Python's file and line
     warnings.showwarning = lambda message, *rest, **named: print("note: %s" % message, file=sys.stderr)
     options = _study_keywords(args, p)
@@ -89,10 +112,14 @@ def main(argv=None):
         table = sweep(args.model, dict(args.grid), out, scheduler=args.scheduler, workers=args.workers,
                       resume=args.resume, overwrite=args.overwrite, progress=not args.quiet,
                       maps=not args.no_maps, strategy=args.strategy, curves=args.curves, families=args.families,
-                      **options)
+                      max_grid_points=args.max_grid_points, **options)
     except ValueError as e:
         print("error: %s" % e, file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("error: interrupted; the grid points finished are kept in %s; --resume continues the sweep"
+              % os.path.abspath(out), file=sys.stderr)
+        return 130
     except (RuntimeError, OSError) as e:  # a grid point's study stopped or not written (a full disk)
         print("error: %s\nthe grid points finished are kept in %s; --resume continues the sweep"
               % (e, os.path.abspath(out)), file=sys.stderr)

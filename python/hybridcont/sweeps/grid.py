@@ -10,20 +10,41 @@ import numpy as np
 SWEEP_FORMAT = 1
 
 
-def grid_values(spec):
-    """{name: (start, stop, count)} or {name: [values]} as {name: [values]} (linspace for a triple)."""
+# Grid points a sweep computes at most unless told otherwise (each is a whole study): a larger grid is most often
+# a mistyped count, and its table, folders and tasks would fill the machine before anything was said.
+MAX_GRID_POINTS = 10000
+
+
+def grid_values(spec, max_grid_points=MAX_GRID_POINTS):
+    """{name: (start, stop, count)} or {name: [values]} as {name: [values]} (linspace for a triple). Values must be
+    finite, counts whole and positive, and the grid at most ``max_grid_points`` points (None: no limit)."""
+    sizes = {}
+    for name, values in spec.items():
+        if not isinstance(name, str) or not name:
+            raise ValueError("grid %r: a parameter's name is a non-empty string" % (name,))
+        if isinstance(values, tuple) and len(values) == 3:
+            count = values[2]
+            if isinstance(count, bool) or int(count) != count or count < 1:
+                raise ValueError("grid %s: the count must be a positive whole number, got %r" % (name, count))
+            sizes[name] = int(count)
+        else:
+            sizes[name] = len(values)
+    total = int(np.prod([float(n) for n in sizes.values()])) if sizes else 0
+    if max_grid_points is not None and total > max_grid_points:
+        raise ValueError("grid: %s grid points (%s), each a whole study: more than %d; a mistyped count? "
+                         "(max_grid_points=N, --max-grid-points N, lifts the limit)"
+                         % (format(total, ","), ", ".join("%s: %d" % kv for kv in sizes.items()), max_grid_points))
     out = {}
     for name, values in spec.items():
         if isinstance(values, tuple) and len(values) == 3:
             start, stop, count = values
-            if int(count) != count or count < 1:
-                raise ValueError("grid %s: the count must be a positive whole number, got %r" % (name, count))
             out[name] = [float(v) for v in np.linspace(float(start), float(stop), int(count))]
         else:
-            vals = [float(v) for v in values]
-            if not vals:
+            out[name] = [float(v) for v in values]
+            if not out[name]:
                 raise ValueError("grid %s: no values" % name)
-            out[name] = vals
+        if not all(np.isfinite(out[name])):
+            raise ValueError("grid %s: the values must be finite, got %r" % (name, values))
     if not out:
         raise ValueError("sweep: the grid has no parameter")
     return out

@@ -7,7 +7,8 @@ import shutil
 import sys
 import time
 
-from .grid import _definition, curve_points, grid_points, grid_values, neighbour_tree, read_definition
+from .grid import (MAX_GRID_POINTS, _definition, curve_points, grid_points, grid_values, neighbour_tree,
+                   read_definition)
 from .maps import plot_maps
 from .report import write_report
 from .table import assemble, read_rows
@@ -44,7 +45,7 @@ def _importing_main_script():
 
 
 def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrite=False, progress=True,
-          maps=True, strategy="explore", curves=None, families=None, **options):
+          maps=True, strategy="explore", curves=None, families=None, max_grid_points=MAX_GRID_POINTS, **options):
     """Runs a study at every point of ``grid`` and returns the tidy table (also ``<out>/table.csv``).
 
     model: a name, a model file's path, or a Model (sent to the workers as its model text).
@@ -61,6 +62,8 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
     the report draws them over the families' ranges along the line (``curve_lines``).
     families: the families to map (names, e.g. ["hopping in place"]): the table has their rows only, and with
     "continue" each grid point traces only the half-branches that led to them (the first is explored whole).
+    max_grid_points: the most grid points the sweep computes (default 10,000; None: no limit): a larger grid is
+    refused before anything runs.
     options: those of ``hybridcont.run`` (set, until, bound, rtol, ...), for every grid point."""
     if scheduler is None and _importing_main_script():
         # A local cluster's worker process starts by importing the main script: a sweep at the script's top
@@ -68,7 +71,9 @@ def sweep(model, grid, out, scheduler=None, workers=None, resume=False, overwrit
         raise RuntimeError("hybridcont.sweep: called while a worker process imports the script that sweeps; "
                            "call it under `if __name__ == \"__main__\":` (as every local Dask cluster needs)")
 
-    values = grid_values(grid)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise ValueError("workers %r: a whole number of processes, at least 1" % (workers,))
+    values = grid_values(grid, max_grid_points)
     points = grid_points(values)
     m, model, model_text, options = _checked_model(model, values, options, curves)
     model_name = m.name if model is None else os.fspath(model)
@@ -174,12 +179,26 @@ def _checked_choices(m, values, options, families, curves, strategy):
     return strategy
 
 
+def _remove_sweep(out):
+    """Removes what a sweep writes into its folder (sweep.json, points/, table.csv, the report and the maps), and
+    nothing else: a folder that also holds the user's own files keeps them."""
+    import glob
+    shutil.rmtree(os.path.join(out, "points"), ignore_errors=True)
+    written = ["sweep.json", "sweep.json.tmp", "table.csv", "table.csv.tmp", "sweep-report.html"]
+    for name in written + [os.path.basename(p) for pattern in ("map-*.png", "map-*.svg", "map-*.pdf", "plane-*.png",
+                                                                 "plane-*.svg", "plane-*.pdf")
+                           for p in glob.glob(os.path.join(glob.escape(out), pattern))]:
+        path = os.path.join(out, name)
+        if os.path.isfile(path) or os.path.islink(path):
+            os.remove(path)
+
+
 def _prepare_folder(out, definition, strategy, points, document, resume, overwrite):
     """The sweep's folder with its definition (sweep.json): a new one, the same sweep resumed (its finished grid
     points' files checked before anything runs), or one replaced with overwrite; refused otherwise."""
     definition_file = os.path.join(out, "sweep.json")
     if os.path.exists(definition_file) and overwrite and not resume:
-        shutil.rmtree(out)  # replaced whole, whatever its files hold
+        _remove_sweep(out)  # what the sweep wrote; the user's own files there are kept
     elif os.path.exists(definition_file):
         saved = read_definition(out)
         same = {k: v for k, v in saved.items() if k != "strategy"} == \

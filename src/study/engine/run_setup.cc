@@ -93,7 +93,10 @@ void ApplyTargetsAndBounds(const StudyOptions& args, const HybridModel& model, C
 }
 
 // A target beyond the model's default bound on the same unknown widens that bound to the target: the user
-// asked to reach it (an explicit --bound on that unknown is kept as given).
+// asked to reach it (an explicit --bound on that unknown is kept as given). A target further beyond the bound than
+// kMaxWidening times its width is refused: the families would be followed through a range the model was never
+// written for, until each branch's point limit (a mistyped exponent, --until H=1e300).
+constexpr double kMaxWidening = 100;
 void WidenBoundsToTargets(const StudyOptions& args, ContinuationOptions* c, std::vector<std::string>* notes) {
   for (const ComponentTarget& t : c->targets) {
     const bool explicit_bound = std::any_of(args.bounds.begin(), args.bounds.end(),
@@ -101,6 +104,16 @@ void WidenBoundsToTargets(const StudyOptions& args, ContinuationOptions* c, std:
     for (ComponentBound& b : c->bounds) {
       if (b.component != t.component || explicit_bound || (t.value >= b.lower && t.value <= b.upper)) continue;
       const double lower = b.lower, upper = b.upper;
+      const double beyond = std::max(lower - t.value, t.value - upper);
+      if (std::isfinite(upper - lower) && beyond > kMaxWidening * (upper - lower)) {
+        const auto given = std::find_if(args.until.begin(), args.until.end(),
+                                        [&](const NamedValue& u) { return u.name == t.component; });
+        Refuse("until", given == args.until.end() ? -1 : static_cast<int>(given - args.until.begin()),
+               fmt::format("'{}={:g}' lies {:g} beyond the model's bound [{:g}, {:g}] of {}, more than {:g} times its "
+                           "width: a mistake? (give {} {}=LOWER:UPPER to follow the families that far)",
+                           t.component, t.value, beyond, lower, upper, t.component, kMaxWidening,
+                           MentionOption("bounds"), t.component));
+      }
       b.lower = std::min(b.lower, t.value);
       b.upper = std::max(b.upper, t.value);
       notes->push_back(fmt::format("{} {}={:g} lies outside the bound [{:g}, {:g}] of {}: the bound is widened "

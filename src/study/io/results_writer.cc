@@ -27,9 +27,12 @@ void ResultsWriter::PrepareDirectory(const fs::path& dir, const std::string& mod
   // ours) only with --overwrite, so that a mistyped --out does not wipe a finished diagram.
   const fs::path summary = dir / "summary.json";
   if (!model.empty() && !overwrite && fs::exists(summary, ec)) {
-    std::ifstream f(summary);
-    const nlohmann::json old = fs::is_regular_file(summary, ec) ? nlohmann::json::parse(f, nullptr, false)
-                                                                : nlohmann::json(nullptr);
+    // Opened only where it is a regular file: a FIFO named summary.json would block the open.
+    nlohmann::json old;
+    if (fs::is_regular_file(summary, ec)) {
+      std::ifstream f(summary);
+      old = nlohmann::json::parse(f, nullptr, false);
+    }
     const bool readable = old.is_object() && old.contains("model") && old["model"].is_string();
     if (!readable) {
       throw std::invalid_argument(where + "holds a summary.json that is not the results of a hybridcont run (or is "

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "hybridcont/version.h"
+#include "modelfile/model_cache.h"
 #include "study/io/json_fields.h"
 
 namespace hybridcont::study {
@@ -15,7 +16,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int kFormat = 1;
+// 2: each stored branch carries the digest of its content with the study's options (a branch changed or
+// planted since it was stored is refused, never resumed from).
+constexpr int kFormat = 2;
 
 template <typename Enum>
 Enum EnumFrom(const nlohmann::json& j, const char* key, const std::string& where, Enum last) {
@@ -192,7 +195,17 @@ Branch BranchFromJson(const nlohmann::json& j, const std::string& where) {
   return b;
 }
 
-ResumeStore::ResumeStore(const fs::path& dir, const nlohmann::json& options, bool resume) : dir_(dir / ".resume") {
+namespace {
+// The digest a stored branch carries: of the study's options and its content (JSON numbers round-trip, so the
+// content read back serializes to the same text). A whole branch under another id is no damage: the exploration
+// takes a stored branch only where it is the one it is about to trace.
+std::string BranchDigest(const nlohmann::json& options, const nlohmann::json& branch) {
+  return internal::Sha256Hex(options.dump() + "\n" + branch.dump());
+}
+}  // namespace
+
+ResumeStore::ResumeStore(const fs::path& dir, const nlohmann::json& options, bool resume)
+    : dir_(dir / ".resume"), options_(options) {
   std::error_code ec;
   const fs::path study = dir_ / "study.json";
   if (resume && fs::exists(study, ec)) {
@@ -229,6 +242,12 @@ ResumeStore::ResumeStore(const fs::path& dir, const nlohmann::json& options, boo
           throw std::invalid_argument(entry.path().string() + ": the file name gives no branch id");
         }
         if (id < 0) throw std::invalid_argument(entry.path().string() + ": the file name gives no branch id");
+        if (!j.contains("sha256") || !j["sha256"].is_string() ||
+            j["sha256"].get<std::string>() != BranchDigest(options, j["branch"])) {
+          throw std::invalid_argument(entry.path().string() + ": the stored branch does not match its digest (it was "
+                                      "changed after it was stored, or belongs to another study); remove " +
+                                      dir_.string() + " to run the study afresh");
+        }
         Branch b = BranchFromJson(j["branch"], entry.path().string() + ": branch");
         loaded_.emplace(id, std::move(b));
       }
@@ -253,8 +272,9 @@ std::optional<Branch> ResumeStore::Lookup(int id) const {
 void ResumeStore::Save(int id, const Branch& branch) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (loaded_.count(id)) return;  // stored already
+  const nlohmann::json stored = BranchToJson(branch);
   WriteWhole(dir_ / ("branch-" + std::to_string(id) + ".json"),
-             nlohmann::json{{"format", kFormat}, {"branch", BranchToJson(branch)}}.dump());
+             nlohmann::json{{"format", kFormat}, {"sha256", BranchDigest(options_, stored)}, {"branch", stored}}.dump());
 }
 
 void ResumeStore::Complete() {

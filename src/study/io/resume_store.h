@@ -12,8 +12,9 @@
 // are not. A study that completes removes the folder.
 //
 // Format (private to the resume; a version mismatch makes the study start afresh): .resume/study.json
-// {"format": 1, "version", "options": {...}}; .resume/branch-<id>.json {"format": 1, "branch": {...}}.
-// Files are untrusted input: a file that does not parse as a branch is refused with its name and field.
+// {"format": 2, "version", "options": {...}}; .resume/branch-<id>.json {"format": 2, "sha256", "branch": {...}},
+// the digest of the options and the branch. Files are untrusted input: a file that does not parse as a
+// branch is refused with its name and field, one whose content does not match its digest as changed.
 #ifndef HYBRIDCONT_STUDY_RESUME_STORE_H_
 #define HYBRIDCONT_STUDY_RESUME_STORE_H_
 
@@ -49,6 +50,7 @@ class ResumeStore {
 
  private:
   std::filesystem::path dir_;
+  nlohmann::json options_;  // the study's options: part of every stored branch's digest
   std::map<int, Branch> loaded_;
   mutable int used_ = 0;
   mutable std::mutex mutex_;

@@ -56,10 +56,22 @@ double Field(const std::string& text, const std::string& where) {
   return value;
 }
 
+// A file of the folder opened for reading: a name that is there but no regular file (a FIFO, a device, a
+// folder) is refused before it is opened, since opening a FIFO blocks until someone writes it. A file that is
+// not there gives a stream that cannot be read.
+std::ifstream OpenRegular(const fs::path& file) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(file, ec);
+  if (fs::exists(status) && !fs::is_regular_file(status)) {
+    throw std::invalid_argument(file.string() + ": not a regular file (a results folder's files are regular files)");
+  }
+  return std::ifstream(file);
+}
+
 // The analysed points of one branch file.
 std::vector<StudyPoint> ReadBranchFile(const fs::path& file, const std::vector<std::string>& unknowns,
                                        const std::vector<std::string>& observables) {
-  std::ifstream f(file);
+  std::ifstream f = OpenRegular(file);
   if (!f) throw std::invalid_argument(file.string() + ": cannot be read");
   std::string line;
   if (!std::getline(f, line)) throw std::invalid_argument(file.string() + ": empty (no header)");
@@ -163,7 +175,7 @@ void ReadCurves(const nlohmann::json& summary, const fs::path& dir, StudyResult*
     curve.name = e.contains("name") && e["name"].is_string() ? e["name"].get<std::string>() : std::string();
     curve.special_point = e.contains("special_point") && e["special_point"].is_number_integer() ? e["special_point"].get<int>() : -1;
     curve.status = e.value("status", std::string());
-    std::ifstream f(dir / file);
+    std::ifstream f = OpenRegular(dir / file);
     std::string line;
     if (!std::getline(f, line)) throw std::invalid_argument((dir / file).string() + ": empty (no header)");
     curve.columns = SplitRow(line);
@@ -207,7 +219,7 @@ void ReadOrbitSamples(const nlohmann::json& summary, const fs::path& dir, StudyR
     if (fs::path(file).filename().string() != file) {
       throw std::invalid_argument("orbits[" + std::to_string(i) + "].file: '" + file + "' is not a file name");
     }
-    std::ifstream f(dir / file);
+    std::ifstream f = OpenRegular(dir / file);
     std::string line;
     if (!f || !std::getline(f, line)) continue;  // an orbit file that was not written (a full disk)
     StudyOrbit& orbit = r->orbits[i];
@@ -238,7 +250,7 @@ StudyResult LoadStudy(const std::string& dir_text) {
   const fs::path summary_file = dir / "summary.json";
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw std::invalid_argument("'" + dir_text + "': not a folder");
-  std::ifstream f(summary_file);
+  std::ifstream f = OpenRegular(summary_file);
   if (!f) throw std::invalid_argument(summary_file.string() + ": cannot be read (not a results folder?)");
   nlohmann::json summary;
   try {
