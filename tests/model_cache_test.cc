@@ -7,13 +7,18 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <optional>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "hybridcont/model_file.h"
+#include "modelfile/model_cache.h"
 
 namespace hybridcont {
 namespace {
@@ -63,6 +68,16 @@ void ReplaceFile(const fs::path& path, const std::string& bytes) {
 std::string Bytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// A library whose constructor creates `marker` when it is loaded (what planted code would do first).
+fs::path PlantedLibrary(const fs::path& folder, const fs::path& marker) {
+  const fs::path source = folder / "planted.cc", planted = folder / "planted.so";
+  std::ofstream(source) << "#include <cstdio>\n__attribute__((constructor)) static void Run() { std::FILE* f = "
+                           "std::fopen(\""
+                        << marker.string() << "\", \"w\"); if (f) std::fclose(f); }\n";
+  EXPECT_EQ(std::system(("c++ -shared -fPIC -o " + planted.string() + " " + source.string()).c_str()), 0);
+  return planted;
 }
 
 class ModelCache : public ::testing::Test {
@@ -158,18 +173,59 @@ TEST_F(ModelCache, AnotherModelsLibraryGivesNoForeignAnswerEvenWithAForgedRecord
 TEST_F(ModelCache, APlantedLibraryWithoutItsRecordIsNeverOpened) {
   const auto [library, record] = Entry(kBall);
   const fs::path marker = cache_ / "constructor-ran";
-  const fs::path source = cache_ / "planted.cc";
-  std::ofstream(source) << "#include <cstdio>\n__attribute__((constructor)) static void Run() { std::FILE* f = "
-                           "std::fopen(\""
-                        << marker.string() << "\", \"w\"); if (f) std::fclose(f); }\n";
-  const fs::path planted = cache_ / "planted.so";
-  ASSERT_EQ(std::system(("c++ -shared -fPIC -o " + planted.string() + " " + source.string()).c_str()), 0);
+  const fs::path planted = PlantedLibrary(cache_, marker);
   ReplaceFile(library, Bytes(planted));
   fs::remove(record);
   const Loaded again = Load(kBall, cache_);
   EXPECT_NE(again.log.find("its record model-"), std::string::npos) << again.log;
   EXPECT_FALSE(fs::exists(marker)) << "the planted constructor ran";
   ExpectThePhysicsOf(kBall, again.model);
+}
+
+// A library planted with a record forged to match it (this model's key, the planted bytes' digest): its bytes do
+// not name this model's source, so it is never opened and its constructor never runs.
+TEST_F(ModelCache, APlantedLibraryWithAForgedRecordIsNeverOpened) {
+  const auto [library, record] = Entry(kBall);
+  const fs::path marker = cache_ / "constructor-ran";
+  const fs::path planted = PlantedLibrary(cache_, marker);
+  std::string header, word, key;
+  {
+    std::ifstream in(record);
+    std::getline(in, header);
+    in >> word >> key;
+  }
+  ReplaceFile(library, Bytes(planted));
+  std::ofstream(record) << header << "\nkey " << key << "\nlibrary-sha256 " << internal::Sha256OfFile(library) << "\n";
+  fs::permissions(record, fs::perms::owner_read | fs::perms::owner_write, fs::perm_options::replace);
+  const Loaded again = Load(kBall, cache_);
+  EXPECT_NE(again.log.find("its bytes do not name this model's source; not opened"), std::string::npos) << again.log;
+  EXPECT_FALSE(fs::exists(marker)) << "the planted constructor ran";
+  ExpectThePhysicsOf(kBall, again.model);
+}
+
+// Two threads of one process compiling the same model (a Dask worker's): one compiles, the other waits and loads
+// what it published; the folder holds one entry and no temporary file.
+TEST_F(ModelCache, TwoThreadsCompilingOneModelMakeOneLibrary) {
+  std::ostringstream logs[2];
+  std::optional<HybridModel> models[2];
+  std::vector<std::thread> threads;
+  for (int i = 0; i < 2; ++i) {
+    threads.emplace_back([&, i] {
+      ModelFileOptions options;
+      options.cache_dir = cache_;
+      options.log = &logs[i];
+      models[i] = LoadModelFile(kBall, options);
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  const std::string both = logs[0].str() + logs[1].str();
+  EXPECT_EQ(both.find("compiling model"), both.rfind("compiling model")) << both;  // once
+  EXPECT_EQ(both.find("interpreted"), std::string::npos) << both;
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(cache_)) files.push_back(e.path().extension().string());
+  std::sort(files.begin(), files.end());
+  EXPECT_EQ(files, (std::vector<std::string>{".sha256", ".so"}));
+  for (const auto& m : models) ExpectThePhysicsOf(kBall, *m);
 }
 
 TEST_F(ModelCache, AFolderOrFileOthersMayWriteIsNotTrusted) {

@@ -878,7 +878,7 @@ TEST(Study, DamagedFilesAreRefusedByName) {
     EXPECT_NE(std::string(e.what()).find("branch-0.json"), std::string::npos) << e.what();
   }
   std::ofstream(dir / ".resume" / "branch-0.json")
-      << "{\"format\": 1, \"branch\": {\"id\": 0, \"direction\": 1, \"parent_special_point\": -1, \"depth\": 0, "
+      << "{\"format\": 2, \"branch\": {\"id\": 0, \"direction\": 1, \"parent_special_point\": -1, \"depth\": 0, "
          "\"points\": [{\"u\": [1, 2], \"tangent\": [1], \"arclength\": 0, \"step\": 0, \"newton_iterations\": 0, "
          "\"contraction\": 0, \"sb_test\": 0, \"test_values\": []}], \"special_points\": [], \"termination\": 1, "
          "\"message\": \"\", \"newton_iterations\": 0, \"rejected_steps\": 0, \"located_iterations\": 0, "

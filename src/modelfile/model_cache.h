@@ -7,7 +7,9 @@
 //     library-sha256 <SHA-256 of the .so's bytes>
 // <key> is the SHA-256 of the generated source, the compiler's identity (its resolved path, size and
 // modification time) and flags, and the library's version; the generated source itself ends with its own
-// digest as a symbol (hybridcont_model_source_sha256), checked after loading.
+// digest as a symbol (hybridcont_model_source_sha256 = "hybridcont-model-source-sha256:<digest>"), whose text is
+// found in the library's bytes before it is opened (a library built from another model's code is never loaded,
+// so its constructors never run) and read through the symbol after.
 //
 // Trust: the folder must be a real folder (not a symbolic link) owned by the effective user and writable by
 // no one else; otherwise nothing in it is loaded (the model runs interpreted, and the reason is said). An
@@ -16,9 +18,10 @@
 // or half-written entry is never opened, so none of its code runs. Such an entry is deleted and compiled
 // again. The default folder without HOME is <tmp>/hybridcont-cache-<uid>, made with mode 0700.
 //
-// Concurrency: a compiling process writes under names of its own (with its pid), loads its own fresh file,
-// then publishes it by renaming the .so and then the record; a reader that finds the .so without its record
-// treats the entry as absent.
+// Concurrency: a compiling process writes under names of its own (its pid and a per-call count), loads its own
+// fresh file, then publishes it by renaming the .so and then the record; a reader that finds the .so without its
+// record treats the entry as absent. Within one process one thread compiles a key at a time (a lock per key):
+// the others wait and load what it published.
 #ifndef HYBRIDCONT_SRC_MODELFILE_MODEL_CACHE_H_
 #define HYBRIDCONT_SRC_MODELFILE_MODEL_CACHE_H_
 

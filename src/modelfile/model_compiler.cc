@@ -17,6 +17,9 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <sstream>
 
 namespace hybridcont::internal {
@@ -242,6 +245,32 @@ std::string CompilerIdentity(const std::string& compiler) {
 }
 
 constexpr const char* kSourceDigestSymbol = "hybridcont_model_source_sha256";
+// The text of that symbol: this prefix and the SHA-256 of the generated source.
+constexpr const char* kIdentityPrefix = "hybridcont-model-source-sha256:";
+
+// Whether the file's bytes hold `text` (read in blocks; the text may straddle two).
+bool FileContains(const fs::path& file, const std::string& text) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in || text.empty()) return false;
+  std::string window;
+  std::vector<char> block(1 << 16);
+  while (in.read(block.data(), static_cast<std::streamsize>(block.size())) || in.gcount() > 0) {
+    window.append(block.data(), static_cast<std::size_t>(in.gcount()));
+    if (window.find(text) != std::string::npos) return true;
+    window.erase(0, window.size() - std::min(window.size(), text.size() - 1));
+  }
+  return false;
+}
+
+// The mutex of a cache key in this process.
+std::mutex& KeyLock(const std::string& key) {
+  static std::mutex guard;
+  static std::map<std::string, std::unique_ptr<std::mutex>> locks;
+  const std::lock_guard<std::mutex> lock(guard);
+  std::unique_ptr<std::mutex>& m = locks[key];
+  if (!m) m = std::make_unique<std::mutex>();
+  return *m;
+}
 
 // The compiler's bounds: $HYBRIDCONT_COMPILE_SECONDS (default 120) and $HYBRIDCONT_COMPILE_MEMORY_MB (its
 // address space, default 4096); a value that is not a whole number in range keeps the default.
@@ -387,7 +416,11 @@ std::shared_ptr<const CompiledPrograms> CompileModel(const ExpressionModelSpec& 
     if (!dir.empty() && dir != include.string()) flags += " -I" + Quote(dir);
   }
   const std::string source_digest = Sha256Hex(source);
-  const std::string code = source + "extern \"C\" const char " + kSourceDigestSymbol + "[] = \"" + source_digest + "\";\n";
+  // The library's identity, in its bytes: the symbol's text, which the library's constant data holds verbatim, is
+  // found in the file before it is loaded (a library built from other code is never opened), and read again
+  // through the loaded symbol.
+  const std::string identity = std::string(kIdentityPrefix) + source_digest;
+  const std::string code = source + "extern \"C\" const char " + kSourceDigestSymbol + "[] = \"" + identity + "\";\n";
   const std::string key =
       Sha256Hex(source_digest + "\n" + CompilerIdentity(compiler) + " " + flags + "\n" + HYBRIDCONT_VERSION).substr(0, 32);
   const fs::path cache = CacheDirectory(options);
@@ -397,6 +430,10 @@ std::shared_ptr<const CompiledPrograms> CompileModel(const ExpressionModelSpec& 
   const int slots = 5 * static_cast<int>(spec.phases.size()) + 5;
   const CacheEntry entry = EntryFor(cache, key);
   const auto load = [&](const fs::path& library, std::string* why) -> std::shared_ptr<CompiledPrograms> {
+    if (!FileContains(library, identity)) {
+      *why = "it was compiled from another model's code (its bytes do not name this model's source; not opened)";
+      return nullptr;
+    }
     void* handle = dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (handle == nullptr) {
       *why = std::string("loading failed: ") + dlerror();
@@ -405,9 +442,12 @@ std::shared_ptr<const CompiledPrograms> CompileModel(const ExpressionModelSpec& 
     auto compiled = std::make_shared<CompiledPrograms>();
     // Never unloaded: phases of models built from it may outlive this object in a user's program.
     compiled->library = std::shared_ptr<void>(handle, [](void*) {});
-    if (!LoadEntries(handle, slots, source_digest, compiled.get(), why)) return nullptr;
+    if (!LoadEntries(handle, slots, identity, compiled.get(), why)) return nullptr;
     return compiled;
   };
+  // One compile per key in this process: a second thread asking for the same model (two threads of a Dask
+  // worker) waits, then finds the entry the first published.
+  const std::unique_lock<std::mutex> compiling(KeyLock(key));
   bool absent = false;
   std::string why = VerifyEntry(entry, key, &absent);
   if (why.empty()) {

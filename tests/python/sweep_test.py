@@ -407,3 +407,23 @@ def test_killing_the_sweep_command_takes_its_python_process_down(tmp_path):
     while time.time() < deadline and any(_alive(p) for p in python):
         time.sleep(0.2)
     assert not any(_alive(p) for p in python), "the Python process outlived the killed command"
+
+
+def test_a_hostile_family_name_cannot_break_the_sweep_report(tmp_path):
+    from hybridcont.sweeps import report
+    if not os.path.exists(os.path.join(hc._paths.REPORT, "plotly-basic.min.js")):
+        pytest.skip("built without npm: no report")
+    name = "/*HYBRIDCONT_VIEWER*/<!--<script></script>"
+    (tmp_path / "sweep.json").write_text(json.dumps({"format": 1, "model": "slip", "grid": {"k": [20.0]},
+                                                     "strategy": "explore", "options": {}}))
+    pd.DataFrame([{"k": 20.0, "point": "0", "family": name, "status": "completed", "strategy": "explore",
+                   "exists": True, "physical": True, "stable": False, "physical_from": 1.0, "physical_to": 2.0,
+                   "stable_from": "", "stable_to": "", "physical_ranges": "1..2", "stable_ranges": "",
+                   "special_points": "[]"}]).to_csv(tmp_path / "table.csv", index=False)
+    page = open(report.write_report(str(tmp_path)), encoding="utf-8").read()
+    with open(os.path.join(hc._paths.REPORT, "sweep.js"), encoding="utf-8") as f:
+        viewer = f.read()
+    assert page.count(viewer.strip()[:200]) == 1  # the viewer inserted once, where the template says
+    assert name not in page
+    assert json.dumps(name).replace("<", "\\u003c") in page
+    assert not os.path.exists(tmp_path / "sweep-report.html.tmp")

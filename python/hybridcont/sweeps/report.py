@@ -51,14 +51,30 @@ def write_report(out):
     def inert(text):  # "</script" (any case) would end the inline script early; "<\/" means the same to JS and JSON
         return re.sub(r"</(script)", r"<\\/\1", text, flags=re.IGNORECASE)
     with open(os.path.join(_paths.REPORT, "sweep.html"), encoding="utf-8") as f:
-        page = f.read()
+        template = f.read()
     with open(plotly, encoding="utf-8") as f:
-        page = page.replace("/*HYBRIDCONT_PLOTLY*/", inert(f.read()), 1)
-    page = page.replace("/*HYBRIDCONT_DATA*/", inert(json.dumps(data, allow_nan=False)), 1)
+        library = inert(f.read())
     with open(os.path.join(_paths.REPORT, "sweep.js"), encoding="utf-8") as f:
-        page = page.replace("/*HYBRIDCONT_VIEWER*/", inert(f.read()), 1)
+        viewer = inert(f.read())
+    # The data's "<" as \u003c (the same string to JSON and JavaScript): a family named "<!--<script>" cannot open
+    # an HTML comment or element inside the inline script.
+    inserted = {"/*HYBRIDCONT_PLOTLY*/": library,
+                "/*HYBRIDCONT_DATA*/": json.dumps(data, allow_nan=False).replace("<", "\\u003c"),
+                "/*HYBRIDCONT_VIEWER*/": viewer}
+    # Each marker found in the template before anything is inserted: text inserted cannot be taken for one.
+    at = sorted((template.index(marker), marker) for marker in inserted)
+    parts, end = [], 0
+    for position, marker in at:
+        parts += [template[end:position], inserted[marker]]
+        end = position + len(marker)
+    page = "".join(parts) + template[end:]
     path = os.path.join(out, "sweep-report.html")
-    with open(path + ".tmp", "w", encoding="utf-8") as f:
-        f.write(page)
-    os.replace(path + ".tmp", path)
+    try:
+        with open(path + ".tmp", "w", encoding="utf-8") as f:
+            f.write(page)
+        os.replace(path + ".tmp", path)
+    except OSError:
+        if os.path.exists(path + ".tmp"):
+            os.remove(path + ".tmp")
+        raise
     return path

@@ -242,13 +242,14 @@ ResumeStore::ResumeStore(const fs::path& dir, const nlohmann::json& options, boo
           throw std::invalid_argument(entry.path().string() + ": the file name gives no branch id");
         }
         if (id < 0) throw std::invalid_argument(entry.path().string() + ": the file name gives no branch id");
+        // Its form first (a damaged file is named with its field), then its content against its digest.
+        Branch b = BranchFromJson(j["branch"], entry.path().string() + ": branch");
         if (!j.contains("sha256") || !j["sha256"].is_string() ||
             j["sha256"].get<std::string>() != BranchDigest(options, j["branch"])) {
           throw std::invalid_argument(entry.path().string() + ": the stored branch does not match its digest (it was "
                                       "changed after it was stored, or belongs to another study); remove " +
                                       dir_.string() + " to run the study afresh");
         }
-        Branch b = BranchFromJson(j["branch"], entry.path().string() + ": branch");
         loaded_.emplace(id, std::move(b));
       }
     }

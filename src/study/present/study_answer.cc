@@ -143,8 +143,8 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
   }
   const int others = static_cast<int>(study.branches.size()) - physical_branches;
   if (others > 0) {
-    out += fmt::format("\n{} more branch{} hold no physical orbit (time-reversed or otherwise no motion of the "
-                       "system).\n", others, others == 1 ? "" : "es");
+    out += fmt::format("\n{} more branch{} no physical orbit (time-reversed or otherwise no motion of the "
+                       "system).\n", others, others == 1 ? " holds" : "es hold");
   }
   if (study.status != ExplorationStatus::kCompleted) {
     out += fmt::format("\nThe run did not complete ({}): {}\n", ToString(study.status), study.message);
