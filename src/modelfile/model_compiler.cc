@@ -4,6 +4,7 @@
 #include "model_cache.h"
 
 #include <dlfcn.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -262,6 +263,45 @@ bool FileContains(const fs::path& file, const std::string& text) {
   return false;
 }
 
+// `command` run by /bin/sh in a child process; its wait status (-1 where it could not start). Unlike
+// std::system this process neither ignores SIGINT nor blocks SIGCHLD meanwhile: Ctrl-C during a compile interrupts
+// the command line at once (the compiler, in the same process group, gets it too), and a caller's own SIGINT
+// handler (Python's) sees it.
+int RunShell(const std::string& command) {
+  const pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return -1;
+  }
+  return status;
+}
+
+// Removes what compiles of processes that no longer run left in the cache folder (a command line interrupted
+// while it compiled): files named model-<key>.<pid>-<n>.{cc,so,log} or model-<key>.sha256.<pid>-<n> whose pid is
+// gone. Files of running processes and published entries are left alone.
+void RemoveLeftovers(const fs::path& cache) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(cache, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("model-", 0) != 0) continue;
+    const std::size_t dot = name.find('.', 6);
+    if (dot == std::string::npos) continue;
+    std::size_t at = dot + 1;
+    if (name.compare(at, 7, "sha256.") == 0) at += 7;
+    const std::size_t dash = name.find('-', at);
+    if (dash == std::string::npos || dash == at || name.find_first_not_of("0123456789", at) != dash) continue;
+    const long pid = std::strtol(name.substr(at, dash - at).c_str(), nullptr, 10);
+    if (pid > 0 && pid != getpid() && kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
+      fs::remove(entry.path(), ec);
+    }
+  }
+}
+
 // The mutex of a cache key in this process.
 std::mutex& KeyLock(const std::string& key) {
   static std::mutex guard;
@@ -457,6 +497,7 @@ std::shared_ptr<const CompiledPrograms> CompileModel(const ExpressionModelSpec& 
     if (options.log) *options.log << "note: the cached model " << entry.library.string() << " is not used (" << why << "); compiling it again\n";
     RemoveEntry(entry);
   }
+  RemoveLeftovers(cache);
   // Compiled under names of this process and this call (two threads of one process, a Dask worker's, may
   // compile the same model at once), loaded from there, then published.
   static std::atomic<long> calls{0};
@@ -478,7 +519,7 @@ std::shared_ptr<const CompiledPrograms> CompileModel(const ExpressionModelSpec& 
   const std::string command = "ulimit -v " + std::to_string(limits.megabytes * 1024) + "; exec timeout -k 5 " +
                               std::to_string(limits.seconds) + " " + Quote(compiler) + " " + flags + " -o " +
                               Quote(tmp.string()) + " " + Quote(src.string()) + " > " + Quote(log.string()) + " 2>&1";
-  const int status = std::system(command.c_str());
+  const int status = RunShell(command);
   const int rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::error_code ec;

@@ -325,3 +325,29 @@ def test_one_version():
     rc, out, _ = cli("--version")
     assert hc.__version__ in out
     assert hc.run("bouncing-ball", progress=False).summary["version"] == hc.__version__
+
+
+def test_ctrl_c_during_a_model_compile_ends_the_command_at_once(tmp_path):
+    """A terminal's Ctrl-C (SIGINT to the foreground process group) while a model file is compiled: the command
+    ends within seconds (it waited for the compiler before), and the next compile cleans what it left."""
+    cache = tmp_path / "cache"
+    env = dict(os.environ, HYBRIDCONT_CACHE=str(cache))
+    model = os.path.join(os.path.dirname(__file__), "..", "..", "models", "bouncing-ball.toml")
+
+    def run():
+        return subprocess.Popen([TOOL, "run", model, "--quiet", "--out", str(tmp_path / "out")], env=env,
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    proc = run()
+    deadline = time.time() + 60
+    while time.time() < deadline and not (cache.exists() and any(p.suffix == ".cc" for p in cache.iterdir())):
+        time.sleep(0.05)
+    assert any(p.suffix == ".cc" for p in cache.iterdir()), "no compile under way"
+    time.sleep(0.5)
+    os.killpg(proc.pid, signal.SIGINT)
+    start = time.time()
+    proc.wait(timeout=30)
+    assert time.time() - start < 5 and proc.returncode != 0
+    left = [p for p in cache.iterdir() if p.suffix in (".cc", ".log") or ".so." in p.name]
+    proc = run()  # compiles again, and removes what the interrupted compile left
+    assert proc.wait(timeout=300) == 0
+    assert not [p for p in left if p.exists()]
