@@ -531,6 +531,13 @@ def special_point_style(kind, bracketed, meanings=None):
     return style
 
 
+def special_point_label(sp):
+    """A special point's label as the library gives it (summary.json's "label": "PD4", what --at names); a folder
+    written before 0.8.0 has none, and its label is its type and id, the rule the library had then."""
+    label = sp.get("label")
+    return label if isinstance(label, str) and label else "%s%s" % (sp.get("type", "?"), sp.get("id", ""))
+
+
 def branch_label(branch, special_points):
     entry = branch["entry"]
     label = "branch %s" % branch["id"]
@@ -782,7 +789,7 @@ def draw_special_points(ax, res, xname, yname, zname=None, annotate=True, only=N
         else:
             ax.scatter([x], [y], **kw)
             if annotate and kind != "start" and main:
-                labels.append((x, y, "%s%s" % (kind, sp.get("id", ""))))
+                labels.append((x, y, special_point_label(sp)))
         if main:
             used[style["name"]] = style
     ax._hc_labels = labels
@@ -1501,8 +1508,8 @@ def figure_curves(res, svg, written):
         if kind == "boundary":
             label = "boundary %s" % c.get("name")
         else:
-            label = "%s%s · %s%s" % (sp.get("type", "?") if sp else "?", c.get("special_point"), kind,
-                                     " (%s)" % branch["family"] if branch and branch["family"] else "")
+            label = "%s · %s%s" % (special_point_label(sp) if sp else "?%s" % c.get("special_point"), kind,
+                                   " (%s)" % branch["family"] if branch and branch["family"] else "")
         ax.plot(xs, ys, color=colour, lw=1.8, ls=CURVE_DASHES.get(kind, "-"), label=label)
         for q in c.get("codim_two") or []:
             ax.plot([to_float(q.get(p))], [to_float(q.get("H"))], "*", color="black", ms=8)

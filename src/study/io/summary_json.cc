@@ -64,6 +64,7 @@ nlohmann::json SpecialPointsJson(const std::vector<StudySpecialPoint>& points) {
   nlohmann::json list = nlohmann::json::array();
   for (const StudySpecialPoint& p : points) {
     nlohmann::json j = {{"id", p.id},
+                        {"label", p.Label()},  // what a restart's --at names; written for the folder's readers
                         {"type", p.code},
                         {"branch", p.branch},
                         {"index", p.index},

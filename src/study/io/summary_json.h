@@ -1,7 +1,7 @@
 // The JSON that a study writes into summary.json beyond the writer's own: the effective options
 // and the special points of the continuation (SB, TP, start, and the Floquet crossings BP and PD located
 // as test functions, floquet_test_functions.h), with one set of fields for every special point:
-//   {"id", "type", "branch", "index", "H", "T", "status", "precision", "precision_arclength",
+//   {"id", "label", "type", "branch", "index", "H", "T", "status", "precision", "precision_arclength",
 //    "precision_H", "residual", "component", "duplicate_of", "message", "u"}
 #ifndef HYBRIDCONT_STUDY_SUMMARY_JSON_H_
 #define HYBRIDCONT_STUDY_SUMMARY_JSON_H_
