@@ -390,7 +390,7 @@ TEST(ModelSetup, ResultsCarryThePresentation) {
   point.u = WithValues(model, {{"t1", 0.1}, {"t2", 0.5}, {"t3", 0.2}, {"H", 0.3}});
   point.extra = {{"stable", 1.0}};
   writer.AddPoint(0, point);
-  const std::vector<std::string> header = ReadHeader(dir / study::ResultsWriter::BranchFileName(0));
+  const std::vector<std::string> header = ReadHeader(dir / BranchFileName(0));
   ASSERT_GE(header.size(), 2u);
   EXPECT_EQ(header[header.size() - 2], "stable");
   EXPECT_EQ(header.back(), "asym");

@@ -226,6 +226,9 @@ struct StudyFamily {
   bool operator==(const StudyFamily&) const = default;  // exact: a study and the same study read back agree
 };
 
+// The file of branch `id` in a results folder (docs/results-format.md): "branch-<id>.csv".
+std::string BranchFileName(int id);
+
 // The families of a study's branches, in the order they are first met (StudyBranch::ranges, each range's
 // family). The one fold of ranges that every front end shows.
 std::vector<StudyFamily> FoldFamilies(const std::vector<StudyBranch>& branches,

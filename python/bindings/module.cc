@@ -480,7 +480,7 @@ py::list BranchRows(const StudyResult& study) {
     row["word"] = b.word.empty() ? py::object(py::none()) : py::object(py::str(word));
     row["image_of"] = b.image_of;
     row["symmetry"] = b.symmetry;
-    row["file"] = "branch-" + std::to_string(b.id) + ".csv";
+    row["file"] = BranchFileName(b.id);
     row["message"] = b.message;
     row["model"] = b.model;
     row["origin"] = b.origin;

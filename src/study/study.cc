@@ -746,6 +746,8 @@ namespace hybridcont {
 
 std::string Version() { return HYBRIDCONT_VERSION; }
 
+std::string BranchFileName(int id) { return "branch-" + std::to_string(id) + ".csv"; }
+
 const StudySpecialPoint* StudyResult::FindSpecialPoint(const std::string& label) const {
   for (const StudySpecialPoint& p : special_points) {
     if (p.Label() == label) return &p;

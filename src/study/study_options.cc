@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <climits>
 #include <cstdlib>
+#include <set>
 
 #include "hybridcont/option_text.h"
 
@@ -311,12 +312,21 @@ void Append(StudyOptionValue* into, StudyOptionValue more) {
       AppendTo<std::vector<NamedInterval>>(into, more);
 }
 
-// How many entries of a list of names (values or intervals) are named `name`.
-template <class List>
-int CountNamed(const StudyOptionValue& value, const std::string& name) {
-  const List* list = std::get_if<List>(&value);
-  if (list == nullptr) return 0;
-  return static_cast<int>(std::count_if(list->begin(), list->end(), [&](const auto& e) { return e.name == name; }));
+// A choice's text, or StudyOptionError (entry `index`) naming the choices.
+void CheckChoice(const StudyOptionSpec& spec, int index, const std::string& text) {
+  if (std::find(spec.choices.begin(), spec.choices.end(), text) != spec.choices.end()) return;
+  std::string expected;
+  for (std::size_t c = 0; c < spec.choices.size(); ++c) {
+    expected += (c == 0 ? "" : c + 1 == spec.choices.size() ? " or " : ", ") + ("'" + spec.choices[c] + "'");
+  }
+  throw StudyOptionError(spec.field, index, "'" + text + "': expected " + expected);
+}
+
+// The name of an entry that sets one value per name (a parameter, a target, a bound); "" for other kinds.
+std::string NameOf(const StudyOptionValue& one) {
+  if (const auto* v = std::get_if<std::vector<NamedValue>>(&one)) return v->size() == 1 ? v->front().name : "";
+  if (const auto* b = std::get_if<std::vector<NamedInterval>>(&one)) return b->front().name;
+  return "";
 }
 
 bool HoldsKind(OptionKind kind, const StudyOptionValue& v) {
@@ -404,25 +414,17 @@ StudyOptionValue ParseStudyOption(const StudyOptionSpec& spec, const std::vector
     throw StudyOptionError(spec.field, 1, "'" + texts[1] + "': given twice (first '" + texts[0] + "'); give it once");
   }
   StudyOptionValue value;
+  std::set<std::string> names;  // one entry per name where the option sets one value per name
   for (std::size_t i = 0; i < texts.size(); ++i) {
     StudyOptionValue one = ParseOne(spec, static_cast<int>(i), texts[i]);
-    if (spec.kind == OptionKind::kChoice &&
-        std::find(spec.choices.begin(), spec.choices.end(), std::get<std::string>(one)) == spec.choices.end()) {
-      std::string expected;
-      for (std::size_t c = 0; c < spec.choices.size(); ++c) {
-        expected += (c == 0 ? "" : c + 1 == spec.choices.size() ? " or " : ", ") + ("'" + spec.choices[c] + "'");
-      }
-      throw StudyOptionError(spec.field, static_cast<int>(i), "'" + texts[i] + "': expected " + expected);
-    }
-    Append(&value, std::move(one));
-    // One entry per name where the option sets one value per name (a parameter, a target, a bound).
+    if (spec.kind == OptionKind::kChoice) CheckChoice(spec, static_cast<int>(i), texts[i]);
     if (spec.kind == OptionKind::kValues || spec.kind == OptionKind::kIntervals) {
-      const std::string name = spec.kind == OptionKind::kValues ? std::get<std::vector<NamedValue>>(value).back().name
-                                                                 : std::get<std::vector<NamedInterval>>(value).back().name;
-      if (CountNamed<std::vector<NamedValue>>(value, name) + CountNamed<std::vector<NamedInterval>>(value, name) > 1) {
+      const std::string name = NameOf(one);
+      if (!names.insert(name).second) {
         throw StudyOptionError(spec.field, static_cast<int>(i), "'" + texts[i] + "': '" + name + "' is given twice");
       }
     }
+    Append(&value, std::move(one));
   }
   return value;
 }
@@ -435,12 +437,7 @@ void SetStudyOption(StudyOptions* options, const std::string& field, const Study
     spec->set(options, spec->get(StudyOptions{}));  // its default
     return;
   }
-  if (spec->kind == OptionKind::kChoice) {
-    const std::string& text = std::get<std::string>(value);
-    if (std::find(spec->choices.begin(), spec->choices.end(), text) == spec->choices.end()) {
-      ParseStudyOption(*spec, {text});  // refused as the text would be, naming the choices
-    }
-  }
+  if (spec->kind == OptionKind::kChoice) CheckChoice(*spec, -1, std::get<std::string>(value));
   spec->set(options, value);
 }
 

@@ -170,7 +170,6 @@ class ResultsWriter {
   }
   // The key-frame orbits added so far, sampled.
   const std::vector<StudyOrbit>& orbits() const { return orbits_; }
-  static std::string BranchFileName(int id) { return "branch-" + std::to_string(id) + ".csv"; }
   // One more than the largest branch id ended so far (0 for none).
   int next_branch_id() const;
 

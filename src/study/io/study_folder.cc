@@ -287,7 +287,7 @@ StudyResult LoadStudy(const std::string& dir_text) {
       if (listed == entries.end()) continue;  // not listed by an interrupted study
       const nlohmann::json& entry = *listed->second;
       const std::string file = entry.contains("file") && entry["file"].is_string() ? entry["file"].get<std::string>()
-                                                                                      : "branch-" + std::to_string(b.id) + ".csv";
+                                                                                      : BranchFileName(b.id);
       if (fs::path(file).filename().string() != file) {
         throw std::invalid_argument("branches[" + std::to_string(b.id) + "].file: '" + file + "' is not a file name");
       }
