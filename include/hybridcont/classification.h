@@ -5,7 +5,8 @@
 //   xi = 0 (Thm 3.1; "at-rest" when all durations vanish too, e.g. the ball's xi-branch),
 //   every t_i > 0 ("reversed-time" if some t_i < 0, "zero-duration" if some t_i = 0),
 //   every event is crossed downward at the end of its phase (de·f < 0; "wrong-direction", "grazing"),
-//   the anchor is crossed downward at the end of the return segment ("anchor-grazing"),
+//   the anchor is crossed downward at the end of the return segment ("wrong-direction" where it is crossed
+//   upward, "anchor-grazing" where it is touched),
 //   the phase's event stays non-negative inside the phase — no earlier downward crossing and no start
 //   beyond the guard, e.g. an end of the rod below the ground ("missed-event") — and no earlier anchor
 //   crossing in the return segment ("missed-anchor"), searched on the dense output (orbit_trace.h).

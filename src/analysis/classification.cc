@@ -139,9 +139,11 @@ Classification ClassifyOrbit(const HybridModel& model, const Vector& u, const Or
     if (speed > -options.grazing_tolerance) {
       os << (i < m ? "event of segment " : "anchor at the end of segment ") << i + 1
          << ": normalized crossing speed " << speed;
-      if (i == m) return NonPhysical(OrbitClass::kAnchorGrazing, os.str());
-      return NonPhysical(speed > options.grazing_tolerance ? OrbitClass::kWrongDirection : OrbitClass::kGrazing,
-                         os.str());
+      if (speed > options.grazing_tolerance) {  // crossed upward: the orbit returns the other way through it
+        if (i == m) os << " (the section is crossed upward; the anchor's expression with the opposite sign is crossed downward)";
+        return NonPhysical(OrbitClass::kWrongDirection, os.str());
+      }
+      return NonPhysical(i == m ? OrbitClass::kAnchorGrazing : OrbitClass::kGrazing, os.str());
     }
   }
   // First crossing: the trajectory stays on the positive side of its event inside the phase (no earlier

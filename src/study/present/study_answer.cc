@@ -143,8 +143,22 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
   }
   const int others = static_cast<int>(study.branches.size()) - physical_branches;
   if (others > 0) {
-    out += fmt::format("\n{} more branch{} no physical orbit (time-reversed or otherwise no motion of the "
-                       "system).\n", others, others == 1 ? " holds" : "es hold");
+    // Why, as the classification of their points says it (classification.h), most frequent first.
+    std::map<std::string, int> reasons;
+    for (const StudyBranch& b : study.branches) {
+      if (!b.ranges.physical.empty()) continue;
+      for (const StudyPoint& p : b.points) ++reasons[ToString(p.analysis.classification.reason)];
+    }
+    std::vector<std::pair<int, std::string>> ranked;
+    for (const auto& [reason, count] : reasons) ranked.push_back({-count, reason});
+    std::sort(ranked.begin(), ranked.end());
+    std::string why;
+    for (std::size_t i = 0; i < ranked.size() && i < 3; ++i) {
+      why += fmt::format("{}{} {}", i ? ", " : "", -ranked[i].first, ranked[i].second);
+    }
+    if (ranked.size() > 3) why += ", ...";
+    out += fmt::format("\n{} more branch{} no physical orbit{}.\n", others, others == 1 ? " holds" : "es hold",
+                       why.empty() ? "" : " (their points: " + why + ")");
   }
   if (study.status != ExplorationStatus::kCompleted) {
     out += fmt::format("\nThe run did not complete ({}): {}\n", ToString(study.status), study.message);
