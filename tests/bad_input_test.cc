@@ -600,9 +600,8 @@ const std::vector<BadInputCase>& Cases() {
       // a bound whose ends are reversed: said at its line (it is evaluated after --set)
       {"BoundReversedInTheFile", Cli({"run", "m.toml", "--quiet", "--no-plots"}), 2,
        "m.toml:34: run.bounds.H: the lower end 1 is not below the upper end -1", BallFile("m.toml", "H = [-1, 1]", "H = [1, -1]")},
-      // a phase's let named like a definition would hide it in that phase only
       // definitions and let quantities each using the next, 1,200 deep (named so that the first read uses the
-      // second): refused naming the limit and the chain (10,001 overflowed the stack while they were resolved)
+      // second): refused naming the limit and the chain (resolving them recurses as deep as the chain)
       {"LetChainTooDeep", Cli({"list", "m.toml"}), 2,
        "more than 1000 deep: 'q0000' uses 'q0001' uses 'q0002' uses ... (995 more) uses", File("m.toml", [] {
          std::string lets = "let.q1199 = \"dy\"\n";
@@ -617,6 +616,7 @@ const std::vector<BadInputCase>& Cases() {
          return Replace(Replace(Ball(), "[[phases]]", definitions + "\n[[phases]]"), "dy = \"-g\" }",
                         "dy = \"-g + 0*d0000\" }");
        })},
+      // a phase's let named like a definition would hide it in that phase only
       {"LetShadowsADefinition", Cli({"check", "m.toml"}), 2,
        "phases.flight.let.gg: 'gg' is also a definition ([definitions]); name it otherwise", File("m.toml", [] {
          return Replace(Replace(Ball(), "[[phases]]", "[definitions]\ngg = \"2*g\"\n\n[[phases]]"),

@@ -350,7 +350,7 @@ py::dict Trace(const ModelHandle& model, const std::vector<double>& u, int sampl
     throw std::invalid_argument("u has " + std::to_string(u.size()) + " entries; the orbit's unknowns (the model's own "
                                 "layout, no free parameters) are " + std::to_string(expected));
   }
-  // A sample is a row of Python objects (~1 kB with its states): a million is a fine curve; more is a mistake.
+  // Every sample becomes Python objects: the bound keeps a mistyped count from exhausting memory.
   constexpr int kMaxSamples = 1000000;
   if (samples < 2 || samples > kMaxSamples) {
     throw std::invalid_argument("samples must lie in [2, " + std::to_string(kMaxSamples) + "], got " +

@@ -208,8 +208,8 @@ class Reader {
   std::set<std::string> resolving_;
   // The definitions and let quantities being resolved, each using the next (resolving recurses through them).
   std::vector<std::string> resolving_chain_;
-  // The longest such chain: each level is a nested parse (about a kilobyte of stack), so a hostile file's chain
-  // of 10,000 would overflow it; a model's real chains are a few dozen long.
+  // The longest such chain: each level is a nested parse on the stack, and this bound keeps the deepest chain
+  // far from the stack's end (bench/README.md, "Requests that ran away, refused").
   static constexpr std::size_t kMaxSymbolNesting = 1000;
   std::vector<const toml::table*> phase_tables_;
   std::vector<const toml::table*> phase_lets_;
