@@ -181,8 +181,36 @@ TEST(Cli, ARunNeverReplacesTheStudyItReadsNorWaitsOnAFifo) {
       << into.err;
   const CliResult plot = RunTool({"plot", fifo_folder.string()});
   EXPECT_NE(plot.code, 0);
+  // A FIFO in a resume store is refused, never opened (the open would block the run).
+  const fs::path resumed = TempDir("resume_fifo");
+  ASSERT_EQ(RunTool({"run", "bouncing-ball", "--quiet", "--no-plots", "--out", resumed.string()}).code, 0);
+  fs::create_directories(resumed / ".resume");
+  ASSERT_EQ(mkfifo((resumed / ".resume" / "study.json").c_str(), 0600), 0);
+  const CliResult resume =
+      RunTool({"run", "bouncing-ball", "--quiet", "--no-plots", "--resume", "--out", resumed.string()});
+  EXPECT_EQ(resume.code, 2);
+  EXPECT_NE(resume.err.find("study.json: not a regular file"), std::string::npos) << resume.err;
+  fs::remove_all(resumed);
   fs::remove_all(saved);
   fs::remove_all(fifo_folder);
+}
+
+// A model whose event has the wrong sign (the ball's phase ends where y crosses 0 upward): no orbit of it is
+// physical, and the answer says which class its orbits have and what that class usually means.
+TEST(Cli, AnAnswerWithoutPhysicalOrbitsNamesTheirClassAndWhatItMeans) {
+  const fs::path dir = TempDir("wrong_sign");
+  fs::create_directories(dir);
+  std::ifstream in(fs::path(HYBRIDCONT_SOURCE_DIR) / "models" / "bouncing-ball.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const std::string event = "event = \"y\"";
+  ASSERT_NE(text.find(event), std::string::npos);
+  text.replace(text.find(event), event.size(), "event = \"-y\"");
+  std::ofstream(dir / "ball.toml") << text;
+  const CliResult r = RunTool({"run", (dir / "ball.toml").string(), "--out", (dir / "out").string(), "--no-plots"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("0 branches with physical orbits"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("wrong-direction: a phase ends where its event is crossed upward"), std::string::npos) << r.out;
+  fs::remove_all(dir);
 }
 
 TEST(Cli, RunBouncingBallWritesClassifiedBranchesThatMatchTheClosedForm) {

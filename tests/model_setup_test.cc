@@ -385,7 +385,7 @@ TEST(ModelSetup, ResultsCarryThePresentation) {
   std::filesystem::remove_all(dir);
   study::ResultsWriter::PrepareDirectory(dir);
   const HybridModel model = MakeBuiltinModel("bouncing-rod");
-  study::ResultsWriter writer(dir, model, nlohmann::json::object());
+  study::ResultsWriter writer(dir, model, nlohmann::json::object(), StudyModelSource{});
   study::PointRecord point;
   point.u = WithValues(model, {{"t1", 0.1}, {"t2", 0.5}, {"t3", 0.2}, {"H", 0.3}});
   point.extra = {{"stable", 1.0}};
@@ -396,7 +396,7 @@ TEST(ModelSetup, ResultsCarryThePresentation) {
   EXPECT_EQ(header.back(), "asym");
 
   const HybridModel slip = MakeBuiltinModel("slip");
-  study::ResultsWriter slip_writer(dir, slip, nlohmann::json::object());
+  study::ResultsWriter slip_writer(dir, slip, nlohmann::json::object(), StudyModelSource{});
   const Vector u0 = StartPoint(slip);
   const OrbitTrace trace(slip, u0, IntegratorOptions{});
   ASSERT_TRUE(trace.ok()) << trace.message();

@@ -66,6 +66,9 @@ class ObservableEvaluator {
  private:
   EvaluationStatus Integral(const Observable& o, int observable, const Vector& u, double* value, RowVector* du);
   EvaluationStatus Extremum(const Observable& o, const Vector& u, double* value, RowVector* du);
+  // Whether guard observable o's segment s begins armed at u (observable.h); p: the parameter values, sign: 1
+  // for o's minimum (-1 for a maximum).
+  bool GuardArmedAtStart(const Observable& o, const Vector& u, const Vector& p, double sign, int s);
   EvaluationStatus Final(const Observable& o, const Vector& u, double* value, RowVector* du);
   // g(x_s(t)) on segment s and, with du, its gradient: ∇g times the sensitivities at t plus ∂g/∂p, and, where
   // t is the segment's end (is_end), ∇g·f~ for t_s.

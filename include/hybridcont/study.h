@@ -78,6 +78,11 @@ struct StudyPoint {
   int newton_iterations = 0;
   double step = 0;
   bool at_branch_point = false;  // the branch's start at a singular point
+  // dT/dc along the branch at the point, c the coordinate it is continued in (H̄ or a parameter): the period's
+  // slope, from the branch's tangent (infinite at a turning point in c; NaN where the tangent is unknown).
+  double period_slope = std::numeric_limits<double>::quiet_NaN();
+  // The model's declared quantities at the point (model_setup.h, "quantities"; NaN where one is undefined).
+  std::vector<NamedValue> quantities;
 };
 
 // One half-branch of the study, with what the study knows about it.
@@ -92,6 +97,8 @@ struct StudyBranch {
   std::vector<std::string> word;           // an automaton's word (its modes); empty otherwise
   int direction = +1;
   int parent_special_point = -1;
+  int newton_iterations = 0;               // over its accepted points
+  int rejected_steps = 0;
   int depth = 0;
   int image_of = -1;
   std::string symmetry;
@@ -105,6 +112,7 @@ struct StudyBranch {
   BranchRanges ranges;                     // where its orbits are physical and stable (family_ranges.h)
   int period_doubled_from = -1;            // the PD point a period-doubled family is born at
   int handed_over_from = -1;               // the word change it begins at (StudyResult::word_changes)
+  bool started_in_word = false;            // a family of another word, traced from that word's own start
 
   // Whether a special point after point `index` lies on (or at an end of) one of its physical stretches.
   bool OnPhysicalStretch(int index) const;
@@ -160,6 +168,17 @@ struct StudyCurve {
   std::string name;         // a boundary's quantity at 0 ("t2 = 0"); empty otherwise
   int special_point = -1;   // the special point it is continued from (-1 for a boundary)
   std::string status;       // "traced", "start-failed"
+  std::string message;      // why it was not traced (or stopped early); may be empty
+  // How each end of it stopped (TerminationReason as text): backward, forward; empty for a boundary.
+  std::vector<std::string> termination;
+  // The codimension-two points found along it: a curve's own folds and branch points, a bracketed end where it
+  // leaves the physical region (special_point_curve.h, CodimTwoPoint).
+  struct CodimTwo {
+    std::string type, name, status;
+    double H = 0, p = 0;
+    bool operator==(const CodimTwo&) const = default;
+  };
+  std::vector<CodimTwo> codim_two;
   std::vector<std::string> columns;  // "H", p, then the curve's other unknowns
   std::vector<Vector> points;        // in curve order, each in `columns` order
 };
@@ -257,6 +276,9 @@ struct StudyResult {
   ExplorationStatus status = ExplorationStatus::kCompleted;
   std::string message;               // why it did not complete
   std::string report;                // the study's report in words
+  // How the study found its start where the caller's parameters needed more than the model's start: "start
+  // carried from the model's own k = 25.48 to 30 at H = 1.04 (12 continuation steps)"; empty otherwise.
+  std::string start_note;
   // Non-empty when a file of out_dir could not be written (a full disk): the folder keeps what was written,
   // marked as not complete; the result holds the whole study.
   std::string write_error;

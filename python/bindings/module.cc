@@ -40,6 +40,7 @@
 #include "hybridcont/study.h"
 #include "hybridcont/study_answer.h"
 #include "hybridcont/study_report.h"
+#include "hybridcont/study_table.h"
 #include "hybridcont/timebased_shooting.h"
 
 namespace py = pybind11;
@@ -540,6 +541,16 @@ py::list CurveRows(const StudyResult& study) {
 }
 
 // What Python's Study holds of a study: status, answer, its families' fold, labels and tables.
+// The study's points, column by column (study_table.h): numbers as numpy arrays, texts as lists.
+py::dict PointColumns(const StudyResult& study) {
+  py::dict columns;
+  for (StudyColumn& c : StudyPointColumns(study)) {
+    if (c.text) columns[py::str(c.name)] = py::cast(c.texts);
+    else columns[py::str(c.name)] = py::array_t<double>(static_cast<py::ssize_t>(c.numbers.size()), c.numbers.data());
+  }
+  return columns;
+}
+
 py::dict StudyDict(const StudyResult& study) {
   py::dict out;
   out["status"] = ToString(study.status);
@@ -553,6 +564,8 @@ py::dict StudyDict(const StudyResult& study) {
   out["branches"] = BranchRows(study);
   out["word_changes"] = WordChangeRows(study);
   out["curves"] = CurveRows(study);
+  out["points"] = PointColumns(study);
+  out["summary_json"] = study.summary_json;  // the saved document (effective options, presentation)
   out["model_source"] = py::dict(py::arg("kind") = ToString(study.model_source.kind), py::arg("name") = study.model_source.name,
                                  py::arg("path") = study.model_source.path, py::arg("text") = study.model_source.text);
   return out;

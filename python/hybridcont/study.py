@@ -4,16 +4,15 @@
     study = hc.run("slip", until={"H": 1.8})      # every option of `hybridcont run`, as keyword arguments
     print(study)                                  # the one-screen answer
     study.special_points                          # DataFrame: label, type, branch, H, T, status, precision ...
-    study.points                                  # every branch file's columns, one row per point
+    study.points                                  # every analysed point, one row each
     study.families                                # where each family is physical and stable
     pd4 = study.continue_from("PD4")              # the period-doubled family born at PD4
     study.save("results/slip"); hc.load("results/slip")
 
 A study is the library's typed result (study.h) and its results folder (docs/results-format.md), the one
-serialization of it. ``families``, ``special_points``, ``branches``, ``word_changes`` and ``curves`` are the typed
-result's (of the run in memory, or of the folder read back by the library's LoadStudy: the same rows); ``points``
-and ``orbits`` are the folder's branch and orbit files, whose columns also hold what the model's presentation
-computes. Without ``out`` the folder is a temporary one, removed when the interpreter exits unless ``save``d.
+serialization of it. ``families``, ``special_points``, ``branches``, ``word_changes``, ``curves`` and ``points`` are
+the typed result's (of the run in memory, or of the folder read back by the library's LoadStudy: the same rows);
+``orbits`` are the folder's orbit files, whose columns also hold the model's drawing at each sample. Without ``out`` the folder is a temporary one, removed when the interpreter exits unless ``save``d.
 """
 import atexit
 import html
@@ -173,13 +172,14 @@ class Study:
         # The typed study's tables (the library's record, as summary.json serializes it): rows of the special
         # points (labels by the library's one rule), branches and changes of word.
         self._rows = {key: list(info[key]) for key in ("special_points", "branches", "word_changes", "curves")}
+        self._points = dict(info["points"])  # the typed points, column by column (study_table.h)
         self._unknowns = list(info["unknowns"])
         self._model_source = dict(info["model_source"])
         self.interrupted = bool(result and result["interrupted"])
         self.write_error = result["write_error"] if result else ""
         self.wall_seconds = result["wall_seconds"] if result else None
-        with open(os.path.join(self.path, "summary.json"), encoding="utf-8") as f:
-            self.summary = json.load(f)
+        # The saved document as the library wrote (or read and checked) it: the effective options, the presentation.
+        self.summary = json.loads(info["summary_json"])
         self._cache = {}
 
     # ---- tables ------------------------------------------------------------------------------------------
@@ -202,20 +202,18 @@ class Study:
 
     @property
     def points(self):
-        """Every branch file's columns (docs/results-format.md), one row per point, with its branch's id
-        and family: index, H, T, the unknowns, physical, classification, stability, dT_dH, multipliers,
-        quantities and observables."""
+        """The study's analysed points, one row per point over every branch (the typed study's, as its branch
+        files hold them: docs/results-format.md): branch, family, index, H, T, the unknowns, physical,
+        classification, stability, residual, newton_iterations, step, dT_d<c>, replay error, Floquet data and
+        multipliers, quantities and observables."""
         def make():
-            frames = []
-            for b in self._rows["branches"]:
-                path = os.path.join(self.path, b["file"])
-                if not os.path.exists(path):
-                    continue
-                frame = pd.read_csv(path, keep_default_na=True)
-                frame.insert(0, "family", b.get("family") or "")
-                frame.insert(0, "branch", b["id"])
-                frames.append(frame)
-            return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+            columns = self._points
+            # branch, index and the counts as integers where every row has one (a table of no rows stays empty)
+            frame = pd.DataFrame(columns)
+            for name in ("branch", "index", "physical", "newton_iterations"):
+                if name in frame and len(frame) and frame[name].notna().all():
+                    frame[name] = frame[name].astype(int)
+            return frame
         return self._table("points", make)
 
     def branch(self, id):

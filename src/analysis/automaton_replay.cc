@@ -20,6 +20,123 @@ constexpr int kBisections = 60;
 // automaton's crossing of a physical orbit lies at that duration, up to the integration error.
 constexpr double kLegMargin = 0.05;
 
+// A state of a leg's trajectory at time t since the leg began.
+struct Sample {
+  double t;
+  Vector y;
+};
+
+// One leg of the replay, in one mode: the flow of the mode's phase and the functions watched along it, the
+// guards of the transitions out of the mode (out) and, on the last leg, the anchor (index out.size()).
+struct WatchedLeg {
+  const HybridModel& model;
+  const HybridAutomaton& a;
+  const std::vector<int>& out;
+  const Vector& p;  // the model's parameter values
+  const Vector& xi;
+  const Phase& ph;
+  bool last;
+  PhaseFlow& flow;
+
+  // The watched functions at y.
+  std::vector<double> Values(const Eigen::Ref<const Vector>& y) const {
+    std::vector<double> v;
+    for (int t : out) v.push_back(a.transitions()[t].guard->Evaluate(y, p, nullptr, nullptr));
+    if (last) v.push_back(model.anchor().Evaluate(y, nullptr));
+    return v;
+  }
+  // Their rates along the flow at y, ġ = ∇g · f.
+  std::vector<double> Rates(const Eigen::Ref<const Vector>& y) const {
+    Vector f;
+    ph.UnfoldedVectorField(y, xi, &f, nullptr, nullptr);
+    std::vector<double> v;
+    RowVector dg;
+    for (int t : out) a.transitions()[t].guard->Evaluate(y, p, &dg, nullptr), v.push_back(dg.dot(f));
+    if (last) model.anchor().Evaluate(y, &dg), v.push_back(dg.dot(f));
+    return v;
+  }
+  // The state the flow reaches from `from` after time t; empty if the integration fails.
+  Vector StateAt(const Vector& from, double t) const {
+    PhaseFlowResult r;
+    flow.Integrate(from, xi, t, false, &r);
+    return r.ok() ? r.x : Vector();
+  }
+};
+
+// The first downward crossing among a leg's watched functions: its index (-1: none), time and state.
+struct LegCrossing {
+  int first = -1;
+  double t = std::numeric_limits<double>::infinity();
+  Vector x;
+};
+
+// Scans consecutive samples of a leg for downward crossings of the watched functions, up to the first pair
+// of samples between which one is found, and keeps in *crossing the earliest (when earlier than the one it
+// holds). A crossing is located by bisection in time, integrating from the earlier sample of its pair.
+//
+// The integrator's steps may step over a shallow dip of a guard (a swing foot that grazes the ground): where
+// a guard positive at both ends of a step has its rate go from negative to positive, its minimum in between
+// is located (bisection on the rate) and, if it is <= 0, the crossing lies before it. Likewise a shallow
+// bump above 0 of a guard negative at both ends arms it, and the crossing lies after its maximum.
+void ScanForFirstCrossing(const WatchedLeg& watched, const std::vector<Sample>& samples, LegCrossing* crossing) {
+  int& first = crossing->first;
+  double& t_cross = crossing->t;
+  Vector& x_cross = crossing->x;
+  std::vector<double> before = watched.Values(samples[0].y), rate_before = watched.Rates(samples[0].y);
+  if (samples[0].t == 0) {
+    for (double& v : before) v = v > kGuardStartTolerance ? v : 0.0;  // on or below a guard: not above it
+  }
+  for (std::size_t s = 1; s < samples.size() && first < 0; ++s) {
+    const Vector& y0 = samples[s - 1].y;
+    const std::vector<double> after = watched.Values(samples[s].y), rate_after = watched.Rates(samples[s].y);
+    for (std::size_t j = 0; j < after.size(); ++j) {
+      double hi = samples[s].t - samples[s - 1].t;
+      Vector y_hi = samples[s].y;
+      double lo = 0;
+      if (before[j] > 0 && after[j] > 0 && rate_before[j] < 0 && rate_after[j] > 0) {
+        for (int b = 0; b < kBisections; ++b) {  // the minimum: the rate's zero
+          const double mid = 0.5 * (lo + hi);
+          const Vector y = watched.StateAt(y0, mid);
+          if (y.size() == 0) break;
+          if (watched.Rates(y)[j] < 0) lo = mid;
+          else hi = mid, y_hi = y;
+        }
+        if (!(watched.Values(y_hi)[j] <= 0)) continue;
+        lo = 0;
+      } else if (before[j] <= 0 && after[j] <= 0 && rate_before[j] > 0 && rate_after[j] < 0) {
+        // A bump above 0 between the samples (a foot that barely clears the ground) arms the guard, and
+        // it is crossed on the way down after the maximum; one by no more than the event flow's touch
+        // tolerance does not (a foot that starts on the ground and sinks into it at once, rising by
+        // rounding first), as in the replay of the word (event_flow.h).
+        double top = hi;
+        Vector y_top = y_hi;
+        for (int b = 0; b < kBisections; ++b) {  // the maximum: the rate's zero
+          const double mid = 0.5 * (lo + top);
+          const Vector y = watched.StateAt(y0, mid);
+          if (y.size() == 0) break;
+          if (watched.Rates(y)[j] > 0) lo = mid;
+          else top = mid, y_top = y;
+        }
+        if (!(watched.Values(y_top)[j] > EventFlowOptions{}.touch_tolerance)) continue;
+        lo = top;
+      } else if (!(before[j] > 0 && after[j] <= 0)) {
+        continue;
+      }
+      // Bisection in [t_{s-1} + lo, t_{s-1} + hi], integrating from sample s-1.
+      for (int b = 0; b < kBisections; ++b) {
+        const double mid = 0.5 * (lo + hi);
+        const Vector y = watched.StateAt(y0, mid);
+        if (y.size() == 0) break;
+        if (watched.Values(y)[j] > 0) lo = mid;
+        else hi = mid, y_hi = y;
+      }
+      if (samples[s - 1].t + hi < t_cross) t_cross = samples[s - 1].t + hi, first = static_cast<int>(j), x_cross = y_hi;
+    }
+    before = after;
+    rate_before = rate_after;
+  }
+}
+
 }  // namespace
 
 AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u, const IntegratorOptions& integrator) {
@@ -48,32 +165,12 @@ AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u,
     const int phase = phase_of_mode[mode];
     HYBRIDCONT_DEMAND(phase >= 0);  // modes are entered by transitions of the word only
     const std::vector<int> out = a.TransitionsFrom(mode);
-    // The functions watched: the guards out of the mode, and on the last leg the anchor (index out.size()).
     const bool last = leg == m;
-    const auto values = [&](const Eigen::Ref<const Vector>& y) {
-      std::vector<double> v;
-      for (int t : out) v.push_back(a.transitions()[t].guard->Evaluate(y, p, nullptr, nullptr));
-      if (last) v.push_back(model.anchor().Evaluate(y, nullptr));
-      return v;
-    };
-    // Their rates along the flow, ġ = ∇g · f.
     const Phase& ph = model.phase(phase);
-    const auto rates = [&](const Eigen::Ref<const Vector>& y) {
-      Vector f;
-      ph.UnfoldedVectorField(y, xi, &f, nullptr, nullptr);
-      std::vector<double> v;
-      RowVector dg;
-      for (int t : out) a.transitions()[t].guard->Evaluate(y, p, &dg, nullptr), v.push_back(dg.dot(f));
-      if (last) model.anchor().Evaluate(y, &dg), v.push_back(dg.dot(f));
-      return v;
-    };
-    struct Sample {
-      double t;
-      Vector y;
-    };
     std::vector<Sample> samples;
     PhaseFlow flow(model.phase(phase), integrator);
     PhaseFlowResult res;
+    const WatchedLeg watched{model, a, out, p, xi, ph, last, flow};
     // The word's own duration of this leg, with a margin, first; the rest of the horizon only when no guard is
     // crossed within it (the orbit is not one of the automaton then, or leaves the word later).
     const double expected = std::abs(u(layout.time_index(leg))) * (1 + kLegMargin) + kLegMargin;
@@ -88,92 +185,28 @@ AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u,
       return result;
     }
     // The first downward crossing among the watched functions in the samples so far.
-    int first = -1;
-    double t_cross = std::numeric_limits<double>::infinity();
-    Vector x_cross;
-    // The integrator's steps may step over a shallow dip of a guard (a swing foot that grazes the ground): where
-    // a guard positive at both ends of a step has its rate go from negative to positive, its minimum in between
-    // is located (bisection on the rate) and, if it is <= 0, the crossing lies before it. Likewise a shallow
-    // bump above 0 of a guard negative at both ends arms it, and the crossing lies after its maximum.
-    const auto state_at = [&](const Vector& from, double t) {
-      PhaseFlowResult r;
-      flow.Integrate(from, xi, t, false, &r);
-      return r.ok() ? r.x : Vector();
-    };
-    const auto scan = [&]() {
-      std::vector<double> before = values(samples[0].y), rate_before = rates(samples[0].y);
-      if (samples[0].t == 0) {
-        for (double& v : before) v = v > kGuardStartTolerance ? v : 0.0;  // on or below a guard: not above it
-      }
-      for (std::size_t s = 1; s < samples.size() && first < 0; ++s) {
-        const Vector& y0 = samples[s - 1].y;
-        const std::vector<double> after = values(samples[s].y), rate_after = rates(samples[s].y);
-        for (std::size_t j = 0; j < after.size(); ++j) {
-          double hi = samples[s].t - samples[s - 1].t;
-          Vector y_hi = samples[s].y;
-          double lo = 0;
-          if (before[j] > 0 && after[j] > 0 && rate_before[j] < 0 && rate_after[j] > 0) {
-            for (int b = 0; b < kBisections; ++b) {  // the minimum: the rate's zero
-              const double mid = 0.5 * (lo + hi);
-              const Vector y = state_at(y0, mid);
-              if (y.size() == 0) break;
-              if (rates(y)[j] < 0) lo = mid;
-              else hi = mid, y_hi = y;
-            }
-            if (!(values(y_hi)[j] <= 0)) continue;
-            lo = 0;
-          } else if (before[j] <= 0 && after[j] <= 0 && rate_before[j] > 0 && rate_after[j] < 0) {
-            // A bump above 0 between the samples (a foot that barely clears the ground) arms the guard, and
-            // it is crossed on the way down after the maximum; one by no more than the event flow's touch
-            // tolerance does not (a foot that starts on the ground and sinks into it at once, rising by
-            // rounding first), as in the replay of the word (event_flow.h).
-            double top = hi;
-            Vector y_top = y_hi;
-            for (int b = 0; b < kBisections; ++b) {  // the maximum: the rate's zero
-              const double mid = 0.5 * (lo + top);
-              const Vector y = state_at(y0, mid);
-              if (y.size() == 0) break;
-              if (rates(y)[j] > 0) lo = mid;
-              else top = mid, y_top = y;
-            }
-            if (!(values(y_top)[j] > EventFlowOptions{}.touch_tolerance)) continue;
-            lo = top;
-          } else if (!(before[j] > 0 && after[j] <= 0)) {
-            continue;
-          }
-          // Bisection in [t_{s-1} + lo, t_{s-1} + hi], integrating from sample s-1.
-          for (int b = 0; b < kBisections; ++b) {
-            const double mid = 0.5 * (lo + hi);
-            const Vector y = state_at(y0, mid);
-            if (y.size() == 0) break;
-            if (values(y)[j] > 0) lo = mid;
-            else hi = mid, y_hi = y;
-          }
-          if (samples[s - 1].t + hi < t_cross) t_cross = samples[s - 1].t + hi, first = static_cast<int>(j), x_cross = y_hi;
-        }
-        before = after;
-        rate_before = rate_after;
-      }
-    };
-    scan();
-    if (first < 0 && samples.back().t < horizon - elapsed) {  // not within the expected duration: the rest
-      const Sample last = samples.back();
+    LegCrossing crossing;
+    ScanForFirstCrossing(watched, samples, &crossing);
+    if (crossing.first < 0 && samples.back().t < horizon - elapsed) {  // not within the expected duration: the rest
+      const Sample last_sample = samples.back();
       samples.erase(samples.begin(), samples.end() - 1);
-      if (integrate(last.y, last.t, horizon - elapsed - last.t)) scan();
+      if (integrate(last_sample.y, last_sample.t, horizon - elapsed - last_sample.t)) {
+        ScanForFirstCrossing(watched, samples, &crossing);
+      }
     }
-    if (first < 0) {
+    if (crossing.first < 0) {
       result.message = fmt::format("no guard out of mode '{}' is crossed within t = {:.6g}", a.modes()[mode].name,
                                    horizon - elapsed);
       return result;
     }
-    elapsed += t_cross;
-    if (last && first == static_cast<int>(out.size())) {  // back at the section
+    elapsed += crossing.t;
+    if (last && crossing.first == static_cast<int>(out.size())) {  // back at the section
       result.ok = true;
       result.same_word = result.taken == word;
-      result.return_error = (x_cross - x1).norm();
+      result.return_error = (crossing.x - x1).norm();
       return result;
     }
-    const int tau = out[first];
+    const int tau = out[crossing.first];
     result.taken.push_back(tau);
     if (phase_of_transition[tau] < 0 || leg == m) {
       result.ok = true;
@@ -181,7 +214,7 @@ AutomatonReplayResult ReplayAutomaton(const HybridModel& model, const Vector& u,
                                    a.transitions()[tau].name, elapsed);
       return result;
     }
-    model.phase(phase_of_transition[tau]).Reset(x_cross, &x, nullptr);
+    model.phase(phase_of_transition[tau]).Reset(crossing.x, &x, nullptr);
     mode = a.transitions()[tau].to;
   }
   HYBRIDCONT_UNREACHABLE();

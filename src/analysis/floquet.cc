@@ -123,6 +123,78 @@ std::string StabilityClass::ToString() const {
   return "unstable (" + kinds + ")";
 }
 
+namespace {
+
+// The multipliers inside the unit circle as reciprocals of B^T Phi_T^{-1} B's outside it, when both
+// count the same number there (they do, but for multipliers on the circle within rounding): then
+// res->nontrivial becomes the multipliers outside the circle followed by those reciprocals, and
+// res->from_inverse_product is set; otherwise res is left as it is.
+void TakeInsideMultipliersFromInverse(const Matrix& B, const Matrix& inverse, int reduced_dim, FloquetResult* res) {
+  const Eigen::VectorXcd dual = Eigenvalues(B.transpose() * inverse * B);
+  if (dual.size() == reduced_dim) {
+    std::vector<std::complex<double>> outside, inside;
+    for (const auto& mu : res->nontrivial) {
+      if (std::abs(mu) >= 1.0) outside.push_back(mu);
+    }
+    for (int i = 0; i < reduced_dim; ++i) {
+      const std::complex<double> nu = dual(i);
+      if (std::abs(nu) > 1.0) inside.push_back(1.0 / nu);
+    }
+    if (outside.size() + inside.size() == static_cast<std::size_t>(reduced_dim)) {
+      outside.insert(outside.end(), inside.begin(), inside.end());
+      res->nontrivial = std::move(outside);
+      res->from_inverse_product = true;
+    }
+  }
+}
+
+// Deflates the res->num_trivial trivial multipliers: with B orthonormal, spanning ker dH ∩ f^⊥, or f^⊥
+// without a first integral (see the header), appends the eigenvalues of B^T Phi_T B to res->nontrivial
+// (unsorted), those inside the unit circle taken from B^T Phi_T^{-1} B when a finite inverse is given.
+// False, with res's status and message set, if the EigenSolver fails on B^T Phi_T B.
+bool DeflateTrivialMultipliers(const Matrix& monodromy, const Vector& f0, const RowVector& dH0, bool conservative,
+                               const Matrix* inverse, FloquetResult* res) {
+  const int n = static_cast<int>(monodromy.rows());
+  const int reduced_dim = n - res->num_trivial;
+  if (reduced_dim > 0) {
+    Matrix Q1 = Matrix::Identity(n, n);  // ker dH (everything without a first integral)
+    if (conservative) Q1 = Matrix(Eigen::HouseholderQR<Matrix>(dH0.transpose()).householderQ()).rightCols(n - 1);
+    const Vector c = Q1.transpose() * f0;
+    const Matrix Qc = Eigen::HouseholderQR<Matrix>(c).householderQ();
+    const Matrix B = Q1 * Qc.rightCols(reduced_dim);
+    const Matrix M = B.transpose() * monodromy * B;
+    const Eigen::VectorXcd reduced = Eigenvalues(M);
+    if (reduced.size() != reduced_dim) {
+      res->status = FloquetStatus::kEigenFailed;
+      res->message = "EigenSolver failed on the deflated monodromy";
+      return false;
+    }
+    for (int i = 0; i < reduced_dim; ++i) res->nontrivial.push_back(reduced(i));
+    if (inverse != nullptr && inverse->allFinite()) TakeInsideMultipliersFromInverse(B, *inverse, reduced_dim, res);
+  }
+  return true;
+}
+
+// At a located branch point (FloquetOptions::at_branch_point): the cluster of nontrivial multipliers
+// colliding at +1, those within branch_point_radius of it when the product of their distances to it is at
+// most branch_point_product; all false otherwise.
+std::vector<bool> CollidingAtBranchPoint(const std::vector<std::complex<double>>& nontrivial,
+                                         const FloquetOptions& options) {
+  std::vector<bool> colliding(nontrivial.size(), false);
+  if (options.at_branch_point) {
+    double product = 1.0;
+    bool any = false;
+    for (std::size_t i = 0; i < nontrivial.size(); ++i) {
+      const double distance = std::abs(nontrivial[i] - 1.0);
+      if (distance <= options.branch_point_radius) colliding[i] = any = true, product *= distance;
+    }
+    if (!any || !(product <= options.branch_point_product)) colliding.assign(colliding.size(), false);
+  }
+  return colliding;
+}
+
+}  // namespace
+
 FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const RowVector& dH0,
                                const FloquetOptions& options, const Matrix* inverse) {
   FloquetResult res;
@@ -155,43 +227,7 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
     return da != db ? da < db : a.imag() > b.imag();
   });
 
-  // Deflate the trivial multipliers: B orthonormal, spanning ker dH ∩ f^⊥, or f^⊥ (see the header).
-  const int reduced_dim = n - res.num_trivial;
-  if (reduced_dim > 0) {
-    Matrix Q1 = Matrix::Identity(n, n);  // ker dH (everything without a first integral)
-    if (conservative) Q1 = Matrix(Eigen::HouseholderQR<Matrix>(dH0.transpose()).householderQ()).rightCols(n - 1);
-    const Vector c = Q1.transpose() * f0;
-    const Matrix Qc = Eigen::HouseholderQR<Matrix>(c).householderQ();
-    const Matrix B = Q1 * Qc.rightCols(reduced_dim);
-    const Matrix M = B.transpose() * monodromy * B;
-    const Eigen::VectorXcd reduced = Eigenvalues(M);
-    if (reduced.size() != reduced_dim) {
-      res.status = FloquetStatus::kEigenFailed;
-      res.message = "EigenSolver failed on the deflated monodromy";
-      return res;
-    }
-    for (int i = 0; i < reduced_dim; ++i) res.nontrivial.push_back(reduced(i));
-    if (inverse != nullptr && inverse->allFinite()) {
-      // The multipliers inside the unit circle as reciprocals of B^T Phi_T^{-1} B's outside it, when both
-      // count the same number there (they do, but for multipliers on the circle within rounding).
-      const Eigen::VectorXcd dual = Eigenvalues(B.transpose() * *inverse * B);
-      if (dual.size() == reduced_dim) {
-        std::vector<std::complex<double>> outside, inside;
-        for (const auto& mu : res.nontrivial) {
-          if (std::abs(mu) >= 1.0) outside.push_back(mu);
-        }
-        for (int i = 0; i < reduced_dim; ++i) {
-          const std::complex<double> nu = dual(i);
-          if (std::abs(nu) > 1.0) inside.push_back(1.0 / nu);
-        }
-        if (outside.size() + inside.size() == static_cast<std::size_t>(reduced_dim)) {
-          outside.insert(outside.end(), inside.begin(), inside.end());
-          res.nontrivial = std::move(outside);
-          res.from_inverse_product = true;
-        }
-      }
-    }
-  }
+  if (!DeflateTrivialMultipliers(monodromy, f0, dH0, conservative, inverse, &res)) return res;
   std::sort(res.nontrivial.begin(), res.nontrivial.end(), [](const auto& a, const auto& b) {
     const double ma = std::abs(a), mb = std::abs(b);
     return ma != mb ? ma > mb : a.imag() > b.imag();
@@ -202,17 +238,7 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
   res.max_modulus = 1.0;
   res.stable = true;
   res.asymptotically_stable = !conservative;
-  // At a located branch point: the cluster colliding at +1 (FloquetOptions::at_branch_point).
-  std::vector<bool> colliding(res.nontrivial.size(), false);
-  if (options.at_branch_point) {
-    double product = 1.0;
-    bool any = false;
-    for (std::size_t i = 0; i < res.nontrivial.size(); ++i) {
-      const double distance = std::abs(res.nontrivial[i] - 1.0);
-      if (distance <= options.branch_point_radius) colliding[i] = any = true, product *= distance;
-    }
-    if (!any || !(product <= options.branch_point_product)) colliding.assign(colliding.size(), false);
-  }
+  const std::vector<bool> colliding = CollidingAtBranchPoint(res.nontrivial, options);
   for (std::size_t i = 0; i < res.nontrivial.size(); ++i) {
     const std::complex<double>& mu = res.nontrivial[i];
     bp *= mu - 1.0;

@@ -336,6 +336,110 @@ SpecialPoint SpecialPointDetector::LocateTestZero(int j, const CurveSample& l, c
   return point;
 }
 
+namespace {
+
+// Golden-section search for the minimum of a function on σ ∈ [0, width], bracketed by its values at the
+// ends: eval(σ, &sample) is the value at σ (NaN where it cannot be evaluated, which ends the search), its
+// point left in sample. Stops once the bracket is below 1e-6 of width. True, at once, when a value is
+// negative (the other sign); otherwise false with the final bracket in [*a_out, *b_out].
+template <class Sample, class Eval>
+bool GoldenSectionSearch(Eval&& eval, double width, double* a_out, double* b_out) {
+  constexpr double kGolden = 0.6180339887498949;
+  double a = 0, b = width;
+  double x1 = b - kGolden * (b - a), x2 = a + kGolden * (b - a);
+  Sample c1, c2;
+  double f1 = eval(x1, &c1), f2 = eval(x2, &c2);
+  while (std::isfinite(f1) && std::isfinite(f2)) {
+    if (f1 < 0 || f2 < 0) return true;
+    if (b - a < 1e-6 * width) break;
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1, c2 = c1;
+      x1 = b - kGolden * (b - a);
+      f1 = eval(x1, &c1);
+    } else {
+      a = x1, x1 = x2, f1 = f2, c1 = c2;
+      x2 = a + kGolden * (b - a);
+      f2 = eval(x2, &c2);
+    }
+  }
+  *a_out = a, *b_out = b;
+  return false;
+}
+
+// Brent's minimization of f (parabolic steps with a golden-section fallback) on the bracket [*a_io, *b_io]
+// from x, where f(x) = fx, to `tolerance` in σ, with at most max_evaluations evaluations; a non-finite
+// value ends it. True, at once, when f takes a negative value (the other sign); otherwise false with the
+// narrowed bracket in [*a_io, *b_io].
+template <class F>
+bool BrentMinimize(F&& f, double tolerance, int max_evaluations, double x, double fx, double* a_io, double* b_io) {
+  constexpr double kGoldenStep = 0.3819660112501051;
+  double a = *a_io, b = *b_io;
+  double w = x, v = x;
+  double fw = fx, fv = fx;
+  double d = 0, e = 0;
+  for (int it = 0; it < max_evaluations; ++it) {
+    const double mid = 0.5 * (a + b);
+    const double tol1 = 0.5 * tolerance + 1e-15 * std::abs(x), tol2 = 2 * tol1;
+    if (std::abs(x - mid) <= tol2 - 0.5 * (b - a)) break;
+    bool golden = true;
+    if (std::abs(e) > tol1) {
+      // The parabola through (x, fx), (w, fw), (v, fv): its vertex x + p/q.
+      const double rr = (x - w) * (fx - fv);
+      double q = (x - v) * (fx - fw);
+      double p = (x - v) * q - (x - w) * rr;
+      q = 2 * (q - rr);
+      if (q > 0) p = -p;
+      q = std::abs(q);
+      const double previous = e;
+      e = d;
+      if (std::abs(p) < std::abs(0.5 * q * previous) && p > q * (a - x) && p < q * (b - x)) {
+        d = p / q;
+        golden = false;
+        if ((x + d) - a < tol2 || b - (x + d) < tol2) d = mid > x ? tol1 : -tol1;
+      }
+    }
+    if (golden) {
+      e = x >= mid ? a - x : b - x;
+      d = kGoldenStep * e;
+    }
+    const double u = x + (std::abs(d) >= tol1 ? d : (d > 0 ? tol1 : -tol1));
+    const double fu = f(u);
+    if (!std::isfinite(fu)) break;
+    if (fu < 0) return true;
+    if (fu <= fx) {
+      (u >= x ? a : b) = x;
+      v = w, fv = fw, w = x, fw = fx, x = u, fx = fu;
+    } else {
+      (u < x ? a : b) = u;
+      if (fu <= fw || w == x) {
+        v = w, fv = fw, w = u, fw = fu;
+      } else if (fu <= fv || v == x || v == w) {
+        v = u, fv = fu;
+      }
+    }
+  }
+  *a_io = a, *b_io = b;
+  return false;
+}
+
+// The miss distance sqrt(value/κ) of the bowl g ≈ κ(σ − σ*)² + value around a minimum `value` at σ* =
+// sigma, with κ from the evaluation (σ, g) in trace nearest σ* whose value is well above the minimum (the
+// minimum's own neighbours are at its noise); half the bracket where there is none.
+double BowlMissDistance(const std::vector<std::pair<double, double>>& trace, double sigma, double value,
+                        double bracket) {
+  double kappa = 0, nearest = std::numeric_limits<double>::infinity();
+  for (const auto& [s, g] : trace) {
+    const double distance = std::abs(s - sigma);
+    if (g > 100 * std::max(value, 0.0) && distance > 0 && distance < nearest) {
+      nearest = distance;
+      kappa = (g - value) / (distance * distance);
+    }
+  }
+  return kappa > 0 ? std::sqrt(std::max(value, 0.0) / kappa) : 0.5 * bracket;
+}
+
+}  // namespace
+
 // Golden-section search for the minimum of sign·g_j on each of the intervals l–m and m–r (the one the
 // parabola through the three samples points to first), stopped at the first sample of the other sign.
 // Where the smallest value found is a candidate touching zero, Brent's method (parabolic steps with a
@@ -377,26 +481,10 @@ SpecialPointDetector::CurveMinimum SpecialPointDetector::MinimizeOnCurve(int j, 
       return v;
     };
     // Golden section on σ ∈ [0, width] of this interval, the minimum bracketed by the samples' values.
-    constexpr double kGolden = 0.6180339887498949;
-    double a = 0, b = width;
-    double x1 = b - kGolden * (b - a), x2 = a + kGolden * (b - a);
-    CurveSample c1, c2;
-    double f1 = eval(x1, &c1), f2 = eval(x2, &c2);
-    while (std::isfinite(f1) && std::isfinite(f2)) {
-      if (f1 < 0 || f2 < 0) {
-        best.other_sign = true;
-        return best;
-      }
-      if (b - a < 1e-6 * width) break;
-      if (f1 < f2) {
-        b = x2, x2 = x1, f2 = f1, c2 = c1;
-        x1 = b - kGolden * (b - a);
-        f1 = eval(x1, &c1);
-      } else {
-        a = x1, x1 = x2, f1 = f2, c1 = c2;
-        x2 = a + kGolden * (b - a);
-        f2 = eval(x2, &c2);
-      }
+    double a = 0, b = 0;
+    if (GoldenSectionSearch<CurveSample>(eval, width, &a, &b)) {
+      best.other_sign = true;
+      return best;
     }
     side.searched = true;
     side.a = a, side.b = b;
@@ -422,71 +510,15 @@ SpecialPointDetector::CurveMinimum SpecialPointDetector::MinimizeOnCurve(int j, 
       if (v < best.value) best.value = v, best.sample = std::move(c), best.sigma = x, best.left = on_left;
       return v;
     };
-    constexpr double kGoldenStep = 0.3819660112501051;
-    double a = side.a, b = side.b;
-    double x = at_m ? (on_left ? b : a) : best.sigma;
-    double w = x, v = x;
-    double fx = best.value, fw = fx, fv = fx;
-    double d = 0, e = 0;
-    for (int it = 0; it < kTouchEvaluations; ++it) {
-      const double mid = 0.5 * (a + b);
-      const double tol1 = 0.5 * location_tolerance_ + 1e-15 * std::abs(x), tol2 = 2 * tol1;
-      if (std::abs(x - mid) <= tol2 - 0.5 * (b - a)) break;
-      bool golden = true;
-      if (std::abs(e) > tol1) {
-        // The parabola through (x, fx), (w, fw), (v, fv): its vertex x + p/q.
-        const double rr = (x - w) * (fx - fv);
-        double q = (x - v) * (fx - fw);
-        double p = (x - v) * q - (x - w) * rr;
-        q = 2 * (q - rr);
-        if (q > 0) p = -p;
-        q = std::abs(q);
-        const double previous = e;
-        e = d;
-        if (std::abs(p) < std::abs(0.5 * q * previous) && p > q * (a - x) && p < q * (b - x)) {
-          d = p / q;
-          golden = false;
-          if ((x + d) - a < tol2 || b - (x + d) < tol2) d = mid > x ? tol1 : -tol1;
-        }
-      }
-      if (golden) {
-        e = x >= mid ? a - x : b - x;
-        d = kGoldenStep * e;
-      }
-      const double u = x + (std::abs(d) >= tol1 ? d : (d > 0 ? tol1 : -tol1));
-      const double fu = f(u);
-      if (!std::isfinite(fu)) break;
-      if (fu < 0) {
-        best.other_sign = true;
-        return best;
-      }
-      if (fu <= fx) {
-        (u >= x ? a : b) = x;
-        v = w, fv = fw, w = x, fw = fx, x = u, fx = fu;
-      } else {
-        (u < x ? a : b) = u;
-        if (fu <= fw || w == x) {
-          v = w, fv = fw, w = u, fw = fu;
-        } else if (fu <= fv || v == x || v == w) {
-          v = u, fv = fu;
-        }
-      }
+    const double x = at_m ? (on_left ? side.b : side.a) : best.sigma;
+    if (BrentMinimize(f, location_tolerance_, kTouchEvaluations, x, best.value, &side.a, &side.b)) {
+      best.other_sign = true;
+      return best;
     }
-    side.a = a, side.b = b;
   }
   const Side& side = sides[best.left ? 0 : 1];
   best.bracket = side.b - side.a;
-  // The bowl's curvature from the evaluation nearest σ* whose value is well above the minimum (the
-  // minimum's own neighbours are at its noise).
-  double kappa = 0, nearest = std::numeric_limits<double>::infinity();
-  for (const auto& [sigma, g] : side.trace) {
-    const double distance = std::abs(sigma - best.sigma);
-    if (g > 100 * std::max(best.value, 0.0) && distance > 0 && distance < nearest) {
-      nearest = distance;
-      kappa = (g - best.value) / (distance * distance);
-    }
-  }
-  best.miss = kappa > 0 ? std::sqrt(std::max(best.value, 0.0) / kappa) : 0.5 * best.bracket;
+  best.miss = BowlMissDistance(side.trace, best.sigma, best.value, best.bracket);
   return best;
 }
 

@@ -23,6 +23,10 @@
 #include "hybridcont/shooting_layout.h"
 #include "model_compiler.h"
 
+namespace hybridcont {
+struct MechanicalSystem;  // mechanics.h
+}  // namespace hybridcont
+
 namespace hybridcont::internal {
 
 class Reader {
@@ -168,6 +172,19 @@ class Reader {
   // kinetic/potential or mass_matrix/forces/potential, and impact: derives the equations of motion
   // (mechanics.h), checks them and stores M for explanations.
   Mechanics ReadMechanics(int i);
+  // Phase i's (table t, field pf) kinetic and potential (T, V), or mass_matrix (M, n × n rows of expressions),
+  // and forces (Q, keyed by coordinate; null where not given), with where each came from, into *system.
+  void ReadEnergiesAndForces(int i, const toml::table& t, const std::string& pf, MechanicalSystem* system);
+  // The contact of phase i's impact (at field, its keys checked): its constraints g(q), several for a contact
+  // that neither slips nor rebounds; sets out->constraint_where, and out->constraint for a single one.
+  std::vector<ExprPtr> ReadContactConstraints(int i, const toml::table& impact, const std::string& field,
+                                              Mechanics* out);
+  // The impact's (at field) restitution e: a number in [0, 1] or an expression of the parameters (a parameter
+  // to continue in), 1 if not given; only the elastic law (1) in a conservative model.
+  ExprPtr ReadRestitution(const toml::table& impact, const std::string& field);
+  // The relabelling q' = S(q) after phase i's impact (rl, the table `relabel` of the impact at field): keyed
+  // by coordinate, an expression of the coordinates; per coordinate, null where not given.
+  std::vector<ExprPtr> ReadRelabelling(int i, const toml::table& rl, const std::string& field);
   void ReadSymmetries();
 
   // ---- sections (read_observables.cc)

@@ -84,7 +84,134 @@ std::string FormatNumber(double v) {
   os << v;
   return os.str();
 }
+
+// The state (of a phase with states state_names) holding a coordinate's or velocity's name s; -1 for an
+// ignorable coordinate (derivatives in it vanish: no input is -1), state_names.size() for a name that is no state.
+int StateIndex(const std::set<std::string>& ignorable, const std::vector<std::string>& state_names,
+               const std::string& s) {
+  if (ignorable.count(s)) return -1;
+  return static_cast<int>(std::find(state_names.begin(), state_names.end(), s) - state_names.begin());
+}
+
+// The states at which a phase's mechanics is checked in values: its typical state and two others around it
+// (dim states each; the velocities, at the indices given, reversed and scaled in the third).
+std::vector<Vector> MechanicsCheckStates(const Vector& typical_state, int dim, const std::vector<int>& velocities) {
+  std::vector<Vector> states;
+  for (int k = 0; k < 3; ++k) {
+    Vector x = typical_state;
+    for (int j = 0; j < dim; ++j) x(j) += k == 0 ? 0.0 : 0.1 * (k == 1 ? 1.0 + 0.3 * j : -1.0 + 0.2 * j);
+    for (int v : velocities) x(v) *= k == 2 ? -1.7 : 1.0;
+    states.push_back(x);
+  }
+  return states;
+}
 }  // namespace
+
+void Reader::ReadEnergiesAndForces(int i, const toml::table& t, const std::string& pf, MechanicalSystem* system) {
+  const MechanicalNames& names = mechanical_names_[i];
+  const ExpressionPhaseSpec& p = spec_.phases[i];
+  const int n = static_cast<int>(names.coordinates.size());
+  if (const toml::node* kinetic = t.get("kinetic")) {
+    system->kinetic = ParsePhaseExpression(i, *kinetic, pf + ".kinetic");
+    system->kinetic_where = At(kinetic, pf + ".kinetic");
+  }
+  if (const toml::node* potential = t.get("potential")) {
+    system->potential = ParsePhaseExpression(i, *potential, pf + ".potential");
+    system->potential_where = At(potential, pf + ".potential");
+  }
+  if (const toml::node* mass = t.get("mass_matrix")) {
+    const std::string field = pf + ".mass_matrix";
+    system->mass_matrix_where = At(mass, field);
+    const toml::array& rows = AsArray(*mass, field);
+    if (static_cast<int>(rows.size()) != n) {
+      Fail(mass, field, std::to_string(rows.size()) + " rows for " + std::to_string(n) + " coordinates (M is n × n)");
+    }
+    for (int r = 0; r < n; ++r) {
+      const std::string rf = field + "[" + std::to_string(r) + "]";
+      const toml::array& row = AsArray(*rows.get(r), rf);
+      if (static_cast<int>(row.size()) != n) {
+        Fail(rows.get(r), rf, std::to_string(row.size()) + " entries for " + std::to_string(n) + " coordinates");
+      }
+      system->mass_matrix.emplace_back();
+      for (int c = 0; c < n; ++c) {
+        system->mass_matrix.back().push_back(
+            ParsePhaseExpression(i, *row.get(c), rf + "[" + std::to_string(c) + "]"));
+      }
+    }
+  }
+  system->forces.assign(n, nullptr);
+  if (const toml::table* forces = OptionalTable(t, "forces", pf)) {
+    system->forces_where = At(forces, pf + ".forces");
+    for (auto&& [key, node] : *forces) {
+      const std::string name(key.str());
+      const auto it = std::find(names.coordinates.begin(), names.coordinates.end(), name);
+      if (it == names.coordinates.end()) {
+        Fail(&node, pf + ".forces." + name, "'" + name + "' is not a coordinate of phase '" + p.name +
+                                                "' (forces are keyed by coordinate: " + JoinNames(names.coordinates) +
+                                                ")");
+      }
+      system->forces[it - names.coordinates.begin()] = ParsePhaseExpression(i, node, pf + ".forces." + name);
+    }
+  }
+}
+
+std::vector<ExprPtr> Reader::ReadContactConstraints(int i, const toml::table& impact, const std::string& field,
+                                                    Mechanics* out) {
+  std::vector<ExprPtr> constraints;
+  CheckKeys(impact, field, {"constraint", "restitution", "relabel"});
+  const toml::node* g = impact.get("constraint");
+  if (g == nullptr) {
+    Fail(&impact, field + ".constraint", "missing field 'constraint' (the contact's g(q); impact at g = 0)");
+  }
+  out->constraint_where = At(g, field + ".constraint");
+  if (g->is_array()) {  // a contact of several constraints: a point that neither slips nor rebounds
+    const toml::array& rows = *g->as_array();
+    if (rows.empty()) Fail(g, field + ".constraint", "an empty list of constraints");
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      constraints.push_back(
+          ParsePhaseExpression(i, *rows.get(r), field + ".constraint[" + std::to_string(r) + "]"));
+    }
+  } else {
+    constraints.push_back(ParsePhaseExpression(i, *g, field + ".constraint"));
+    out->constraint = constraints[0];
+  }
+  return constraints;
+}
+
+ExprPtr Reader::ReadRestitution(const toml::table& impact, const std::string& field) {
+  ExprPtr e = MakeConstant(1.0);
+  if (const toml::node* r = impact.get("restitution")) {
+    const std::string rf = field + ".restitution";
+    e = ParseExpression(ExpressionText(*r, rf), [this](const std::string& name) { return GlobalSymbol(name); },
+                        At(r, rf));
+    if (e->op == ExprOp::kConstant && !(e->value >= 0.0 && e->value <= 1.0)) {
+      Fail(r, rf, "restitution " + FormatNumber(e->value) + " is outside [0, 1]");
+    }
+    if (conservative_ && !IsConstant(e, 1.0)) {
+      const std::string shown = e->op == ExprOp::kConstant ? FormatNumber(e->value) : ExpressionText(*r, rf);
+      Fail(r, rf, "restitution " + shown + ": only the elastic law (1), which conserves the "
+                  "energy, is possible in a conservative model (declare conservative = false for a dissipative one)");
+    }
+  }
+  return e;
+}
+
+std::vector<ExprPtr> Reader::ReadRelabelling(int i, const toml::table& rl, const std::string& field) {
+  const MechanicalNames& names = mechanical_names_[i];
+  const ExpressionPhaseSpec& p = spec_.phases[i];
+  std::vector<ExprPtr> relabel(names.coordinates.size());
+  for (auto&& [key, node] : rl) {
+    const std::string name(key.str());
+    const std::string rf = field + ".relabel." + name;
+    const auto it = std::find(names.coordinates.begin(), names.coordinates.end(), name);
+    if (it == names.coordinates.end() || names.ignorable.count(name)) {
+      Fail(&node, rf, "'" + name + "' is not a coordinate of phase '" + p.name + "' that is a state (the " +
+                          "relabelling gives coordinates after the impact: " + JoinNames(names.coordinates) + ")");
+    }
+    relabel[it - names.coordinates.begin()] = ParsePhaseExpression(i, node, rf);
+  }
+  return relabel;
+}
 
 Reader::Mechanics Reader::ReadMechanics(int i) {
   Mechanics out;
@@ -95,11 +222,7 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
   const std::string pf = "phases." + p.name;
   const int dim = static_cast<int>(p.state_names.size());
   const int n = static_cast<int>(names.coordinates.size());
-  // The state holding a name; -1 for an ignorable coordinate (derivatives in it vanish: no input is -1).
-  const auto index = [&](const std::string& s) {
-    if (names.ignorable.count(s)) return -1;
-    return static_cast<int>(std::find(p.state_names.begin(), p.state_names.end(), s) - p.state_names.begin());
-  };
+  const auto index = [&](const std::string& s) { return StateIndex(names.ignorable, p.state_names, s); };
   MechanicalSystem system;
   for (int k = 0; k < n; ++k) {
     system.coordinates.push_back(index(names.coordinates[k]));
@@ -113,83 +236,18 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
     system.pinned_velocities.push_back(dim + np + k);
   }
   if (np > 0) pinned_symbols_phase_ = i;  // until the contact is read (a failure ends the reading)
-  if (const toml::node* kinetic = t.get("kinetic")) {
-    system.kinetic = ParsePhaseExpression(i, *kinetic, pf + ".kinetic");
-    system.kinetic_where = At(kinetic, pf + ".kinetic");
-  }
-  if (const toml::node* potential = t.get("potential")) {
-    system.potential = ParsePhaseExpression(i, *potential, pf + ".potential");
-    system.potential_where = At(potential, pf + ".potential");
-  }
-  if (const toml::node* mass = t.get("mass_matrix")) {
-    const std::string field = pf + ".mass_matrix";
-    system.mass_matrix_where = At(mass, field);
-    const toml::array& rows = AsArray(*mass, field);
-    if (static_cast<int>(rows.size()) != n) {
-      Fail(mass, field, std::to_string(rows.size()) + " rows for " + std::to_string(n) + " coordinates (M is n × n)");
-    }
-    for (int r = 0; r < n; ++r) {
-      const std::string rf = field + "[" + std::to_string(r) + "]";
-      const toml::array& row = AsArray(*rows.get(r), rf);
-      if (static_cast<int>(row.size()) != n) {
-        Fail(rows.get(r), rf, std::to_string(row.size()) + " entries for " + std::to_string(n) + " coordinates");
-      }
-      system.mass_matrix.emplace_back();
-      for (int c = 0; c < n; ++c) {
-        system.mass_matrix.back().push_back(
-            ParsePhaseExpression(i, *row.get(c), rf + "[" + std::to_string(c) + "]"));
-      }
-    }
-  }
-  system.forces.assign(n, nullptr);
-  if (const toml::table* forces = OptionalTable(t, "forces", pf)) {
-    system.forces_where = At(forces, pf + ".forces");
-    for (auto&& [key, node] : *forces) {
-      const std::string name(key.str());
-      const auto it = std::find(names.coordinates.begin(), names.coordinates.end(), name);
-      if (it == names.coordinates.end()) {
-        Fail(&node, pf + ".forces." + name, "'" + name + "' is not a coordinate of phase '" + p.name +
-                                                "' (forces are keyed by coordinate: " + JoinNames(names.coordinates) +
-                                                ")");
-      }
-      system.forces[it - names.coordinates.begin()] = ParsePhaseExpression(i, node, pf + ".forces." + name);
-    }
-  }
+  ReadEnergiesAndForces(i, t, pf, &system);
   const toml::table* impact = OptionalTable(t, "impact", pf);
   const std::string field = pf + ".impact";
   std::vector<ExprPtr> constraints;
-  if (impact) {
-    CheckKeys(*impact, field, {"constraint", "restitution", "relabel"});
-    const toml::node* g = impact->get("constraint");
-    if (g == nullptr) {
-      Fail(impact, field + ".constraint", "missing field 'constraint' (the contact's g(q); impact at g = 0)");
-    }
-    out.constraint_where = At(g, field + ".constraint");
-    if (g->is_array()) {  // a contact of several constraints: a point that neither slips nor rebounds
-      const toml::array& rows = *g->as_array();
-      if (rows.empty()) Fail(g, field + ".constraint", "an empty list of constraints");
-      for (std::size_t r = 0; r < rows.size(); ++r) {
-        constraints.push_back(
-            ParsePhaseExpression(i, *rows.get(r), field + ".constraint[" + std::to_string(r) + "]"));
-      }
-    } else {
-      constraints.push_back(ParsePhaseExpression(i, *g, field + ".constraint"));
-      out.constraint = constraints[0];
-    }
-  }
+  if (impact) constraints = ReadContactConstraints(i, *impact, field, &out);
   pinned_symbols_phase_ = -1;
   const EquationsOfMotion eq = DeriveEquationsOfMotion(system);
 
   // Values only: T quadratic in q̇, M symmetric; at the typical state and two others around it.
   std::vector<double> values;
   for (const ParameterInfo& info : spec_.parameters) values.push_back(info.default_value);
-  std::vector<Vector> states;
-  for (int k = 0; k < 3; ++k) {
-    Vector x = p.typical_state;
-    for (int j = 0; j < dim; ++j) x(j) += k == 0 ? 0.0 : 0.1 * (k == 1 ? 1.0 + 0.3 * j : -1.0 + 0.2 * j);
-    for (int v : system.velocities) x(v) *= k == 2 ? -1.7 : 1.0;
-    states.push_back(x);
-  }
+  const std::vector<Vector> states = MechanicsCheckStates(p.typical_state, dim, system.velocities);
   CheckMechanics(PinnedAtRest(system), eq, dim, states, values, p.state_names);
 
   out.vector_field.assign(dim, nullptr);
@@ -206,35 +264,11 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
   p.coordinates = system.coordinates;
 
   if (impact) {
-    // e: a number in [0, 1] or an expression of the parameters (a parameter to continue in).
-    ExprPtr e = MakeConstant(1.0);
-    if (const toml::node* r = impact->get("restitution")) {
-      const std::string rf = field + ".restitution";
-      e = ParseExpression(ExpressionText(*r, rf), [this](const std::string& name) { return GlobalSymbol(name); },
-                          At(r, rf));
-      if (e->op == ExprOp::kConstant && !(e->value >= 0.0 && e->value <= 1.0)) {
-        Fail(r, rf, "restitution " + FormatNumber(e->value) + " is outside [0, 1]");
-      }
-      if (conservative_ && !IsConstant(e, 1.0)) {
-        const std::string shown = e->op == ExprOp::kConstant ? FormatNumber(e->value) : ExpressionText(*r, rf);
-        Fail(r, rf, "restitution " + shown + ": only the elastic law (1), which conserves the "
-                    "energy, is possible in a conservative model (declare conservative = false for a dissipative one)");
-      }
-    }
+    const ExprPtr e = ReadRestitution(*impact, field);
     std::vector<ExprPtr> after = ImpactVelocities(system, eq, constraints, e, out.constraint_where);
-    // The relabelling q' = S(q): keyed by coordinate, an expression of the coordinates.
     std::vector<ExprPtr> relabel(n);
     if (const toml::table* rl = OptionalTable(*impact, "relabel", field)) {
-      for (auto&& [key, node] : *rl) {
-        const std::string name(key.str());
-        const std::string rf = field + ".relabel." + name;
-        const auto it = std::find(names.coordinates.begin(), names.coordinates.end(), name);
-        if (it == names.coordinates.end() || names.ignorable.count(name)) {
-          Fail(&node, rf, "'" + name + "' is not a coordinate of phase '" + p.name + "' that is a state (the " +
-                              "relabelling gives coordinates after the impact: " + JoinNames(names.coordinates) + ")");
-        }
-        relabel[it - names.coordinates.begin()] = ParsePhaseExpression(i, node, rf);
-      }
+      relabel = ReadRelabelling(i, *rl, field);
       after = RelabelVelocities(system, relabel, after, At(rl, field + ".relabel"));
     }
     // Into the next phase: a state named like one of this phase's takes its value after the impact.

@@ -346,35 +346,103 @@ Observable OwnEventObservable(const HybridModel& model, int phase) {
   return o;
 }
 
-EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector& u, double* value, RowVector* du) {
+namespace {
+
+// A state of a segment's trajectory at time t from the segment's start (t of the duration's sign).
+struct ExtremumSample {
+  double t;
+  Vector x;
+};
+
+// h = sign·g along one shooting segment and its derivative along the sequence of the segment's samples,
+// dh = sign·ġ·dir (ġ = ∇g·f~; dir: the sign of the segment's duration), with the segment's flow to refine
+// between samples. Integrations add their work to `counters` and leave their result in `res`; f and dg are
+// scratch.
+struct SegmentProfile {
+  const SmoothFunction& g;
+  const Phase& phase;
+  PhaseFlow& flow;
+  Eigen::Ref<const Vector> xi;
+  const Vector& p;
+  double sign;
+  double dir;
+  PhaseFlowResult& res;
+  FlowCounters& counters;
+  Vector& f;
+  RowVector& dg;
+
+  // h at x, and dh there in *slope.
+  double HAndSlope(const Eigen::Ref<const Vector>& x, double* slope) const {
+    const double gx = g.Evaluate(x, p, &dg, nullptr);
+    phase.UnfoldedVectorField(x, xi, &f, nullptr, nullptr);
+    *slope = sign * dir * dg.dot(f);
+    return sign * gx;
+  }
+
+  // The zero of dh between samples a and a+1, where it changes sign (dh[a] < 0 < dh[a+1]: a local minimum
+  // of h; the other way round, a local maximum), located by TOMS 748 on the flow from sample a: its time in
+  // *t_star, and h there (+inf where the integration fails).
+  double RefineExtremum(const std::vector<ExtremumSample>& samples, const std::vector<double>& dh, int a,
+                        double* t_star) const {
+    const ExtremumSample& start = samples[a];
+    double slope = 0.0;
+    Vector x;
+    const auto slope_at = [&](double t) {
+      flow.Integrate(start.x, xi, t - start.t, false, &res);
+      counters += res.counters;
+      if (!res.ok()) return std::numeric_limits<double>::quiet_NaN();
+      HAndSlope(res.x, &slope);
+      return slope;
+    };
+    std::uintmax_t max_iter = 100;
+    const auto tol = [](double lo, double hi) {
+      return std::abs(hi - lo) <= 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(lo), std::abs(hi));
+    };
+    double lo = samples[a].t, hi = samples[a + 1].t;
+    double flo = dh[a], fhi = dh[a + 1];
+    if (lo > hi) {
+      std::swap(lo, hi);
+      std::swap(flo, fhi);
+    }
+    const auto bracket = boost::math::tools::toms748_solve(slope_at, lo, hi, flo, fhi, tol, max_iter);
+    *t_star = 0.5 * (bracket.first + bracket.second);
+    flow.Integrate(start.x, xi, *t_star - start.t, false, &res);
+    counters += res.counters;
+    double unused;
+    return res.ok() ? HAndSlope(res.x, &unused) : std::numeric_limits<double>::infinity();
+  }
+};
+
+// A competing guard counts from where it is reached from above (observable.h): per sample j of a segment,
+// whether it has been positive by then, the segment beginning armed as armed_at_start says. A bump above 0
+// between samples j-1 and j (a foot that barely clears the ground), located on the flow, arms it too.
+std::vector<char> GuardArmedSamples(const SegmentProfile& profile, const std::vector<ExtremumSample>& samples,
+                                    const std::vector<double>& h, const std::vector<double>& dh, bool armed_at_start) {
+  const int ns = static_cast<int>(samples.size());
+  std::vector<char> armed(ns, 1);
+  bool on = armed_at_start;
+  for (int j = 0; j < ns; ++j) {
+    const bool below_before = j == 1 ? h[0] <= kGuardStartTolerance : h[j - 1] <= 0.0;
+    if (!on && j > 0 && below_before && h[j] <= 0.0 && dh[j - 1] > 0.0 && dh[j] < 0.0) {
+      double t_top = 0.0;
+      const double top = profile.RefineExtremum(samples, dh, j - 1, &t_top);
+      on = std::isfinite(top) && top > 0.0;
+    }
+    armed[j] = on = on || (j > 0 && h[j] > 0.0);
+  }
+  return armed;
+}
+
+}  // namespace
+
+// Guards: whether segment s begins armed (observable.h). A segment that begins after a transition that
+// changes the motion begins armed only above the guard; one that begins at the section or after a cut
+// continues its predecessor's motion, and so its arming: armed if the predecessor began armed or was
+// above the guard after its start (a chain of cuts without any transition is one motion).
+bool ObservableEvaluator::GuardArmedAtStart(const Observable& o, const Vector& u, const Vector& p, double sign, int s) {
   const int m = model_->num_phases();
   const int k = layout_.num_first_integrals();
   const auto xi = u.segment(layout_.xi_index(), k);
-  const Vector p = Parameters();
-  const double sign = o.kind == ObservableKind::kMaximum ? -1.0 : 1.0;  // extremum of sign·g is a minimum
-  struct Sample {
-    double t;
-    Vector x;
-  };
-  // The best candidate so far: value of sign·g, segment, time (signed), interior or an end.
-  double best = std::numeric_limits<double>::infinity();
-  int best_segment = -1;
-  double best_t = 0.0;
-  bool best_interior = false;
-  double best_end = std::numeric_limits<double>::infinity();  // constraints: the smaller end value
-  int end_segment = -1;
-  double end_t = 0.0;
-  double unarmed = std::numeric_limits<double>::infinity();  // guards: -max g where never reached from above
-  int unarmed_segment = -1;
-  double unarmed_t = 0.0;
-  PhaseFlowResult res;
-  std::vector<Sample> samples;
-  Vector f;
-  RowVector dg;
-  // Guards: whether segment s begins armed (observable.h). A segment that begins after a transition that
-  // changes the motion begins armed only above the guard; one that begins at the section or after a cut
-  // continues its predecessor's motion, and so its arming: armed if the predecessor began armed or was
-  // above the guard after its start (a chain of cuts without any transition is one motion).
   const int num_segments = layout_.num_segments();
   const auto start_value = [&](int s) {
     const SmoothFunction* g = o.phases[s % m].get();
@@ -396,16 +464,38 @@ EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector
     counters_ += r.counters;
     return positive;
   };
-  const auto armed_at_start = [&](int s) {
-    for (int depth = 0; depth < num_segments; ++depth) {
-      if (start_value(s) > kGuardStartTolerance) return true;
-      if (!continuous(s)) return false;
-      s = s == 0 ? num_segments - 1 : s - 1;
-      if (o.phases[s % m] == nullptr) return false;
-      if (positive_after_start(s)) return true;
-    }
-    return false;
-  };
+  for (int depth = 0; depth < num_segments; ++depth) {
+    if (start_value(s) > kGuardStartTolerance) return true;
+    if (!continuous(s)) return false;
+    s = s == 0 ? num_segments - 1 : s - 1;
+    if (o.phases[s % m] == nullptr) return false;
+    if (positive_after_start(s)) return true;
+  }
+  return false;
+}
+
+EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector& u, double* value, RowVector* du) {
+  const int m = model_->num_phases();
+  const int k = layout_.num_first_integrals();
+  const auto xi = u.segment(layout_.xi_index(), k);
+  const Vector p = Parameters();
+  const double sign = o.kind == ObservableKind::kMaximum ? -1.0 : 1.0;  // extremum of sign·g is a minimum
+  // The best candidate so far: value of sign·g, segment, time (signed), interior or an end.
+  double best = std::numeric_limits<double>::infinity();
+  int best_segment = -1;
+  double best_t = 0.0;
+  bool best_interior = false;
+  double best_end = std::numeric_limits<double>::infinity();  // constraints: the smaller end value
+  int end_segment = -1;
+  double end_t = 0.0;
+  double unarmed = std::numeric_limits<double>::infinity();  // guards: -max g where never reached from above
+  int unarmed_segment = -1;
+  double unarmed_t = 0.0;
+  PhaseFlowResult res;
+  std::vector<ExtremumSample> samples;
+  Vector f;
+  RowVector dg;
+  const int num_segments = layout_.num_segments();
   for (int s = 0; s < num_segments; ++s) {
     const int i = s % m;
     const SmoothFunction* g = o.phases[i].get();
@@ -423,60 +513,15 @@ EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector
     if (!res.ok()) return EvaluationStatus::Failure(res.message);
     if (samples.empty()) samples.push_back({0.0, x0});  // a zero duration: the start alone
     // h = sign·g along the samples and its derivative along the sequence, dh = sign·ġ·dir.
-    const auto h_and_slope = [&](const Eigen::Ref<const Vector>& x, double* slope) {
-      const double gx = g->Evaluate(x, p, &dg, nullptr);
-      phase.UnfoldedVectorField(x, xi, &f, nullptr, nullptr);
-      *slope = sign * dir * dg.dot(f);
-      return sign * gx;
-    };
+    const SegmentProfile profile{*g, phase, flow, xi, p, sign, dir, res, counters_, f, dg};
     const int ns = static_cast<int>(samples.size());
     std::vector<double> h(ns), dh(ns);
-    for (int j = 0; j < ns; ++j) h[j] = h_and_slope(samples[j].x, &dh[j]);
-    // The zero of dh between samples a and a+1 (dh[a] < 0 < dh[a+1]): a local minimum of h.
-    const auto refine = [&](int a, double* t_star) {
-      const Sample& start = samples[a];
-      double slope = 0.0;
-      Vector x;
-      const auto slope_at = [&](double t) {
-        flow.Integrate(start.x, xi, t - start.t, false, &res);
-        counters_ += res.counters;
-        if (!res.ok()) return std::numeric_limits<double>::quiet_NaN();
-        h_and_slope(res.x, &slope);
-        return slope;
-      };
-      std::uintmax_t max_iter = 100;
-      const auto tol = [](double lo, double hi) {
-        return std::abs(hi - lo) <= 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(lo), std::abs(hi));
-      };
-      double lo = samples[a].t, hi = samples[a + 1].t;
-      double flo = dh[a], fhi = dh[a + 1];
-      if (lo > hi) {
-        std::swap(lo, hi);
-        std::swap(flo, fhi);
-      }
-      const auto bracket = boost::math::tools::toms748_solve(slope_at, lo, hi, flo, fhi, tol, max_iter);
-      *t_star = 0.5 * (bracket.first + bracket.second);
-      flow.Integrate(start.x, xi, *t_star - start.t, false, &res);
-      counters_ += res.counters;
-      double unused;
-      return res.ok() ? h_and_slope(res.x, &unused) : std::numeric_limits<double>::infinity();
-    };
-    // A competing guard counts from where it is reached from above (observable.h): armed[j] says whether it
-    // has been positive by sample j (a segment begins armed as armed_at_start says). Other observables count
-    // everywhere.
+    for (int j = 0; j < ns; ++j) h[j] = profile.HAndSlope(samples[j].x, &dh[j]);
+    // A competing guard counts from where it is reached from above (GuardArmedSamples). Other observables
+    // count everywhere.
     std::vector<char> armed(ns, 1);
     if (o.guard) {
-      bool on = armed_at_start(s);
-      for (int j = 0; j < ns; ++j) {
-        // A bump above 0 between samples j-1 and j (a foot that barely clears the ground) arms it too.
-        const bool below_before = j == 1 ? h[0] <= kGuardStartTolerance : h[j - 1] <= 0.0;
-        if (!on && j > 0 && below_before && h[j] <= 0.0 && dh[j - 1] > 0.0 && dh[j] < 0.0) {
-          double t_top = 0.0;
-          const double top = refine(j - 1, &t_top);
-          on = std::isfinite(top) && top > 0.0;
-        }
-        armed[j] = on = on || (j > 0 && h[j] > 0.0);
-      }
+      armed = GuardArmedSamples(profile, samples, h, dh, GuardArmedAtStart(o, u, p, sign, s));
       // A zero-duration segment has its start alone.
       for (int j = ns > 1 ? 1 : 0; j < ns; ++j) {
         if (!armed[j] && -h[j] < unarmed) unarmed = -h[j], unarmed_segment = s, unarmed_t = samples[j].t;
@@ -486,7 +531,7 @@ EvaluationStatus ObservableEvaluator::Extremum(const Observable& o, const Vector
     for (int a = 0; a + 1 < ns; ++a) {
       if (!(dh[a] < 0.0 && dh[a + 1] > 0.0) || !armed[a]) continue;
       double t_star = 0.0;
-      const double v = refine(a, &t_star);
+      const double v = profile.RefineExtremum(samples, dh, a, &t_star);
       if (v < best) best = v, best_segment = s, best_t = t_star, best_interior = true;
     }
     // The ends.

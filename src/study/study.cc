@@ -40,6 +40,7 @@
 #include "study/engine/orbit_start.h"
 #include "study/stages/parameter_curves.h"
 #include "study/engine/parameter_starts.h"
+#include "study/engine/start_carry.h"
 #include "study/stages/period_doubled_families.h"
 #include "study/engine/point_analysis.h"
 #include "study/stages/restart.h"
@@ -335,12 +336,12 @@ ExploredFamilies ExploreFamilies(const HybridModel& model, const RunSetup& setup
     say("start", out.starts_report);
     out.parameter_starts = StudyParameterStarts{starts.crossings, static_cast<int>(starts.points.size()), skipped,
                                                 starts.ordinary_branches};
-    writer.Annotate("starts", ParameterStartsJson(*out.parameter_starts));
+    writer.SetParameterStarts(*out.parameter_starts);
   }
   if (formulation == Formulation::kStateBased) ConvertToTimeBased(exploration, layout, &diagram);
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
   exploration.ForgetBranchPointAnalyses();  // every point of the exploration has been analysed
-  writer.Annotate("exploration", {{"status", ToString(diagram.status)}, {"message", diagram.message}});
+  writer.SetExplorationStatus(diagram.status, diagram.message);
   return out;
 }
 
@@ -367,16 +368,14 @@ std::string RunLaterStages(const StudyOptions& options, const HybridModel& model
     say("words", "");
     WordRecord words;
     report += ExploreWordChanges(model, setup, explored.diagram, special_points, &words, writer, hooks);
-    result->words = std::move(words.words);
-    result->word_changes = std::move(words.changes);
   }
   if (!setup.curve_parameter.empty() && !stopped()) {
     say("curves", "");
-    nlohmann::json curves = nlohmann::json::array();
+    std::vector<StudyCurve> curves;
     std::string curves_report;
     try {
       curves = TraceParameterCurves(model, setup, from_curve ? explored.restart_points : explored.diagram, writer.dir(),
-                                    &curves_report, &result->curves);
+                                    &curves_report);
     } catch (const CurveFileError& e) {  // a curve file that could not be written (a full disk)
       writer.RecordWriteError(e.what());
     }
@@ -384,14 +383,14 @@ std::string RunLaterStages(const StudyOptions& options, const HybridModel& model
       curves_report += fmt::format("  from {}: not traced (curves start at physical orbits; this one is not)\n",
                                    restart->where.value("label", std::string()));
     }
-    writer.Annotate("curves", std::move(curves));
+    writer.SetCurves(setup.curve_parameter, curves);
     report += curves_report;
   }
   // A stop (or a failed write) during these stages: what they did is kept, the study is not complete.
   if (stopped() && result->status == ExplorationStatus::kCompleted) {
     result->status = ExplorationStatus::kCancelled;
     result->message = "stopped after the exploration, before the study's end";
-    writer.Annotate("exploration", {{"status", ToString(result->status)}, {"message", result->message}});
+    writer.SetExplorationStatus(result->status, result->message);
   }
   return report;
 }
@@ -414,7 +413,6 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   result->status = diagram.status;
   result->message = diagram.message;
   result->diagram = diagram;
-  result->parameter_starts = explored.parameter_starts;
   if (writer.failed()) return;  // the failed write is the result's write_error
   std::vector<StudySpecialPoint> special_points = RecordSpecialPoints(diagram, layout, &model, setup.integrator);
   const std::unique_ptr<HybridModel> at_point = setup.free.empty() ? nullptr : std::make_unique<HybridModel>(model.Clone());
@@ -427,14 +425,13 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
       period_doubling ? std::make_unique<HybridModel>(RepeatedModel(model, 2)) : nullptr;
   const std::string stages = RunLaterStages(options, model, doubled.get(), setup, restart, explored, writer, hooks, say,
                                             &special_points, result);
-  writer.SetSpecialPoints(SpecialPointsJson(special_points));
+  writer.SetSpecialPoints(std::move(special_points));
   say("key frames", "");
   WriteKeyframeOrbits(diagram, stream.log(), model, setup, layout, writer);
   const std::string ranges = RangesReport(diagram, setup.scenario, layout, writer);
   const std::string report = RunReport(diagram, explored.starts_report + floquet_report + ranges + stages, start_time,
                                        exploration, stream.floquet_map());
   writer.SetReport(report);
-  result->report = report;
   const TestFunctionWork tests = exploration.test_function_work();
   result->work.rhs_evaluations = exploration.counters().rhs_evaluations;
   result->work.map_evaluations = exploration.num_evaluations();
@@ -548,6 +545,7 @@ struct PreparedStudy {
   std::unique_ptr<ModelExploration> exploration;
   std::unique_ptr<FamilyGuide> guide;  // options.families_of: prunes the exploration's half-branches
   StudyModelSource source;             // which model it is (recorded in the result)
+  std::string start_note;              // how the start was found, where the model's own did not do (StudyResult)
 };
 
 // `given`: the caller's model (copied; options.model and models_directory are then not read).
@@ -700,11 +698,48 @@ void AttachGuide(const StudyOptions& options, PreparedStudy* p) {
 // The ordinary run's start, checked (a guess corrected) before anything is written: a start that is not an
 // orbit is an error of the model's input, said per part of the cycle that does not close (or, where a start
 // may fail, a note and the study's status).
-void CheckStart(const StudyOptions& options, const StudyHooks& hooks, PreparedStudy* p) {
+// At parameters the user set (options.parameters), a start that does not converge is carried there from the
+// model's own values (start_carry.h); one that cannot be is a numerical outcome (the study's status), not bad
+// input. The model's own values come from the model built without options.parameters.
+void CheckStart(const StudyOptions& options, const StudyHooks& hooks, const HybridModel* given, PreparedStudy* p) {
   const HybridModel& model = *p->model;
   if (!p->setup.free.empty() || model.num_first_integrals() == 0 || options.restart) return;
   std::string why;
-  if (p->exploration->PrepareStart(&why)) return;
+  const bool converged = p->exploration->PrepareStart(&why);
+  const StartSpec::Kind kind = model.setup().start.kind;
+  const bool carried_kind = kind == StartSpec::Kind::kGuess || kind == StartSpec::Kind::kSimulation;
+  // At parameters the user set, a start that does not converge, or converges to an orbit that is not physical
+  // while the model's own is, is carried from the model's own values.
+  if (!p->setup.own_parameters.empty() && carried_kind &&
+      (!converged || !IsPhysical(model, p->exploration->prepared_start(), p->setup.integrator))) {
+    StudyOptions own_options = options;
+    own_options.parameters.clear();
+    std::ostringstream quiet;
+    StudyModelSource source;
+    const std::unique_ptr<HybridModel> own = BuildModel(own_options, given, quiet, &source);
+    const RunSetup own_setup = MakeRunSetup(own_options, *own);
+    const std::unique_ptr<ModelExploration> at_own = MakeExploration(own_options, *own, own_setup);
+    std::string own_why;
+    if (at_own->PrepareStart(&own_why) && IsPhysical(*own, at_own->prepared_start(), p->setup.integrator)) {
+      const CarriedStart carried =
+          CarryStart(model, p->setup.own_parameters, at_own->prepared_start(), p->setup.integrator);
+      if (carried.ok) {
+        p->exploration->SetStart(carried.u, carried.report + "\n");
+        p->start_note = carried.report;
+        if (hooks.on_note) hooks.on_note(carried.report);
+        return;
+      }
+      // A numerical outcome at valid parameters: the study's status says it (kStartFailed), nothing is refused.
+      std::string first = converged ? std::string("the start converges to an orbit that is not physical")
+                                    : why.substr(0, why.find('\n'));
+      while (!first.empty() && (first.back() == ':' || first.back() == ' ')) first.pop_back();
+      why = first + "; " + carried.why;
+      p->exploration->SetStartFailure(why);
+      if (hooks.on_note) hooks.on_note(why);
+      return;
+    }
+  }
+  if (converged) return;
   SourceLocation where = model.setup().start.where;
   if (where.field.empty()) where.field = "start";
   if (options.start_must_converge) throw ModelInputError(where, why);
@@ -725,13 +760,21 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
   const HybridModel& model = *p.model;
   CheckOptionPairs(options);
   p.setup = MakeRunSetup(options, model);
+  if (!options.parameters.empty()) {  // the model's own values of the parameters set (start_carry.h)
+    StudyOptions own_options = options;
+    own_options.parameters.clear();
+    std::ostringstream quiet;
+    StudyModelSource source;
+    const std::unique_ptr<HybridModel> own = BuildModel(own_options, given, quiet, &source);
+    for (const NamedValue& set : options.parameters) p.setup.own_parameters.push_back({set.name, own->parameter(set.name)});
+  }
   // The period-doubled families' model is drawn too: its presentation is checked before anything runs.
   if (options.period_doubling) OrbitPresentation(RepeatedModel(model, 2), p.setup.free);
   p.exploration = MakeExploration(options, model, p.setup);
   CheckConservationAtStart(model, options.model, p.exploration->shooting().layout(), p.setup.scenario.start);
   CheckAutomatonWords(model, options.model);
   if (!options.families_of.empty()) AttachGuide(options, &p);
-  CheckStart(options, hooks, &p);
+  CheckStart(options, hooks, given, &p);
   return p;
 }
 
@@ -811,8 +854,8 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
     }
     p.exploration->set_branch_store(store.get());
   }
-  ResultsWriter writer(dir, model, options_json, p.setup.free, &hooks);
-  writer.Annotate("model_source", ModelSourceJson(p.source));
+  ResultsWriter writer(dir, model, options_json, p.source, p.setup.free, &hooks);
+  writer.SetStartNote(p.start_note);
   writer.set_resume_store(store.get());
   // Every exploration of the study (the period-doubled and word families', the starts' of a free parameter)
   // stops at a stop request or a failed write.
@@ -841,8 +884,6 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
                                 guided["rays"].get<int>()));
     }
   }
-  // The families as every front end shows them (families.h), for the folder's readers.
-  writer.Annotate("families", FamiliesJson(ResultFromSummary(writer.summary(), {}).families));
   // A stopped study ends its folder as "cancelled": whole, but not the whole study (--resume completes it).
   if (!writer.Finish(result.status == ExplorationStatus::kCancelled)) writer.Fail(writer.write_error());  // a full disk: the folder is marked incomplete
   const bool complete = writer.write_error().empty() && result.status != ExplorationStatus::kCancelled;
@@ -850,17 +891,11 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
     result.work.resumed_branches = store->used();
     if (complete) store->Complete();  // nothing left to resume
   }
-  StudyResult typed = ResultFromSummary(writer.summary(), writer.points());
+  // The record the stages filled is the result; the folder holds its serialization.
+  StudyResult typed = writer.Record();
   typed.status = result.status;
   typed.message = result.message;
-  typed.report = result.report;
   typed.work = result.work;
-  typed.orbits = writer.orbits();
-  typed.curves = std::move(result.curves);
-  typed.words = std::move(result.words);
-  typed.word_changes = std::move(result.word_changes);
-  typed.parameter_starts = result.parameter_starts;
-  typed.curve_parameter = p.setup.curve_parameter;
   typed.diagram = std::move(result.diagram);
   typed.write_error = writer.write_error();
   return typed;

@@ -45,12 +45,23 @@ def test_same_diagram_as_the_command_line_on_the_paper_models(tmp_path, name):
     for g, w in zip(got, want):
         assert g[:3] == w[:3] and g[5] == w[5], (g, w)
         assert g[3] == pytest.approx(w[3], rel=1e-12, abs=1e-12) and g[4] == pytest.approx(w[4], rel=1e-12, abs=1e-12)
-    # The DataFrames are the folder's files: every column of every branch file, one row per point.
+    # The points table is the typed study's: every column of every branch file, one row per point, each number
+    # as the file holds it (to the bit).
     points = study.points
     with open(tmp_path / "py" / "branch-0.csv") as f:
         header = f.readline().strip().split(",")
-    assert list(points.columns) == ["branch", "family"] + header
+    assert list(points.columns[:5]) == ["branch", "family", "index", "H", "T"]
+    assert set(points.columns) == {"branch", "family"} | set(header)
     assert len(points) == sum(b["points"] for b in study.summary["branches"])
+    import pandas as pd
+    saved = pd.read_csv(tmp_path / "py" / "branch-0.csv", float_precision="round_trip")
+    mine = points[points.branch == 0].reset_index(drop=True)
+    for column in header:
+        a, b = mine[column], saved[column]
+        if a.dtype == object or b.dtype == object:
+            assert list(a.fillna("")) == list(b.fillna("")), column
+        else:
+            assert ((a == b) | (a.isna() & b.isna())).all(), column
     assert os.path.exists(tmp_path / "py" / "report.html")
 
 

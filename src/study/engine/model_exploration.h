@@ -88,6 +88,21 @@ class ModelExploration {
   // it did not move it beyond the corrector's tolerance).
   bool PrepareStart(std::string* why);
   const std::string& start_report() const { return start_report_; }
+  // The start PrepareStart corrected (time-based layout, model units); empty before or when it failed.
+  Vector prepared_start() const { return start_prepared_ && start_failure_.empty() ? prepared_start_ : Vector(); }
+  // Run explores from the orbit u (time-based layout, model units: a start found otherwise, start_carry.h)
+  // instead of the scenario's start; `report` is its start_report().
+  void SetStart(const Vector& u, const std::string& report) {
+    start_prepared_ = true;
+    prepared_start_ = u;
+    start_failure_.clear();
+    start_report_ = report;
+  }
+  // Run has no start: it ends with kStartFailed and `why`.
+  void SetStartFailure(const std::string& why) {
+    start_prepared_ = true;
+    start_failure_ = why;
+  }
 
   // Explores from each of `starts` (regular points, model units) in turn, one diagram: a start that lies on
   // a branch traced (or mapped) from an earlier one, or whose image under one of the problem's symmetries

@@ -33,6 +33,9 @@ struct RunSetup {
   // What the set-up changed that the user did not write, said before the run ("--until H=5 widens the
   // bound of H to [0, 5]").
   std::vector<std::string> notes;
+  // The model's own values of the parameters options.parameters sets (in that order; empty without): where a
+  // declared start fails at the values set, it is carried there from these (start_carry.h).
+  std::vector<NamedValue> own_parameters;
 };
 
 // The model's default scenario with the options free, fix, curves, rtol, atol, until, bounds, max_branches,

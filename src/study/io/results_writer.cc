@@ -11,7 +11,9 @@
 #include <stdexcept>
 
 #include "hybridcont/version.h"
+#include "hybridcont/invariant.h"
 #include "study/io/study_document.h"
+#include "study/io/summary_json.h"
 
 namespace hybridcont::study {
 
@@ -97,22 +99,21 @@ nlohmann::json PresentationJson(const HybridModel& model, const OrbitPresentatio
 }  // namespace
 
 ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::json options,
-                             const FreeParameters& free, const StudyHooks* hooks)
+                             const StudyModelSource& source, const FreeParameters& free, const StudyHooks* hooks)
     : dir_(std::move(dir)), model_(model), free_(free), layout_(model, free), presentation_(model, free),
       hooks_(hooks) {
-  summary_["model"] = model.name();
-  summary_["version"] = HYBRIDCONT_VERSION;
-  summary_["format"] = kResultsFormat;  // docs/results-format.md
-  summary_["description"] = model.description();
-  nlohmann::json params = nlohmann::json::object();
-  for (const auto& info : model.parameters()) params[info.name] = model.parameter(info.name);
-  summary_["parameters"] = params;
+  record_.version = HYBRIDCONT_VERSION;
+  record_.model = model.name();
+  record_.model_source = source;
+  for (const auto& info : model.parameters()) record_.parameters.push_back({info.name, model.parameter(info.name)});
+  record_.unknown_names = layout_.unknown_names();
+  document_["format"] = kResultsFormat;  // docs/results-format.md
+  document_["description"] = model.description();
   nlohmann::json phases = nlohmann::json::array();
   for (int i = 0; i < model.num_phases(); ++i) {
     phases.push_back({{"name", model.phase(i).name()}, {"states", model.phase(i).state_names()}});
   }
-  summary_["phases"] = phases;
-  summary_["unknowns"] = layout_.unknown_names();
+  document_["phases"] = phases;
   // The special-point codes and what they mean, from their one definition (special_point.h).
   nlohmann::json codes = nlohmann::json::object();
   for (int t = 0; t <= static_cast<int>(SpecialPointType::kKreinCollision); ++t) {
@@ -120,13 +121,10 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
     std::replace(meaning.begin(), meaning.end(), '-', ' ');
     codes[Code(static_cast<SpecialPointType>(t))] = meaning;
   }
-  summary_["special_point_codes"] = codes;
-  summary_["presentation"] = PresentationJson(model, presentation_, free);
-  summary_["options"] = std::move(options);
-  summary_["branches"] = nlohmann::json::array();
-  summary_["special_points"] = nlohmann::json::array();
-  summary_["orbits"] = nlohmann::json::array();
-  summary_["status"] = "running";
+  document_["special_point_codes"] = codes;
+  document_["presentation"] = PresentationJson(model, presentation_, free);
+  document_["options"] = std::move(options);
+  document_["status"] = "running";
   // Remove the results of an earlier run in the same folder so that the folder describes this run only:
   // summary.json first (while the rest is removed the folder claims nothing), then the CSV files, the
   // figures (the generic ones, those the old summary declared and every one figures.txt lists), the report and
@@ -186,51 +184,107 @@ void ResultsWriter::SetBranchModel(int branch_id, const HybridModel& model, cons
                                                          model.WordModeNames(), model.name(), origin});
 }
 
-int ResultsWriter::next_branch_id() const {
-  int next = 0;
-  for (const nlohmann::json& b : summary_["branches"]) next = std::max(next, b["id"].get<int>() + 1);
-  return next;
+int ResultsWriter::next_branch_id() const { return branches_.empty() ? 0 : branches_.rbegin()->first + 1; }
+
+int ResultsWriter::num_points() const {
+  int n = 0;
+  for (const auto& [id, b] : branches_) n += static_cast<int>(b.points.size());
+  return n;
+}
+
+const std::vector<StudyPoint>* ResultsWriter::PointsOf(int branch_id) const {
+  const auto b = branches_.find(branch_id);
+  return b == branches_.end() || b->second.points.empty() ? nullptr : &b->second.points;
+}
+
+StudyBranch& ResultsWriter::Listed(int branch_id) {
+  const auto found = branches_.find(branch_id);
+  if (found != branches_.end()) return found->second;
+  StudyBranch& b = branches_[branch_id];
+  b.id = branch_id;
+  b.termination = "running";
+  const auto other = branch_models_.find(branch_id);
+  const ShootingLayout& layout = other == branch_models_.end() ? layout_ : other->second.layout;
+  b.unknown_names = layout.unknown_names();
+  b.continued = layout.continued_name();
+  b.ranges.branch = branch_id;
+  if (other != branch_models_.end()) {
+    b.model = other->second.model_name;
+    b.origin = other->second.origin;
+    b.word = other->second.word;
+  } else {
+    b.model = model_.name();
+    b.word = model_.WordModeNames();
+  }
+  return b;
+}
+
+StudyBranch& ResultsWriter::Ended(int branch_id) {
+  const auto found = branches_.find(branch_id);
+  HYBRIDCONT_DEMAND(found != branches_.end());  // a later stage annotates a branch after its end
+  return found->second;
+}
+
+StudyBranch ResultsWriter::Unpointed(int branch_id) const {
+  const StudyBranch& listed = branches_.at(branch_id);
+  StudyBranch b;
+  b.id = listed.id;
+  b.model = listed.model;
+  b.origin = listed.origin;
+  b.unknown_names = listed.unknown_names;
+  b.continued = listed.continued;
+  b.word = listed.word;
+  b.termination = listed.termination;
+  b.ranges.branch = listed.id;
+  return b;
 }
 
 void ResultsWriter::SetBranchFamily(int branch_id, const BranchFamily& family) {
-  families_[branch_id] = family;
-  const auto json_of = [](const std::vector<Range>& list) {
-    nlohmann::json a = nlohmann::json::array();
-    for (const Range& r : list) {
-      a.push_back({{"from", r.from.value}, {"to", r.to.value}, {"from_how", r.from.how}, {"to_how", r.to.how},
-                   {"from_special_point", r.from.special_point}, {"to_special_point", r.to.special_point},
-                   {"first_point", r.first_point}, {"last_point", r.last_point}, {"family", r.family}});
-    }
-    return a;
-  };
-  AnnotateBranch(branch_id, {{"family", family.family},
-                             {"physical_ranges", json_of(family.ranges.physical)},
-                             {"stable_ranges", json_of(family.ranges.stable)}});
+  StudyBranch& b = Ended(branch_id);
+  b.family = family.family;
+  b.ranges = family.ranges;
+  b.ranges.branch = branch_id;
+  WriteSummary();
 }
 
-void ResultsWriter::AnnotateBranch(int branch_id, const nlohmann::json& fields) {
-  for (nlohmann::json& b : summary_["branches"]) {
-    if (b["id"] == branch_id) b.update(fields);
-  }
+void ResultsWriter::SetPeriodDoubledFrom(int branch_id, int special_point) {
+  StudyBranch& b = Ended(branch_id);
+  b.period_doubled_from = special_point;
+  if (b.origin.empty()) b.origin = "period-doubled";
+  WriteSummary();
+}
+
+void ResultsWriter::SetStartedInWord(int branch_id) {
+  Ended(branch_id).started_in_word = true;
+  WriteSummary();
+}
+
+void ResultsWriter::SetHandedOverFrom(int branch_id, int word_change) {
+  Ended(branch_id).handed_over_from = word_change;
   WriteSummary();
 }
 
 void ResultsWriter::AddPoint(int branch_id, const PointRecord& p) {
   const auto other = branch_models_.find(branch_id);
   const ShootingLayout& layout = other == branch_models_.end() ? layout_ : other->second.layout;
-  std::vector<StudyPoint>& points = points_[branch_id];
-  points.push_back({p.index, p.u, layout.Period(p.u), p.analysis, p.newton_iterations, p.step, p.at_branch_point});
-  if (points.size() == 1 && !writes_files()) StartBranchEntry(branch_id);
-  WritePoint(branch_id, p, layout, other == branch_models_.end() ? presentation_ : other->second.presentation);
+  const bool first = branches_.find(branch_id) == branches_.end();
+  StudyBranch& b = Listed(branch_id);
+  const OrbitPresentation& presentation = other == branch_models_.end() ? presentation_ : other->second.presentation;
+  StudyPoint point{p.index, p.u, layout.Period(p.u), p.analysis, p.newton_iterations, p.step, p.at_branch_point,
+                   p.period_slope, {}};
+  const std::vector<double> quantities = presentation.Quantities(p.u);
+  for (std::size_t q = 0; q < quantities.size(); ++q) point.quantities.push_back({presentation.quantity_names()[q], quantities[q]});
+  b.points.push_back(std::move(point));
+  WritePoint(branch_id, p, b.points.back(), layout);
+  if (first) WriteSummary();  // listed from its first point on: an interrupted run shows what it traced
   if (hooks_ && hooks_->on_point) {
     auto live = live_.find(branch_id);
-    if (live == live_.end()) live = live_.emplace(branch_id, BranchOf(branch_id, /*with_points=*/false)).first;
-    hooks_->on_point(points.back(), live->second);
+    if (live == live_.end()) live = live_.emplace(branch_id, Unpointed(branch_id)).first;
+    hooks_->on_point(b.points.back(), live->second);
   }
 }
-
-void ResultsWriter::WritePoint(int branch_id, const PointRecord& p, const ShootingLayout& layout,
-                               const OrbitPresentation& presentation) {
+void ResultsWriter::WritePoint(int branch_id, const PointRecord& p, const StudyPoint& point,
+                               const ShootingLayout& layout) {
   if (!writes_files() || !write_error_.empty()) return;  // a full disk: keep what is there, write nothing more
   // The row (and, first, the header) is made in memory and written at once; a write that fails leaves the
   // file cut back to its last whole row (a full disk tears no row).
@@ -239,7 +293,6 @@ void ResultsWriter::WritePoint(int branch_id, const PointRecord& p, const Shooti
   if (it == branch_files_.end()) {
     it = branch_files_.emplace(branch_id, std::ofstream(dir_ / BranchFileName(branch_id))).first;
     branch_bytes_[branch_id] = 0;
-    StartBranchEntry(branch_id);  // listed from its first point on: an interrupted run shows what it traced
     f << "index,H,T";
     const auto& names = layout.unknown_names();
     for (int j = 0; j < layout.num_free_parameters(); ++j) f << "," << names[layout.parameter_index(j)];
@@ -251,7 +304,7 @@ void ResultsWriter::WritePoint(int branch_id, const PointRecord& p, const Shooti
     f << ",physical,classification,stability,residual,newton_iterations,step";
     f << ",dT_d" << layout.continued_name();
     for (const auto& [name, value] : p.extra) f << "," << name;
-    for (const std::string& name : presentation.quantity_names()) f << "," << name;
+    for (const NamedValue& q : point.quantities) f << "," << q.name;
     for (const auto& [name, value] : p.observables) f << "," << name;
     f << "\n";
   }
@@ -265,16 +318,17 @@ void ResultsWriter::WritePoint(int branch_id, const PointRecord& p, const Shooti
   for (int i = 0; i < layout.num_segments(); ++i) {
     for (int c = 0; c < layout.dim(i); ++c) f << fmt::format(",{:.17g}", u(layout.state_offset(i) + c));
   }
-  f << fmt::format(",{},{},{},{:.3e},{},{:.6g}", p.classification.physical ? 1 : 0, ToString(p.classification.reason),
+  // Every number below in its shortest form that reads back exactly ("{}"): a study read back is the study.
+  f << fmt::format(",{},{},{},{},{},{}", p.classification.physical ? 1 : 0, ToString(p.classification.reason),
                    p.stability, p.residual, p.newton_iterations, p.step);
-  if (std::isfinite(p.period_slope)) f << fmt::format(",{:.10g}", p.period_slope);
+  if (!std::isnan(p.period_slope)) f << fmt::format(",{}", p.period_slope);  // inf at a turning point
   else f << ",";
   for (const auto& [name, value] : p.extra) {
-    if (std::isfinite(value)) f << fmt::format(",{:.10g}", value);
+    if (std::isfinite(value)) f << fmt::format(",{}", value);
     else f << ",";  // not defined for this point (e.g. Floquet data of a non-physical orbit)
   }
-  for (const double value : presentation.Quantities(u)) {
-    if (std::isfinite(value)) f << fmt::format(",{:.17g}", value);
+  for (const NamedValue& q : point.quantities) {
+    if (std::isfinite(q.value)) f << fmt::format(",{:.17g}", q.value);
     else f << ",";
   }
   for (const auto& [name, value] : p.observables) {
@@ -293,113 +347,69 @@ void ResultsWriter::WritePoint(int branch_id, const PointRecord& p, const Shooti
     return;
   }
   branch_bytes_[branch_id] += row.size();
-  ++points_per_branch_[branch_id];
+  ++rows_[branch_id];
 }
 
 void ResultsWriter::EndBranch(const Branch& b) {
   auto file = branch_files_.find(b.id);
   if (file != branch_files_.end()) file->second.close();
-  if (!writes_files()) {
-    const auto listed = points_.find(b.id);
-    points_per_branch_[b.id] = listed == points_.end() ? 0 : static_cast<int>(listed->second.size());
-  }
-  nlohmann::json entry = {{"id", b.id},
-                          {"file", BranchFileName(b.id)},
-                          {"parent", b.parent_special_point},
-                          {"direction", b.direction},
-                          {"depth", b.depth},
-                          {"points", points_per_branch_[b.id]},
-                          {"termination", ToString(b.termination)},
-                          {"message", b.message},
-                          {"newton_iterations", b.newton_iterations},
-                          {"rejected_steps", b.rejected_steps}};
-  // Its phase sequence: the modes of its word (a cyclic model's phases).
-  const auto other = branch_models_.find(b.id);
-  entry["word"] = other == branch_models_.end() ? model_.WordModeNames() : other->second.word;
-  // A branch of another layout (another word's, a period-doubled family's) names its unknowns, the order of u.
-  if (other != branch_models_.end()) entry["unknowns"] = other->second.layout.unknown_names();
-  if (b.image_of >= 0) {  // mapped, not traced (exploration.h, "Symmetries")
-    entry["image_of"] = b.image_of;
-    entry["symmetry"] = b.symmetry;
-  }
-  if (b.reflected_from >= 0) {  // a loop traced to its midpoint and completed by reflection
-    entry["reflected_from"] = b.reflected_from;
-    entry["symmetry"] = b.symmetry;
-  }
-  // The entry listed at the branch's first point (StartBranchEntry) is replaced in place.
-  nlohmann::json& branches = summary_["branches"];
-  const auto listed = std::find_if(branches.begin(), branches.end(), [&](const nlohmann::json& e) { return e["id"] == b.id; });
-  if (listed != branches.end()) {
-    *listed = std::move(entry);
-  } else {  // a branch without points: listed in the order of the ids
-    const auto later = std::find_if(branches.begin(), branches.end(),
-                                    [&](const nlohmann::json& e) { return e["id"].get<int>() > b.id; });
-    branches.insert(later, std::move(entry));
-  }
+  StudyBranch& record = Listed(b.id);
+  record.parent_special_point = b.parent_special_point;
+  record.direction = b.direction;
+  record.depth = b.depth;
+  record.termination = ToString(b.termination);
+  record.message = b.message;
+  record.newton_iterations = b.newton_iterations;
+  record.rejected_steps = b.rejected_steps;
+  record.image_of = b.image_of;  // mapped, not traced (exploration.h, "Symmetries")
+  record.reflected_from = b.reflected_from;  // a loop traced to its midpoint and completed by reflection
+  record.symmetry = b.image_of >= 0 || b.reflected_from >= 0 ? b.symmetry : "";
   WriteSummary();
   live_.erase(b.id);
-  if (hooks_ && hooks_->on_branch) hooks_->on_branch(BranchOf(b.id, /*with_points=*/true));
-}
-
-StudyBranch ResultsWriter::BranchOf(int branch_id, bool with_points) const {
-  const nlohmann::json& branches = summary_["branches"];
-  const auto entry = std::find_if(branches.begin(), branches.end(),
-                                  [&](const nlohmann::json& e) { return e["id"] == branch_id; });
-  const auto other = branch_models_.find(branch_id);
-  const ShootingLayout& layout = other == branch_models_.end() ? layout_ : other->second.layout;
-  const auto points = points_.find(branch_id);
-  StudyBranch b = entry == branches.end() ? StudyBranch{} : BranchFromSummary(*entry, layout.unknown_names());
-  b.id = branch_id;
-  b.continued = layout.continued_name();
-  if (other != branch_models_.end()) b.model = other->second.model_name, b.origin = other->second.origin;
-  else b.model = model_.name();
-  if (with_points && points != points_.end()) b.points = points->second;
-  if (const auto f = families_.find(branch_id); f != families_.end()) {
-    b.family = f->second.family;
-    b.ranges = f->second.ranges;
-    b.ranges.branch = branch_id;
-  }
-  return b;
-}
-
-void ResultsWriter::StartBranchEntry(int branch_id) {
-  const auto other = branch_models_.find(branch_id);
-  summary_["branches"].push_back({{"id", branch_id},
-                                  {"file", BranchFileName(branch_id)},
-                                  {"points", 0},
-                                  {"termination", "running"},
-                                  {"word", other == branch_models_.end() ? model_.WordModeNames() : other->second.word}});
-  WriteSummary();
+  if (hooks_ && hooks_->on_branch) hooks_->on_branch(record);
 }
 
 void ResultsWriter::Annotate(const std::string& key, nlohmann::json value) {
-  summary_[key] = std::move(value);
+  document_[key] = std::move(value);
   WriteSummary();
 }
 
-void ResultsWriter::SetSpecialPoints(nlohmann::json special_points) {
-  summary_["special_points"] = std::move(special_points);
+void ResultsWriter::SetExplorationStatus(ExplorationStatus status, const std::string& message) {
+  record_.status = status;
+  record_.message = message;
+  Annotate("exploration", {{"status", ToString(status)}, {"message", message}});
+}
+
+void ResultsWriter::SetParameterStarts(const StudyParameterStarts& starts) {
+  record_.parameter_starts = starts;
+  WriteSummary();
+}
+
+void ResultsWriter::SetWords(const std::vector<StudyWord>& words, const std::vector<StudyWordChange>& changes) {
+  record_.words = words;
+  record_.word_changes = changes;
+  WriteSummary();
+}
+
+void ResultsWriter::SetCurves(const std::string& parameter, const std::vector<StudyCurve>& curves) {
+  record_.curve_parameter = parameter;
+  record_.curves = curves;
+  WriteSummary();
+}
+
+void ResultsWriter::SetSpecialPoints(std::vector<StudySpecialPoint> special_points) {
+  record_.special_points = std::move(special_points);
 }
 
 std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int index, double H, double T,
                                     const std::string& label, const Matrix& monodromy) {
-  const std::string name = "orbit-" + std::to_string(summary_["orbits"].size()) + ".csv";
+  const std::string name = OrbitFileName(listed_orbits_);
   const std::vector<OrbitSample> samples = trace.Sample(400);
   StudyOrbit orbit{branch_id, index, label, H, T, {}, {}, {}, monodromy};
-  nlohmann::json entry = {{"file", name}, {"branch", branch_id}, {"index", index}, {"H", H}, {"T", T}, {"label", label}};
-  if (monodromy.size() > 0) {
-    nlohmann::json rows = nlohmann::json::array();
-    for (Eigen::Index i = 0; i < monodromy.rows(); ++i) {
-      nlohmann::json row = nlohmann::json::array();
-      for (Eigen::Index j = 0; j < monodromy.cols(); ++j) row.push_back(monodromy(i, j));
-      rows.push_back(std::move(row));
-    }
-    entry["monodromy"] = std::move(rows);
-  }
   for (const OrbitSample& s : samples) orbit.t.push_back(s.t), orbit.segment.push_back(s.segment), orbit.x.push_back(s.x);
-  orbits_.push_back(std::move(orbit));
+  record_.orbits.push_back(std::move(orbit));
   if (!writes_files()) {
-    summary_["orbits"].push_back(std::move(entry));
+    ++listed_orbits_;
     return name;
   }
   if (!write_error_.empty()) return name;
@@ -439,11 +449,34 @@ std::string ResultsWriter::AddOrbit(const OrbitTrace& trace, int branch_id, int 
     fs::remove(dir_ / name, ec);  // no torn orbit: it is listed nowhere
     return name;
   }
-  summary_["orbits"].push_back(std::move(entry));
+  ++listed_orbits_;
   return name;
 }
 
-void ResultsWriter::SetReport(const std::string& report) { summary_["report"] = report; }
+void ResultsWriter::SetReport(const std::string& report) { record_.report = report; }
+
+StudyResult ResultsWriter::Record() const {
+  StudyResult r = record_;
+  // id == index: an id not listed (a branch without points that never ended: an interrupted study) is there,
+  // "unlisted", as LoadStudy gives it.
+  for (const auto& [id, b] : branches_) {
+    while (static_cast<int>(r.branches.size()) < id) {
+      r.branches.push_back(UnlistedBranch(static_cast<int>(r.branches.size()), r, layout_.continued_name()));
+    }
+    r.branches.push_back(b);
+  }
+  r.families = FoldFamilies(r.branches, r.special_points);
+  r.summary_json = Document().dump(1);
+  return r;
+}
+
+nlohmann::json ResultsWriter::Document() const {
+  std::map<int, int> listed_rows = rows_;
+  if (!writes_files()) {
+    for (const auto& [id, b] : branches_) listed_rows[id] = static_cast<int>(b.points.size());
+  }
+  return SummaryJson(record_, branches_, listed_rows, listed_orbits_, document_);
+}
 
 bool ResultsWriter::WriteSummary() {
   if (!writes_files()) return true;
@@ -453,7 +486,7 @@ bool ResultsWriter::WriteSummary() {
   bool ok = false;
   {
     std::ofstream f(tmp);
-    f << summary_.dump(1) << "\n";
+    f << Document().dump(1) << "\n";
     f.close();
     ok = !f.fail();
   }
@@ -469,13 +502,13 @@ bool ResultsWriter::WriteSummary() {
 }
 
 bool ResultsWriter::Finish(bool cancelled) {
-  summary_["status"] = cancelled ? "cancelled" : "complete";
+  document_["status"] = cancelled ? "cancelled" : "complete";
   return WriteSummary();
 }
 
 void ResultsWriter::Fail(const std::string& message) {
-  summary_["status"] = "failed";
-  summary_["status_message"] = message;
+  document_["status"] = "failed";
+  document_["status_message"] = message;
   if (write_error_.empty()) WriteSummary();
 }
 

@@ -92,9 +92,12 @@ inline PointRecord RecordOf(const ProgressInfo& info, const Vector& u) {
   return record;
 }
 
-// The record of a study as it grows: the summary document and the analysed points of every branch, kept in
-// memory for the study's result (study.h) and, with a folder, written there as described above. Each point
-// and each finished branch is handed to the caller's hooks.
+// The record of a study as it grows: the typed study (study.h) that every stage fills — branches with their
+// analysed points, special points, key frames, words, curves, the report — and, with a folder, its files
+// written as described above. summary.json is one serialization of that record (SummaryJson, summary_json.h),
+// LoadStudy its reader back (study_document.h); beside it the document holds only what is no part of the
+// typed study (the effective options, the model's presentation, how a restart or a guided study began). Each
+// point and each finished branch is handed to the caller's hooks.
 class ResultsWriter {
  public:
   // Creates dir if needed and checks that a file can be written in it. Throws std::invalid_argument
@@ -109,29 +112,38 @@ class ResultsWriter {
   // and the model's figures that plot H on the horizontal axis plot the first parameter instead.
   // An empty `dir` writes nothing (the record in memory only). `hooks` may be null; it must outlive the writer.
   ResultsWriter(std::filesystem::path dir, const HybridModel& model, nlohmann::json options,
-                const FreeParameters& free = {}, const StudyHooks* hooks = nullptr);
-  // Sets a top-level field of summary.json (e.g. "curves") and rewrites it.
+                const StudyModelSource& source, const FreeParameters& free = {}, const StudyHooks* hooks = nullptr);
+  // Sets a field of summary.json that is no part of the typed study ("restarted_from", "guided") and rewrites it.
   void Annotate(const std::string& key, nlohmann::json value);
 
   // Branch `branch_id` is one of another model (a period-doubled family's, RepeatedModel(model, 2)): its
   // CSV columns follow that model's layout and presentation. Call before its first point; `model` must
   // outlive the branch's last AddPoint (the presentation kept for it is not used after).
-  // `origin` names the family's kind for the hooks (StudyBranch::origin): "period-doubled", a word's name.
+  // `origin` names the family's kind (StudyBranch::origin): "period-doubled", a word's name.
   void SetBranchModel(int branch_id, const HybridModel& model, const std::string& origin = "");
   void AddPoint(int branch_id, const PointRecord& point);
-  // The family and ranges of branch `branch_id` (families.h), after EndBranch: in the branch's record and its
-  // summary entry ("family", "physical_ranges", "stable_ranges").
-  void SetBranchFamily(int branch_id, const BranchFamily& family);
-  // Adds `fields` to the summary entry of branch `branch_id` (after EndBranch) and rewrites summary.json.
-  void AnnotateBranch(int branch_id, const nlohmann::json& fields);
-  // Records the finished branch's metadata and rewrites summary.json.
+  // Records the finished branch (its metadata; its points came by AddPoint) and rewrites summary.json.
   void EndBranch(const Branch& branch);
-  void SetSpecialPoints(nlohmann::json special_points);
-  // Writes orbit-<k>.csv and records it in the summary (with its monodromy matrix Φ_T, when not empty, as
-  // "monodromy": rows); returns the file name.
+  // The family and ranges of branch `branch_id` (families.h), after EndBranch.
+  void SetBranchFamily(int branch_id, const BranchFamily& family);
+  // What the later stages learn of a finished branch (StudyBranch): the PD point a period-doubled family is
+  // born at; a family of another word traced from that word's own start; the word change it begins at.
+  void SetPeriodDoubledFrom(int branch_id, int special_point);
+  void SetStartedInWord(int branch_id);
+  void SetHandedOverFrom(int branch_id, int word_change);
+
+  // The study's typed parts that its stages give whole, each rewriting summary.json.
+  void SetExplorationStatus(ExplorationStatus status, const std::string& message);
+  void SetParameterStarts(const StudyParameterStarts& starts);
+  void SetWords(const std::vector<StudyWord>& words, const std::vector<StudyWordChange>& changes);
+  void SetCurves(const std::string& parameter, const std::vector<StudyCurve>& curves);
+  void SetSpecialPoints(std::vector<StudySpecialPoint> special_points);
+  // Writes orbit-<k>.csv and records the key frame (with its monodromy matrix Φ_T, when not empty); returns
+  // the file name.
   std::string AddOrbit(const OrbitTrace& trace, int branch_id, int index, double H, double T,
                        const std::string& label, const Matrix& monodromy = Matrix());
   void SetReport(const std::string& report);
+  void SetStartNote(const std::string& note) { record_.start_note = note; }
   // Rewrites summary.json atomically; false (and write_error() set) when it could not be written.
   bool WriteSummary();
   // The final summary: "status": "complete", or "cancelled" for a study stopped on request. False when it
@@ -158,19 +170,22 @@ class ResultsWriter {
   // folder.
   ResumeStore* resume_store() const { return resume_store_; }
   void set_resume_store(ResumeStore* store) { resume_store_ = store; }
-  // The summary document so far.
-  const nlohmann::json& summary() const { return summary_; }
-  // The analysed points of every branch so far, by branch id.
-  const std::map<int, std::vector<StudyPoint>>& points() const { return points_; }
-  // The points added so far, over every branch.
-  int num_points() const {
-    int n = 0;
-    for (const auto& [id, list] : points_) n += static_cast<int>(list.size());
-    return n;
+
+  // The study so far, typed: branches id == index (an id not listed yet is there, "unlisted"), special points,
+  // families (FoldFamilies), key frames, words, curves, report, and summary_json, the document as it stands.
+  StudyResult Record() const;
+  // The summary document as it stands (summary.json).
+  nlohmann::json Document() const;
+  // The record of branch `branch_id` so far (with its points); null for a branch not listed yet.
+  const StudyBranch* FindBranch(int branch_id) const {
+    const auto b = branches_.find(branch_id);
+    return b == branches_.end() ? nullptr : &b->second;
   }
-  // The key-frame orbits added so far, sampled.
-  const std::vector<StudyOrbit>& orbits() const { return orbits_; }
-  // One more than the largest branch id ended so far (0 for none).
+  // The analysed points of branch `branch_id` so far; null for a branch without points.
+  const std::vector<StudyPoint>* PointsOf(int branch_id) const;
+  // The points added so far, over every branch.
+  int num_points() const;
+  // One more than the largest branch id listed so far (0 for none).
   int next_branch_id() const;
 
  private:
@@ -179,7 +194,11 @@ class ResultsWriter {
   FreeParameters free_;
   ShootingLayout layout_;
   OrbitPresentation presentation_;
-  nlohmann::json summary_;
+  // The typed study (branches, families and summary_json aside: branches_, Record()).
+  StudyResult record_;
+  std::map<int, StudyBranch> branches_;  // listed from their first point (or their end) on
+  // The fields of summary.json that are no part of the typed study.
+  nlohmann::json document_;
   struct BranchModel {
     ShootingLayout layout;
     OrbitPresentation presentation;
@@ -188,28 +207,27 @@ class ResultsWriter {
     std::string origin;
   };
   std::map<int, BranchModel> branch_models_;  // branches of another model (SetBranchModel)
-  std::map<int, std::vector<StudyPoint>> points_;
-  std::map<int, BranchFamily> families_;  // SetBranchFamily
-  std::vector<StudyOrbit> orbits_;
-  std::map<int, StudyBranch> live_;  // the branches being traced, as the point hook sees them (no points)
+  int listed_orbits_ = 0;                      // the first key frames, whose files were written
+  std::map<int, StudyBranch> live_;            // the branches being traced, as the point hook sees them
   const StudyHooks* hooks_ = nullptr;
   ResumeStore* resume_store_ = nullptr;
   std::map<int, std::ofstream> branch_files_;
-  std::map<int, int> points_per_branch_;
+  std::map<int, int> rows_;                      // rows of each branch file written in full
   std::map<int, std::uintmax_t> branch_bytes_;  // bytes of each branch file written in full (whole rows)
   std::string write_error_;
   std::atomic<bool> failed_{false};
 
   // Records the first failed write of `file` (errno's message) and returns false.
   bool WriteFailed(const std::filesystem::path& file);
-  // The point's CSV row (and, first, the file's header and the branch's summary entry).
-  void WritePoint(int branch_id, const PointRecord& p, const ShootingLayout& layout,
-                  const OrbitPresentation& presentation);
-  // The branch as the study's result gives it: its summary entry so far and (with_points) its points.
-  StudyBranch BranchOf(int branch_id, bool with_points) const;
-  // Lists branch `branch_id` in summary.json ("termination": "running") when its first point is written;
-  // EndBranch completes the entry.
-  void StartBranchEntry(int branch_id);
+  // The point's CSV row (and, first, the file's header); `point` is its typed record.
+  void WritePoint(int branch_id, const PointRecord& p, const StudyPoint& point, const ShootingLayout& layout);
+  // The branch's record, listed (and summary.json rewritten) when it is first met: at its first point, or at
+  // its end for a branch without points.
+  StudyBranch& Listed(int branch_id);
+  // The branch with the given id as the hooks see it: without its points.
+  StudyBranch Unpointed(int branch_id) const;
+  // The record of a finished branch that a later stage annotates (an invariant: EndBranch came first).
+  StudyBranch& Ended(int branch_id);
 };
 
 }  // namespace hybridcont::study

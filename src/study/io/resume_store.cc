@@ -90,7 +90,13 @@ bool WriteWhole(const fs::path& file, const std::string& text) {
   return !ec;
 }
 
+// A stored file read as JSON; a name there that is no regular file (a FIFO would block the open) is refused.
 nlohmann::json ReadJson(const fs::path& file) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(file, ec);
+  if (fs::exists(status) && !fs::is_regular_file(status)) {
+    throw std::invalid_argument(file.string() + ": not a regular file (a resume store holds regular files only)");
+  }
   std::ifstream f(file);
   nlohmann::json j;
   try {

@@ -69,8 +69,14 @@ StudyBranch BranchFromSummary(const nlohmann::json& entry, const std::vector<std
   b.ranges.branch = b.id;
   b.ranges.physical = RangesFromSummary(entry, "physical_ranges", where);
   b.ranges.stable = RangesFromSummary(entry, "stable_ranges", where);
+  b.newton_iterations = JsonInt(entry, "newton_iterations", where, 0);
+  b.rejected_steps = JsonInt(entry, "rejected_steps", where, 0);
   b.period_doubled_from = JsonInt(entry, "period_doubled_from", where, -1);
   b.handed_over_from = JsonInt(entry, "handed_over_from", where, -1);
+  // Its origin (since 0.9.0; before: "started_in_word" for some families of other words, none for the others).
+  const std::string started = JsonText(entry, "started_in_word", where, "");
+  b.started_in_word = FindField(entry, "started_in_word") != nullptr;
+  b.origin = JsonText(entry, "origin", where, b.period_doubled_from >= 0 ? "period-doubled" : started);
   return b;
 }
 
@@ -221,6 +227,17 @@ void WordsFromSummary(const nlohmann::json& summary, StudyResult* r) {
 
 }  // namespace
 
+StudyBranch UnlistedBranch(int id, const StudyResult& study, const std::string& continued) {
+  StudyBranch missing;
+  missing.id = id;
+  missing.model = study.model;
+  missing.unknown_names = study.unknown_names;
+  missing.continued = continued;
+  missing.termination = "unlisted";
+  missing.ranges.branch = id;
+  return missing;
+}
+
 StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::vector<StudyPoint>> points) {
   if (!summary.is_object()) Malformed("summary", "expected an object");
   StudyResult r;
@@ -249,7 +266,6 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
     StudyBranch b = BranchFromSummary((*branches)[i], r.unknown_names, where);
     if (b.id < 0 || b.id > 1000000) Malformed(where + ".id", "out of range: " + std::to_string(b.id));
     if (b.model.empty()) b.model = r.model;
-    if (b.period_doubled_from >= 0) b.origin = "period-doubled";
     b.continued = continued;
     if (auto it = points.find(b.id); it != points.end()) b.points = std::move(it->second);
     if (!listed.emplace(b.id, std::move(b)).second) Malformed(where + ".id", "listed twice");
@@ -257,13 +273,7 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
   // id == index: a branch an interrupted study had not listed yet (it had no point) is there, "unlisted".
   for (auto& [id, b] : listed) {
     while (static_cast<int>(r.branches.size()) < id) {
-      StudyBranch missing;
-      missing.id = static_cast<int>(r.branches.size());
-      missing.model = r.model;
-      missing.unknown_names = r.unknown_names;
-      missing.continued = continued;
-      missing.termination = "unlisted";
-      r.branches.push_back(std::move(missing));
+      r.branches.push_back(UnlistedBranch(static_cast<int>(r.branches.size()), r, continued));
     }
     r.branches.push_back(std::move(b));
   }
@@ -275,6 +285,7 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
     }
   }
   r.report = JsonText(summary, "report", "summary", "");
+  r.start_note = JsonText(summary, "start_note", "summary", "");
   r.message = JsonText(summary, "status_message", "summary", "");
   const std::string status = JsonText(summary, "status", "summary", "complete");
   r.status = status == "complete" ? ExplorationStatus::kCompleted : ExplorationStatus::kCancelled;
@@ -299,6 +310,20 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
     const std::vector<std::string>& names = r.branches[p.branch].unknown_names;
     const auto position = [&](const NamedValue& v) { return std::find(names.begin(), names.end(), v.name) - names.begin(); };
     std::stable_sort(p.named_unknowns.begin(), p.named_unknowns.end(),
+                     [&](const NamedValue& a, const NamedValue& b) { return position(a) < position(b); });
+  }
+  // Observables in the model's order (the presentation's list; a JSON object keeps its keys sorted).
+  std::vector<std::string> declared;
+  if (const nlohmann::json* presentation = FindField(summary, "presentation"); presentation && presentation->is_object()) {
+    if (const nlohmann::json* list = FindField(*presentation, "observables"); list && list->is_array()) {
+      for (const nlohmann::json& o : *list) {
+        if (o.is_object() && o.contains("name") && o["name"].is_string()) declared.push_back(o["name"]);
+      }
+    }
+  }
+  for (StudySpecialPoint& p : r.special_points) {
+    const auto position = [&](const NamedValue& v) { return std::find(declared.begin(), declared.end(), v.name) - declared.begin(); };
+    std::stable_sort(p.observables.begin(), p.observables.end(),
                      [&](const NamedValue& a, const NamedValue& b) { return position(a) < position(b); });
   }
   r.families = FoldFamilies(r.branches, r.special_points);  // derived: summary.json's "families" is not read

@@ -23,6 +23,9 @@ namespace hybridcont::study {
 StudyBranch BranchFromSummary(const nlohmann::json& entry, const std::vector<std::string>& unknowns,
                               const std::string& where = "branches[]");
 StudySpecialPoint SpecialPointFromSummary(const nlohmann::json& entry, const std::string& where = "special_points[]");
+// The branch with id `id` that a study's record does not list (an interrupted study's branch that had no point
+// yet): "unlisted", in the study's own model and layout.
+StudyBranch UnlistedBranch(int id, const StudyResult& study, const std::string& continued);
 // The whole study; points[id] are branch id's analysed points.
 StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::vector<StudyPoint>> points);
 

@@ -1,9 +1,9 @@
 // LoadStudy (study.h): a results folder read back into the typed study. The folder is untrusted input: its
 // summary.json and every branch file are checked, and an error names the file, the line and the field.
 //
-// Precision: u is written with 17 significant digits and read back exactly; the analysis columns
-// (multipliers, replay errors, test functions) with 10 and the residual with 4 (docs/results-format.md), so
-// a loaded analysis equals the computed one to that many digits. Key-frame orbits are read with their samples
+// Precision: u is written with 17 significant digits and the analysis columns (multipliers, replay errors, test
+// functions, residual, step, the period's slope) in their shortest exact form, so a loaded study equals the
+// computed one to the bit (folders written before 0.9.0: the analysis to 10 digits, docs/results-format.md). Key-frame orbits are read with their samples
 // (orbit-<k>.csv: time and states at 17 digits, exactly; older folders' 12).
 #include <cctype>
 #include <cerrno>
@@ -20,6 +20,7 @@
 
 #include "hybridcont/study.h"
 #include "study/io/results_writer.h"
+#include "study/io/json_fields.h"
 #include "study/io/study_document.h"
 
 namespace hybridcont {
@@ -68,9 +69,11 @@ std::ifstream OpenRegular(const fs::path& file) {
   return std::ifstream(file);
 }
 
-// The analysed points of one branch file.
+// The analysed points of one branch file: its unknowns, analysis, observables and quantities (by name), and the
+// period's slope dT_d<continued>.
 std::vector<StudyPoint> ReadBranchFile(const fs::path& file, const std::vector<std::string>& unknowns,
-                                       const std::vector<std::string>& observables) {
+                                       const std::vector<std::string>& observables,
+                                       const std::vector<std::string>& quantities, const std::string& continued) {
   std::ifstream f = OpenRegular(file);
   if (!f) throw std::invalid_argument(file.string() + ": cannot be read");
   std::string line;
@@ -144,6 +147,11 @@ std::vector<StudyPoint> ReadBranchFile(const fs::path& file, const std::vector<s
       const auto it = last.find(name);
       if (it != last.end()) a.observables.emplace_back(name, number(it->second));
     }
+    for (const std::string& name : quantities) {  // before the observables: the first column of the name
+      const auto it = first.find(name);
+      if (it != first.end()) p.quantities.push_back({name, number(it->second)});
+    }
+    p.period_slope = optional("dT_d" + continued);
     points.push_back(std::move(p));
   }
   return points;
@@ -175,6 +183,18 @@ void ReadCurves(const nlohmann::json& summary, const fs::path& dir, StudyResult*
     curve.name = e.contains("name") && e["name"].is_string() ? e["name"].get<std::string>() : std::string();
     curve.special_point = e.contains("special_point") && e["special_point"].is_number_integer() ? e["special_point"].get<int>() : -1;
     curve.status = e.value("status", std::string());
+    curve.message = e.contains("message") && e["message"].is_string() ? e["message"].get<std::string>() : std::string();
+    using study::JsonNumber, study::JsonText, study::JsonTexts;
+    if (e.contains("termination")) curve.termination = JsonTexts(e, "termination", at);
+    if (e.contains("codim_two")) {
+      if (!e["codim_two"].is_array()) throw std::invalid_argument(at + ".codim_two: expected a list");
+      for (std::size_t k = 0; k < e["codim_two"].size(); ++k) {
+        const nlohmann::json& q = e["codim_two"][k];
+        const std::string where = at + ".codim_two[" + std::to_string(k) + "]";
+        curve.codim_two.push_back({JsonText(q, "type", where), JsonText(q, "name", where, ""), JsonText(q, "status", where),
+                                   JsonNumber(q, "H", where), JsonNumber(q, r->curve_parameter, where)});
+      }
+    }
     std::ifstream f = OpenRegular(dir / file);
     std::string line;
     if (!std::getline(f, line)) throw std::invalid_argument((dir / file).string() + ": empty (no header)");
@@ -270,12 +290,15 @@ StudyResult LoadStudy(const std::string& dir_text) {
     }
   }
   try {
-    std::vector<std::string> observables;
-    if (summary.contains("presentation") && summary["presentation"].is_object() &&
-        summary["presentation"].contains("observables") && summary["presentation"]["observables"].is_array()) {
-      for (const nlohmann::json& o : summary["presentation"]["observables"]) {
-        if (o.is_object() && o.contains("name") && o["name"].is_string()) observables.push_back(o["name"]);
+    std::vector<std::string> observables, quantities;
+    if (summary.contains("presentation") && summary["presentation"].is_object()) {
+      const nlohmann::json& presentation = summary["presentation"];
+      if (presentation.contains("observables") && presentation["observables"].is_array()) {
+        for (const nlohmann::json& o : presentation["observables"]) {
+          if (o.is_object() && o.contains("name") && o["name"].is_string()) observables.push_back(o["name"]);
+        }
       }
+      if (presentation.contains("quantities")) quantities = study::JsonTexts(presentation, "quantities", "presentation");
     }
     // The typed branches first (their layouts), then their files.
     StudyResult shape = study::ResultFromSummary(summary, {});
@@ -292,7 +315,13 @@ StudyResult LoadStudy(const std::string& dir_text) {
         throw std::invalid_argument("branches[" + std::to_string(b.id) + "].file: '" + file + "' is not a file name");
       }
       if (!fs::exists(dir / file, ec)) continue;  // listed before its first point was written
-      points[b.id] = ReadBranchFile(dir / file, b.unknown_names, observables);
+      // A branch of another model names its own quantities and observables (summary_json.h, BranchJson).
+      const std::string at = "branches[" + std::to_string(b.id) + "]";
+      const std::vector<std::string> own_quantities =
+          entry.contains("quantities") ? study::JsonTexts(entry, "quantities", at) : quantities;
+      const std::vector<std::string> own_observables =
+          entry.contains("observables") ? study::JsonTexts(entry, "observables", at) : observables;
+      points[b.id] = ReadBranchFile(dir / file, b.unknown_names, own_observables, own_quantities, b.continued);
     }
     StudyResult r = study::ResultFromSummary(summary, std::move(points));
     ReadCurves(summary, dir, &r);

@@ -6,6 +6,7 @@
 
 #include "hybridcont/orbit_observables.h"
 #include "study/engine/model_exploration.h"
+#include "study/stages/families.h"
 
 namespace hybridcont::study {
 
@@ -147,6 +148,153 @@ nlohmann::json WordChangesJson(const std::vector<StudyWordChange>& changes) {
     list.push_back(std::move(j));
   }
   return list;
+}
+
+namespace {
+
+nlohmann::json RangesJson(const std::vector<Range>& list) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const Range& r : list) {
+    a.push_back({{"from", r.from.value}, {"to", r.to.value}, {"from_how", r.from.how}, {"to_how", r.to.how},
+                 {"from_special_point", r.from.special_point}, {"to_special_point", r.to.special_point},
+                 {"first_point", r.first_point}, {"last_point", r.last_point}, {"family", r.family}});
+  }
+  return a;
+}
+
+nlohmann::json StabilityChangesJson(const StudyBranch& b) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const StabilityChange& c : StabilityChanges(b)) {
+    nlohmann::json j = {{"after_point", c.after_point}, {b.continued, c.value}, {"stable", c.stable},
+                        {"located", c.located}};
+    if (c.special_point >= 0) j["special_point"] = c.special_point, j["how"] = c.how;
+    list.push_back(std::move(j));
+  }
+  return list;
+}
+
+}  // namespace
+
+nlohmann::json BranchJson(const StudyBranch& b, int rows, const StudyResult& study) {
+  nlohmann::json j = {{"id", b.id},
+                      {"file", BranchFileName(b.id)},
+                      {"parent", b.parent_special_point},
+                      {"direction", b.direction},
+                      {"depth", b.depth},
+                      {"points", rows},
+                      {"termination", b.termination},
+                      {"message", b.message},
+                      {"newton_iterations", b.newton_iterations},
+                      {"rejected_steps", b.rejected_steps},
+                      {"word", b.word}};
+  if (b.model != study.model) j["model"] = b.model;
+  if (b.model != study.model || !b.origin.empty()) {  // another model (another word's may keep the name)
+    // Its own model's quantities and observables, the names of its file's columns of them.
+    std::vector<std::string> quantities, observables;
+    if (!b.points.empty()) {
+      for (const NamedValue& q : b.points.front().quantities) quantities.push_back(q.name);
+      for (const auto& [name, value] : b.points.front().analysis.observables) observables.push_back(name);
+    }
+    j["quantities"] = quantities;
+    j["observables"] = observables;
+  }
+  if (!b.origin.empty()) j["origin"] = b.origin;
+  if (b.unknown_names != study.unknown_names) j["unknowns"] = b.unknown_names;
+  if (b.image_of >= 0) j["image_of"] = b.image_of, j["symmetry"] = b.symmetry;
+  if (b.reflected_from >= 0) j["reflected_from"] = b.reflected_from, j["symmetry"] = b.symmetry;
+  if (!b.family.empty()) {
+    j["family"] = b.family;
+    j["physical_ranges"] = RangesJson(b.ranges.physical);
+    j["stable_ranges"] = RangesJson(b.ranges.stable);
+  }
+  if (b.period_doubled_from >= 0) {
+    j["period_doubled_from"] = b.period_doubled_from;
+    j["stability_changes"] = StabilityChangesJson(b);
+  }
+  if (b.started_in_word) j["started_in_word"] = b.origin;
+  if (b.handed_over_from >= 0) j["handed_over_from"] = b.handed_over_from;
+  return j;
+}
+
+nlohmann::json CurvesJson(const std::string& parameter, const std::vector<StudyCurve>& curves) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const StudyCurve& c : curves) {
+    nlohmann::json codim_two = nlohmann::json::array();
+    for (const StudyCurve::CodimTwo& q : c.codim_two) {
+      codim_two.push_back({{"type", q.type}, {"name", q.name}, {"status", q.status}, {"H", q.H}, {parameter, q.p}});
+    }
+    nlohmann::json j = {{"id", c.id},
+                        {"file", "curve_" + std::to_string(c.id) + ".csv"},
+                        {"type", c.type},
+                        {"special_point", c.special_point >= 0 ? nlohmann::json(c.special_point) : nlohmann::json(nullptr)},
+                        {"status", c.status},
+                        {"message", c.message},
+                        {"points", c.points.size()},
+                        {"codim_two", codim_two}};
+    if (!c.name.empty()) j["name"] = c.name;
+    if (!c.termination.empty()) j["termination"] = c.termination;
+    list.push_back(std::move(j));
+  }
+  return list;
+}
+
+std::string OrbitFileName(int k) { return "orbit-" + std::to_string(k) + ".csv"; }
+
+nlohmann::json OrbitsJson(const std::vector<StudyOrbit>& orbits, int listed) {
+  nlohmann::json list = nlohmann::json::array();
+  for (int k = 0; k < listed && k < static_cast<int>(orbits.size()); ++k) {
+    const StudyOrbit& o = orbits[k];
+    nlohmann::json entry = {{"file", OrbitFileName(k)}, {"branch", o.branch}, {"index", o.index},
+                            {"H", o.H},                 {"T", o.T},           {"label", o.family}};
+    if (o.monodromy.size() > 0) {
+      nlohmann::json rows = nlohmann::json::array();
+      for (Eigen::Index i = 0; i < o.monodromy.rows(); ++i) {
+        nlohmann::json row = nlohmann::json::array();
+        for (Eigen::Index j = 0; j < o.monodromy.cols(); ++j) row.push_back(o.monodromy(i, j));
+        rows.push_back(std::move(row));
+      }
+      entry["monodromy"] = std::move(rows);
+    }
+    list.push_back(std::move(entry));
+  }
+  return list;
+}
+
+nlohmann::json SummaryJson(const StudyResult& record, const std::map<int, StudyBranch>& branches,
+                           const std::map<int, int>& rows, int listed_orbits, nlohmann::json document) {
+  document["model"] = record.model;
+  document["version"] = record.version;
+  document["model_source"] = ModelSourceJson(record.model_source);
+  nlohmann::json parameters = nlohmann::json::object();
+  for (const NamedValue& p : record.parameters) parameters[p.name] = p.value;
+  document["parameters"] = parameters;
+  document["unknowns"] = record.unknown_names;
+  nlohmann::json listed = nlohmann::json::array();
+  std::vector<StudyBranch> ranged;  // the branches without their points, for the families
+  for (const auto& [id, b] : branches) {
+    const auto r = rows.find(id);
+    listed.push_back(BranchJson(b, r == rows.end() ? 0 : r->second, record));
+    StudyBranch copy;
+    copy.id = b.id;
+    copy.continued = b.continued;
+    copy.family = b.family;
+    copy.ranges = b.ranges;
+    ranged.push_back(std::move(copy));
+  }
+  document["branches"] = std::move(listed);
+  // Derived, for the folder's readers that do not fold ranges themselves (LoadStudy folds them again).
+  document["families"] = FamiliesJson(FoldFamilies(ranged, record.special_points));
+  document["special_points"] = SpecialPointsJson(record.special_points);
+  document["orbits"] = OrbitsJson(record.orbits, listed_orbits);
+  if (!record.words.empty()) {
+    document["words"] = WordsJson(record.words);
+    document["word_changes"] = WordChangesJson(record.word_changes);
+  }
+  if (record.parameter_starts) document["starts"] = ParameterStartsJson(*record.parameter_starts);
+  if (!record.curve_parameter.empty()) document["curves"] = CurvesJson(record.curve_parameter, record.curves);
+  if (!record.report.empty()) document["report"] = record.report;
+  if (!record.start_note.empty()) document["start_note"] = record.start_note;
+  return document;
 }
 
 nlohmann::json ParameterStartsJson(const StudyParameterStarts& s) {

@@ -6,8 +6,10 @@
 #ifndef HYBRIDCONT_STUDY_SUMMARY_JSON_H_
 #define HYBRIDCONT_STUDY_SUMMARY_JSON_H_
 
-#include <nlohmann/json.hpp>
+#include <map>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "hybridcont/study.h"
 #include "hybridcont/exploration.h"
@@ -40,6 +42,29 @@ nlohmann::json WordChangesJson(const std::vector<StudyWordChange>& changes);
 // A free-parameter study's starts, summary.json's "starts": {"crossings", "distinct", "on_traced_branches",
 // "ordinary_half_branches"}.
 nlohmann::json ParameterStartsJson(const StudyParameterStarts& starts);
+
+// A branch's entry in summary.json ("branches"; BranchFromSummary reads it back): {"id", "file", "parent",
+// "direction", "depth", "points" (`rows`: the rows of its file), "termination", "message", "newton_iterations",
+// "rejected_steps", "word"} and as the branch has them: "model", "quantities" and "observables" (its
+// model's, the names of their columns), "origin" and "unknowns" (a branch of another
+// model or layout than the study's), "image_of"/"reflected_from" with "symmetry", "family" with
+// "physical_ranges" and "stable_ranges", "period_doubled_from" with "stability_changes", "started_in_word",
+// "handed_over_from".
+nlohmann::json BranchJson(const StudyBranch& b, int rows, const StudyResult& study);
+// The study's two-parameter curves, summary.json's "curves" (parameter_curves.h).
+nlohmann::json CurvesJson(const std::string& parameter, const std::vector<StudyCurve>& curves);
+// The file of the k-th key frame of a results folder: "orbit-<k>.csv".
+std::string OrbitFileName(int k);
+// The first `listed` key frames, summary.json's "orbits": [{"file", "branch", "index", "H", "T", "label",
+// "monodromy" (rows; where computed)}] (their samples are in the files).
+nlohmann::json OrbitsJson(const std::vector<StudyOrbit>& orbits, int listed);
+
+// summary.json: the typed study `record` (its branches given apart, by id, with the rows of their files; the
+// first `listed_orbits` key frames) serialized into `document`, which holds the fields that are no part of
+// the typed study (format, description, phases, special-point codes, presentation, options, status, how a
+// restart or a guided study began). The one writer of the document; ResultFromSummary its reader.
+nlohmann::json SummaryJson(const StudyResult& record, const std::map<int, StudyBranch>& branches,
+                           const std::map<int, int>& rows, int listed_orbits, nlohmann::json document);
 
 // The study's model_source (study.h, StudyModelSource): {"kind", "name", "path", "sha256", "text"}, the
 // fields its kind has.

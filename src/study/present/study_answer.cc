@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "hybridcont/classification.h"
+
 namespace hybridcont {
 
 namespace {
@@ -60,6 +62,37 @@ int TwinOf(const StudyResult& study, const StudyBranch& b) {
   return -1;
 }
 
+// What an orbit class usually says about a model where a whole study finds no physical orbit of it.
+std::string ClassMeaning(OrbitClass c) {
+  switch (c) {
+    case OrbitClass::kWrongDirection:
+      return "a phase ends where its event is crossed upward, while a phase ends at a downward crossing (e_i from "
+             "positive to negative): an event's sign is likely reversed";
+    case OrbitClass::kReversedTime:
+      return "a duration is negative: the orbit runs backward in time (the family's mirror image of a physical one, "
+             "or a reset or event that sends the motion back)";
+    case OrbitClass::kMissedEvent:
+      return "the event was crossed earlier in the phase, or the phase starts beyond it: the phase would have ended "
+             "sooner (check the event and the reset into the phase)";
+    case OrbitClass::kAnchorGrazing:
+    case OrbitClass::kMissedAnchor:
+      return "the anchor (the Poincaré section) is not crossed once, downward: check the anchor";
+    case OrbitClass::kConstraintViolated:
+      return "a constraint of the model is negative (a foot below the ground, a contact force pulling)";
+    case OrbitClass::kDissipative:
+    case OrbitClass::kAtRest:
+      return "xi is not zero: the orbit is one of the unfolded field f + xi grad H, not of the model (the first "
+             "integral is not kept by a phase or a reset, or the family is at rest)";
+    case OrbitClass::kZeroDuration:
+      return "a phase lasts no time: the orbit sits on a boundary of its phase sequence";
+    case OrbitClass::kReplayFailed:
+      return "the event-driven simulation from the orbit's first state does not return to it: an event is crossed "
+             "between the phases' own ends";
+    default:
+      return "";
+  }
+}
+
 }  // namespace
 
 std::string OneScreenAnswer(const StudyResult& study, double seconds) {
@@ -71,6 +104,7 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
   }
   out += fmt::format("\n{}: {} branch{} with physical orbits of {} ({} points)\n", study.model, physical_branches,
                      physical_branches == 1 ? "" : "es", study.branches.size(), points);
+  if (!study.start_note.empty()) out += study.start_note + "\n";
   // The families over all their branches (FoldFamilies): what a sweep's table and Python's families say.
   if (!study.families.empty()) {
     out += "families, over all their branches:\n";
@@ -159,6 +193,15 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
     if (ranked.size() > 3) why += ", ...";
     out += fmt::format("\n{} more branch{} no physical orbit{}.\n", others, others == 1 ? " holds" : "es hold",
                        why.empty() ? "" : " (their points: " + why + ")");
+    // What the most frequent classes usually mean, where no family is physical at all: the first thing to check.
+    if (physical_branches == 0) {
+      for (std::size_t i = 0; i < ranked.size() && i < 3; ++i) {
+        OrbitClass c;
+        if (FromString(ranked[i].second, &c) && !ClassMeaning(c).empty()) {
+          out += fmt::format("  {}: {}\n", ranked[i].second, ClassMeaning(c));
+        }
+      }
+    }
   }
   if (study.status != ExplorationStatus::kCompleted) {
     out += fmt::format("\nThe run did not complete ({}): {}\n", ToString(study.status), study.message);

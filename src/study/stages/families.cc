@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -45,9 +46,9 @@ BranchFamily FamilyOfBranch(const Branch& b, const std::vector<StudyPoint>& poin
 
 std::string AssignBranchFamily(const Branch& b, const ShootingLayout& layout, const FamilyNamer& name_of,
                                ResultsWriter& writer) {
-  const auto points = writer.points().find(b.id);
-  if (points == writer.points().end()) return "";
-  const BranchFamily f = FamilyOfBranch(b, points->second, layout.continued_index(), name_of);
+  const std::vector<StudyPoint>* points = writer.PointsOf(b.id);
+  if (points == nullptr) return "";
+  const BranchFamily f = FamilyOfBranch(b, *points, layout.continued_index(), name_of);
   if (f.family.empty()) return "";
   writer.SetBranchFamily(b.id, f);
   const std::string& name = layout.continued_name();
@@ -122,6 +123,34 @@ std::vector<FamilyInterval> Union(std::vector<FamilyInterval> list) {
 }
 
 }  // namespace
+
+std::vector<study::StabilityChange> study::StabilityChanges(const StudyBranch& b) {
+  std::vector<StabilityChange> changes;
+  const auto c = std::find(b.unknown_names.begin(), b.unknown_names.end(), b.continued);
+  if (c == b.unknown_names.end()) return changes;
+  const auto coordinate = static_cast<Eigen::Index>(c - b.unknown_names.begin());
+  std::optional<bool> previous;  // the stability of the last physical point with multipliers
+  for (std::size_t i = 0; i < b.points.size(); ++i) {
+    const OrbitAnalysis& a = b.points[i].analysis;
+    if (!a.classification.physical || !a.floquet) continue;
+    if (previous && a.stable != *previous) {
+      StabilityChange change{static_cast<int>(i) - 1, b.points[i].u(coordinate), a.stable, false, -1, ""};
+      for (const Range& r : b.ranges.stable) {  // a stable stretch that begins at point i or ends before it
+        const RangeEnd* end = r.first_point == static_cast<int>(i)      ? &r.from
+                              : r.last_point + 1 == static_cast<int>(i) ? &r.to
+                                                                        : nullptr;
+        if (end == nullptr || end->special_point < 0) continue;
+        change.value = end->value;
+        change.located = end->located;
+        change.special_point = end->special_point;
+        change.how = end->how;
+      }
+      changes.push_back(change);
+    }
+    previous = a.stable;
+  }
+  return changes;
+}
 
 bool StudyBranch::OnPhysicalStretch(int index) const {
   for (const Range& r : ranges.physical) {

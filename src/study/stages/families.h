@@ -44,6 +44,20 @@ BranchFamily FamilyOfBranch(const Branch& b, const std::vector<StudyPoint>& poin
 std::string AssignBranchFamily(const Branch& b, const ShootingLayout& layout, const FamilyNamer& name_of,
                                ResultsWriter& writer);
 
+// Where the linear stability of a branch's physical orbits flips, between points after_point and after_point + 1
+// (a period-doubled family's "stability_changes" in summary.json): at the special point located there — the
+// end of a stable stretch (family_ranges.h), its value and how it is known — else at the later point's value,
+// not located. From the branch's analysed points and stable ranges; empty without them.
+struct StabilityChange {
+  int after_point = 0;
+  double value = 0;      // of the branch's continued coordinate
+  bool stable = false;   // after the change
+  bool located = false;
+  int special_point = -1;
+  std::string how;       // the end's text (RangeEnd::how) where it is a special point's
+};
+std::vector<StabilityChange> StabilityChanges(const StudyBranch& b);
+
 // The family names of a period-doubled family's orbits u_2 = [c_1 | c_2 | ξ | H̄ ...] (period_doubling.h), from
 // the parent model's rules (`parent_name_of`, on parent orbits of `parent`'s layout) applied to each cycle
 // [c_j | ξ | H̄ ...]: "period-doubled " and the cycles' names, distinct and in alphabetical order, joined by

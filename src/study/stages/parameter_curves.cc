@@ -29,22 +29,15 @@ std::vector<int> CurveColumns(const SpecialPointCurve& curve, const std::string&
   return order;
 }
 
-// The curve typed for the study's result, its points in CurveColumns' order.
-StudyCurve Typed(const SpecialPointCurve& curve, const std::string& p, const nlohmann::json& entry) {
-  StudyCurve c;
-  c.id = entry["id"];
-  c.type = entry["type"];
-  c.name = entry.value("name", std::string());
-  c.special_point = entry["special_point"].is_number() ? entry["special_point"].get<int>() : -1;
-  c.status = entry["status"];
+// The curve's points in CurveColumns' order, into `c` (its columns and points).
+void SetPoints(const SpecialPointCurve& curve, const std::string& p, StudyCurve* c) {
   const std::vector<int> order = CurveColumns(curve, p);
-  for (const int j : order) c.columns.push_back(curve.unknown_names[j]);
+  for (const int j : order) c->columns.push_back(curve.unknown_names[j]);
   for (const Vector& u : curve.points) {
     Vector v(static_cast<Eigen::Index>(order.size()));
     for (std::size_t j = 0; j < order.size(); ++j) v(static_cast<Eigen::Index>(j)) = u(order[j]);
-    c.points.push_back(std::move(v));
+    c->points.push_back(std::move(v));
   }
-  return c;
 }
 
 // The curve's points as CSV: H, p, then the other unknowns. False when the file could not be written.
@@ -156,10 +149,10 @@ bool OnCurve(const std::vector<std::vector<Eigen::Vector2d>>& curves, const Eige
 class CurveTracer {
  public:
   CurveTracer(const HybridModel& model, const RunSetup& setup, const std::filesystem::path& dir, std::string* report,
-              std::vector<StudyCurve>* typed)
+              std::vector<StudyCurve>* curves)
       : model_(model), setup_(setup), p_(setup.curve_parameter), p0_(model.parameter(p_)),
         base_(model, setup.integrator, FreeParameters{{p_}, {{p_, p0_}}, {}}), fix_row_(base_.layout().fixed_row(0)),
-        layout_(model), dir_(dir), report_(report), typed_(typed) {
+        layout_(model), dir_(dir), report_(report), curves_(curves) {
     ContinuationOptions& c = options_.continuation;
     c.bounds = {setup.curve_bound};
     for (const ComponentBound& b : setup.exploration.continuation.bounds) {
@@ -174,13 +167,12 @@ class CurveTracer {
     c.max_points = setup.scenario.max_points;
   }
 
-  nlohmann::json Trace(const BifurcationDiagram& diagram) {
+  void Trace(const BifurcationDiagram& diagram) {
     *report_ += fmt::format("Special-point curves in (H, {}) over {} in [{:g}, {:g}]:\n", p_, p_,
                             setup_.curve_bound.lower, setup_.curve_bound.upper);
     for (const SpecialPoint& sp : diagram.special_points) FromSpecialPoint(sp, diagram);
     Boundaries(diagram);
-    if (curves_.empty()) *report_ += "  none\n";
-    return curves_;
+    if (curves_->empty()) *report_ += "  none\n";
   }
 
  private:
@@ -193,21 +185,18 @@ class CurveTracer {
   const ShootingLayout layout_;
   const std::filesystem::path dir_;
   std::string* report_;
-  std::vector<StudyCurve>* typed_;
+  std::vector<StudyCurve>* curves_;
   SpecialPointCurveOptions options_;
-  nlohmann::json curves_ = nlohmann::json::array();
   std::map<std::string, std::vector<std::vector<Eigen::Vector2d>>> traced_;  // boundaries' (H, p) polylines
 
-  // Writes the curve's file and records it (`entry` gets its id and file); returns its id.
-  int Record(const SpecialPointCurve& curve, nlohmann::json entry) {
-    const int id = static_cast<int>(curves_.size());
-    const std::string file = "curve_" + std::to_string(id) + ".csv";
+  // Writes the curve's file (curve_<id>.csv) and records `c` with its id and points; returns its id.
+  int Record(const SpecialPointCurve& curve, StudyCurve c) {
+    c.id = static_cast<int>(curves_->size());
+    const std::string file = "curve_" + std::to_string(c.id) + ".csv";
     if (!dir_.empty() && !WriteCurve(curve, p_, dir_ / file)) throw CurveFileError("writing " + (dir_ / file).string() + " failed");
-    entry["id"] = id;
-    entry["file"] = file;
-    curves_.push_back(std::move(entry));
-    if (typed_) typed_->push_back(Typed(curve, p_, curves_.back()));
-    return id;
+    SetPoints(curve, p_, &c);
+    curves_->push_back(std::move(c));
+    return curves_->back().id;
   }
 
   // A fold, an SB point, or a PD or NS point (the zero of its Floquet test function: the stability boundary a
@@ -253,19 +242,17 @@ class CurveTracer {
       return static_cast<int>(std::find(curve.unknown_names.begin(), curve.unknown_names.end(), name) -
                               curve.unknown_names.begin());
     };
-    nlohmann::json codim_two = nlohmann::json::array();
+    StudyCurve c;
+    c.type = floquet ? ToString(sp.type) : ToString(curve.kind);
+    c.special_point = sp.id;
+    c.status = ToString(curve.status);
+    c.message = curve.message;
+    c.termination = {ToString(curve.backward_termination), ToString(curve.forward_termination)};
     for (const CodimTwoPoint& q : curve.codim_two_points) {
-      codim_two.push_back({{"type", ToString(q.type)}, {"name", q.name}, {"status", ToString(q.status)},
-                           {"H", q.u(column("H"))}, {p_, q.u(column(p_))}});
+      c.codim_two.push_back({ToString(q.type), q.name, ToString(q.status), q.u(column("H")), q.u(column(p_))});
     }
-    const std::string type = floquet ? ToString(sp.type) : ToString(curve.kind);
-    const int id = Record(curve, {{"type", type},
-                                  {"special_point", sp.id},
-                                  {"status", ToString(curve.status)},
-                                  {"message", curve.message},
-                                  {"points", curve.points.size()},
-                                  {"termination", {ToString(curve.backward_termination), ToString(curve.forward_termination)}},
-                                  {"codim_two", codim_two}});
+    const std::string type = c.type;
+    const int id = Record(curve, std::move(c));
     *report_ += fmt::format("  curve {} ({}) from special point {} at H = {:.10f}: {} points, {}; {} codimension-two "
                             "points\n",
                             id, type, sp.id, sp.u(base_.layout().H_index()), curve.points.size(),
@@ -293,13 +280,11 @@ class CurveTracer {
     SpecialPointCurve curve;
     curve.unknown_names = names;
     curve.points = points;
-    const int id = Record(curve, {{"type", "boundary"},
-                                  {"name", boundary.name + " = 0"},
-                                  {"special_point", nullptr},
-                                  {"status", "traced"},
-                                  {"message", ""},
-                                  {"points", points.size()},
-                                  {"codim_two", nlohmann::json::array()}});
+    StudyCurve c;
+    c.type = "boundary";
+    c.name = boundary.name + " = 0";
+    c.status = "traced";
+    const int id = Record(curve, std::move(c));
     const auto by_H = [](const auto& a, const auto& b) { return a(0) < b(0); };
     *report_ += fmt::format("  curve {} (boundary {} = 0) from {}: {} points, H in [{:.6f}, {:.6f}]\n", id,
                             boundary.name, from, points.size(),
@@ -334,10 +319,12 @@ class CurveTracer {
 
 }  // namespace
 
-nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
-                                    const std::filesystem::path& dir, std::string* report,
-                                    std::vector<StudyCurve>* typed) {
-  return CurveTracer(model, setup, dir, report, typed).Trace(diagram);
+std::vector<StudyCurve> TraceParameterCurves(const HybridModel& model, const RunSetup& setup,
+                                             const BifurcationDiagram& diagram, const std::filesystem::path& dir,
+                                             std::string* report) {
+  std::vector<StudyCurve> curves;
+  CurveTracer(model, setup, dir, report, &curves).Trace(diagram);
+  return curves;
 }
 
 }  // namespace hybridcont::study

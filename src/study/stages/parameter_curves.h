@@ -2,7 +2,7 @@
 // families, each continued in (H̄, p) as a two-parameter curve (special_point_curve.h), written as
 // curve_<n>.csv and listed in summary.json under "curves".
 //
-//   nlohmann::json curves = TraceParameterCurves(model, setup, diagram, writer.dir(), &report);
+//   std::vector<StudyCurve> curves = TraceParameterCurves(model, setup, diagram, writer.dir(), &report);
 //
 // Base map of every curve: the time-based map with p free and held at its value by a fixing row
 // (FreeParameters{{p}, {{p, p0}}}): the family in H̄ at fixed p, whose turning points are folds and whose
@@ -16,7 +16,7 @@
 // in (H̄, p) — the boundary of the region where the family exists and is physical. One curve per boundary
 // quantity and place (a start on a traced curve of the same quantity is skipped).
 //
-// summary.json: "curves": [{"id", "type" ("fold" | "branch-point" | "boundary"), "file", "special_point"
+// summary.json (summary_json.h, CurvesJson): "curves": [{"id", "type" ("fold" | "branch-point" | "boundary"), "file", "special_point"
 // (null for a boundary), "name" (a boundary's "t2 = 0", "clearance = 0"), "status", "points", "termination":
 // [backward, forward], "codim_two": [{"type", "name", "status", "H", p}]}].
 // curve_<n>.csv: H, p, then the other curve unknowns (those of the map, and beta for branch points).
@@ -26,8 +26,6 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 #include "hybridcont/exploration.h"
 #include "hybridcont/study.h"
@@ -43,11 +41,11 @@ class CurveFileError : public std::runtime_error {
 
 // Traces the curves of diagram's special points (model units, the model's layout) in
 // setup.curve_parameter within setup.curve_bound and the scenario's H bound, writes their files into
-// dir and returns the "curves" list; report gets one line per curve.
-// Each curve also typed into `typed` (may be null).
-nlohmann::json TraceParameterCurves(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
-                                    const std::filesystem::path& dir, std::string* report,
-                                    std::vector<StudyCurve>* typed = nullptr);
+// dir (when not empty) and returns them, id == index; report gets one line per curve. A file that cannot be
+// written throws CurveFileError.
+std::vector<StudyCurve> TraceParameterCurves(const HybridModel& model, const RunSetup& setup,
+                                             const BifurcationDiagram& diagram, const std::filesystem::path& dir,
+                                             std::string* report);
 
 }  // namespace hybridcont::study
 

@@ -55,36 +55,6 @@ std::string Multipliers(const FloquetResult& f) {
   return text;
 }
 
-// Where the stability of a branch's physical orbits changes (summary.json's "stability_changes"): at the special
-// point located between the two points, the end of a stable stretch there (family_ranges.h), else between them,
-// not located (the later point's value).
-nlohmann::json StabilityChanges(const std::vector<StudyPoint>& points, const BranchRanges& ranges,
-                                const ShootingLayout& layout) {
-  nlohmann::json changes = nlohmann::json::array();
-  std::optional<bool> previous;  // the stability of the last physical point with multipliers
-  for (size_t i = 0; i < points.size(); ++i) {
-    const OrbitAnalysis& a = points[i].analysis;
-    if (!a.classification.physical || !a.floquet) continue;
-    if (previous && a.stable != *previous) {
-      nlohmann::json change = {{"after_point", i - 1}, {layout.continued_name(), points[i].u(layout.continued_index())},
-                               {"stable", a.stable}, {"located", false}};
-      for (const Range& r : ranges.stable) {  // a stable stretch that begins at point i or ends before it
-        const RangeEnd* end = r.first_point == static_cast<int>(i)      ? &r.from
-                              : r.last_point + 1 == static_cast<int>(i) ? &r.to
-                                                                        : nullptr;
-        if (end == nullptr || end->special_point < 0) continue;
-        change[layout.continued_name()] = end->value;
-        change["located"] = end->located;
-        change["special_point"] = end->special_point;
-        change["how"] = end->how;
-      }
-      changes.push_back(change);
-    }
-    previous = a.stable;
-  }
-  return changes;
-}
-
 }  // namespace
 
 std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridModel& doubled, const RunSetup& setup,
@@ -136,26 +106,19 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
       special_points->push_back(std::move(p));
     }
     for (const Branch& b : d.branches) {
+      if (!begun.count(b.id)) writer.SetBranchModel(b.id, doubled, "period-doubled");  // a branch without points
       writer.EndBranch(b);
       // Its family and ranges (families.h), from the typed analysis of its points, and where its stability changes.
       family_lines += AssignBranchFamily(b, layout, name_of, writer);
-      const auto analysed = writer.points().find(b.id);
-      const nlohmann::json changes =
-          analysed == writer.points().end()
-              ? nlohmann::json::array()
-              : StabilityChanges(analysed->second,
-                                 FamilyOfBranch(b, analysed->second, layout.continued_index(), name_of).ranges, layout);
-      writer.AnnotateBranch(b.id, {{"period_doubled_from", pd_id},
-                                   {"model", doubled.name()},
-                                   {"unknowns", layout.unknown_names()},
-                                   {"stability_changes", changes}});
+      writer.SetPeriodDoubledFrom(b.id, pd_id);
+      const std::vector<StabilityChange> changes = StabilityChanges(*writer.FindBranch(b.id));
       const Vector& start = b.points.empty() ? u_pd : b.points.front().u;
       const FloquetResult f = b.points.empty() ? FloquetResult{} : ComputeFloquet(floquet_map, start);
       std::string flips;
-      for (const nlohmann::json& c : changes) {
-        flips += fmt::format("{}{} = {:.10f} ({}{})", flips.empty() ? "" : ", ", layout.continued_name(),
-                             c[layout.continued_name()].get<double>(), c["stable"].get<bool>() ? "stable" : "unstable",
-                             c.contains("how") ? ", " + c["how"].get<std::string>() : ", between two points, not located");
+      for (const StabilityChange& c : changes) {
+        flips += fmt::format("{}{} = {:.10f} ({}{})", flips.empty() ? "" : ", ", layout.continued_name(), c.value,
+                             c.stable ? "stable" : "unstable",
+                             c.special_point >= 0 ? ", " + c.how : ", between two points, not located");
       }
       report += fmt::format("    branch {}: {} points, {}; start T = {:.12f} (2x parent {:.12f}), multipliers {}; "
                             "stability changes: {}\n",

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "study/engine/family_boundaries.h"
+#include "study/engine/start_carry.h"
 #include "study/stages/families.h"
 #include "hybridcont/automaton_words.h"
 #include "hybridcont/corrector.h"
@@ -120,9 +121,9 @@ std::vector<PhysicalEnd> PhysicalEnds(const HybridModel& model, const Bifurcatio
   std::vector<PhysicalEnd> ends;
   for (const Branch& b : d.branches) {
     if (b.image_of >= 0) continue;  // an image's ends are the images of its source's
-    const auto listed = writer.points().find(b.id);
-    if (listed == writer.points().end()) continue;
-    const std::vector<StudyPoint>& points = listed->second;
+    const std::vector<StudyPoint>* listed = writer.PointsOf(b.id);
+    if (listed == nullptr) continue;
+    const std::vector<StudyPoint>& points = *listed;
     for (std::size_t i = 0; i + 1 < points.size(); ++i) {
       const bool a = points[i].analysis.classification.physical, z = points[i + 1].analysis.classification.physical;
       if (a == z) continue;
@@ -209,8 +210,7 @@ class WordExplorer {
       for (const Branch& b : w.branches.branches) word.branches.push_back(b.id);
       words_out_->push_back(std::move(word));
     }
-    writer_.Annotate("words", WordsJson(*words_out_));
-    writer_.Annotate("word_changes", WordChangesJson(*changes_));
+    writer_.SetWords(*words_out_, *changes_);
     if (changes_->empty()) report_ += "  none (no physical family reaches a zero duration or a competing guard)\n";
     if (!word_ranges_.empty()) {
       report_ += "Physical families of the other words (where their orbits are physical and where stable, in H):\n" +
@@ -300,6 +300,7 @@ class WordExplorer {
     }
     const std::string word_name = automaton_.WordName(w.word);
     for (const Branch& b : d.branches) {
+      if (writer_.FindBranch(b.id) == nullptr) writer_.SetBranchModel(b.id, *w.model, word_name);  // without points
       writer_.EndBranch(b);
       w.branches.branches.push_back(b);
       word_ranges_ += AssignBranchFamily(b, word_layout, [&](const Vector&) { return word_name; }, writer_);
@@ -324,7 +325,20 @@ class WordExplorer {
       Corrector corrector(&map);
       Vector u;
       const CorrectorResult corrected = corrector.CorrectFixedComponent(guess, layout.H_index(), guess(layout.H_index()), &u);
-      if (!corrected.converged()) {
+      // At parameters the user set, a start that fails there (or gives an orbit that is not physical) is carried
+      // from the model's own values (start_carry.h).
+      if (!setup_.own_parameters.empty() && (!corrected.converged() || !IsPhysical(word_model, u, integrator_))) {
+        const CarriedStart carried = CarryGuess(word_model, setup_.own_parameters, guess, integrator_);
+        if (carried.ok) {
+          u = carried.u;
+          report_ += fmt::format("  start in word {}: {}\n", name, carried.report);
+          Say(fmt::format("word {}: {}", name, carried.report));
+        } else if (!corrected.converged()) {
+          report_ += fmt::format("  start in word {}: the guess does not converge to an orbit at H = {}: {}; {}\n", name,
+                                 guess(layout.H_index()), corrected.message, carried.why);
+          continue;
+        }
+      } else if (!corrected.converged()) {
         report_ += fmt::format("  start in word {}: the guess does not converge to an orbit at H = {}: {}\n", name,
                                guess(layout.H_index()), corrected.message);
         continue;
@@ -335,7 +349,7 @@ class WordExplorer {
         report_ += fmt::format("  start in word {}: not explored, {}\n", name, d.message);
         continue;
       }
-      for (const Branch& b : d.branches) writer_.AnnotateBranch(b.id, {{"started_in_word", name}});
+      for (const Branch& b : d.branches) writer_.SetStartedInWord(b.id);
       report_ += fmt::format("  start in word {} (H = {:.10f}): {} branches ({} to {}), {} special points\n", name,
                              u(layout.H_index()), d.branches.size(), FirstId(d),
                              FirstId(d) + static_cast<int>(d.branches.size()) - 1, d.special_points.size());
@@ -452,7 +466,7 @@ class WordExplorer {
     BifurcationDiagram d = Explore(target, c.u);
     if (d.status == ExplorationStatus::kStartFailed) return refuse("not explored: " + d.message);
     for (const Branch& b : d.branches) {
-      writer_.AnnotateBranch(b.id, {{"handed_over_from", id}});
+      writer_.SetHandedOverFrom(b.id, id);
       change->to_branches.push_back(b.id);
     }
     report_ += fmt::format("    {}: accepted, same orbit to {:.1e} (state at the section), {:.1e} (period); word {}: "
