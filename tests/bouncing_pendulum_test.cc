@@ -38,7 +38,7 @@ HybridModel LoadPendulum() {
   return LoadModelFile(std::filesystem::path(HYBRIDCONT_SOURCE_DIR) / "models" / "bouncing-pendulum.toml", options);
 }
 
-BifurcationDiagram Explore(const HybridModel& model) { return StudyOf(model).diagram; }
+BifurcationDiagram Explore(const HybridModel& model) { return *StudyOf(model).diagram; }
 
 // ---- the independent simulation: state (y, theta, dy, dtheta)
 using State = std::array<double, 4>;

@@ -43,7 +43,7 @@ struct Run {
 Run Explore(const HybridModel& model) {
   Run run;
   const auto start = std::chrono::steady_clock::now();
-  run.diagram = StudyOf(model).diagram;
+  run.diagram = *StudyOf(model).diagram;
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   run.H = ShootingLayout(model).H_index();
   return run;

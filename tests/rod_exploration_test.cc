@@ -22,7 +22,7 @@ struct RodRun {
 RodRun ExploreRod(double rtol) {
   const HybridModel model = MakeBuiltinModel("bouncing-rod");
   RodRun run;
-  run.diagram = StudyOf(model, WithTolerance(rtol)).diagram;
+  run.diagram = *StudyOf(model, WithTolerance(rtol)).diagram;
   const ShootingLayout shooting(model);
   run.t1 = shooting.UnknownIndex("t1");
   run.t2 = shooting.UnknownIndex("t2");

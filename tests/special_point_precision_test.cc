@@ -160,7 +160,7 @@ TEST(SpecialPointPrecision, ExactProblemsKeepTheBracket) {
 }
 
 BifurcationDiagram ExploreSlip(double tolerance_factor) {
-  return StudyOf(MakeSlip(), WithTolerance(IntegratorOptions().rtol * tolerance_factor)).diagram;
+  return *StudyOf(MakeSlip(), WithTolerance(IntegratorOptions().rtol * tolerance_factor)).diagram;
 }
 
 // The independent check: the SLIP explored again at 10x tighter tolerances. Every special point of the

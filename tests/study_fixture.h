@@ -3,10 +3,11 @@
 // exploration themselves (study/model_exploration.h); every other test explores through this.
 //
 //   const StudyResult study = StudyOf(model);                    // typed families, analysis, special points
-//   const BifurcationDiagram& d = study.diagram;                  // the engine's diagram (tangents, widths)
+//   const BifurcationDiagram& d = *study.diagram;                 // the engine's diagram (tangents, widths)
 #ifndef HYBRIDCONT_TESTS_STUDY_FIXTURE_H_
 #define HYBRIDCONT_TESTS_STUDY_FIXTURE_H_
 
+#include "hybridcont/exploration.h"
 #include "hybridcont/study.h"
 
 namespace hybridcont {

@@ -39,6 +39,7 @@
 
 #include "hybridcont/branch_switching.h"
 #include "hybridcont/continuation.h"
+#include "hybridcont/exploration_status.h"
 #include "hybridcont/special_point.h"
 #include "hybridcont/types.h"
 #include "hybridcont/zero_problem.h"
@@ -105,14 +106,6 @@ struct ExplorationOptions {
 
   std::string Validate() const;
 };
-
-enum class ExplorationStatus {
-  kCompleted,    // every reachable branch within the bounds and depth was traced
-  kMaxBranches,  // stopped at max_branches
-  kStartFailed,  // no branch could be started (see message)
-  kCancelled,    // ContinuationOptions::cancel returned true: the branches traced so far
-};
-std::string ToString(ExplorationStatus status);
 
 struct SwitchRecord {
   int special_point = -1;     // the SB point (or singular start) switched at

@@ -37,8 +37,7 @@
 #include <string>
 #include <vector>
 
-#include "hybridcont/continuation.h"
-#include "hybridcont/exploration.h"
+#include "hybridcont/exploration_status.h"
 #include "hybridcont/family_ranges.h"
 #include "hybridcont/model.h"
 #include "hybridcont/orbit_analysis.h"
@@ -46,6 +45,8 @@
 #include "hybridcont/study_options.h"
 
 namespace hybridcont {
+
+struct BifurcationDiagram;  // exploration.h: the engine's diagram a study keeps (StudyResult::diagram)
 
 // The version of the library, the tool and the results folders they write.
 std::string Version();
@@ -294,8 +295,9 @@ struct StudyResult {
   std::string summary_json;
   // The exploration of the study's own families as the engine gives it (time-based layout, model units): every
   // branch's ContinuationPoint and SpecialPoint with tangents, interval widths and test values, the branch
-  // switches and the start's analysis. Not saved, so not read back by LoadStudy (empty there).
-  BifurcationDiagram diagram;
+  // switches and the start's analysis (include exploration.h to read it). Not saved, so not read back by
+  // LoadStudy (null there).
+  std::shared_ptr<const BifurcationDiagram> diagram;
 
   // The special point with this label ("PD4"), or null.
   const StudySpecialPoint* FindSpecialPoint(const std::string& label) const;

@@ -412,7 +412,7 @@ void Compute(const StudyOptions& options, const StudyHooks& hooks, const HybridM
   const BifurcationDiagram& diagram = explored.diagram;
   result->status = diagram.status;
   result->message = diagram.message;
-  result->diagram = diagram;
+  result->diagram = std::make_shared<const BifurcationDiagram>(diagram);
   if (writer.failed()) return;  // the failed write is the result's write_error
   std::vector<StudySpecialPoint> special_points = RecordSpecialPoints(diagram, layout, &model, setup.integrator);
   const std::unique_ptr<HybridModel> at_point = setup.free.empty() ? nullptr : std::make_unique<HybridModel>(model.Clone());
@@ -873,7 +873,7 @@ StudyResult Run(const StudyOptions& given, const StudyHooks& hooks, const Hybrid
   }
   if (p.guide) {
     std::vector<Vector> switch_points;
-    for (const SpecialPoint& sp : result.diagram.special_points) switch_points.push_back(sp.u);
+    for (const SpecialPoint& sp : result.diagram->special_points) switch_points.push_back(sp.u);
     const nlohmann::json guided = p.guide->Json(switch_points);
     writer.Annotate("guided", guided);
     if (hooks.on_note) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "hybridcont/continuation.h"
+#include "hybridcont/exploration.h"
 #include "hybridcont/model.h"
 #include "hybridcont/shooting_layout.h"
 #include "hybridcont/study.h"
