@@ -508,6 +508,21 @@ TEST(Study, AStartIsCarriedToTheParametersSetOrSaysWhereItsFamilyTurnsBack) {
   EXPECT_EQ(families(folded), (std::set<std::string>{"stance > flight > stance > flight"}));
 }
 
+// A monitored observable joins the map's unknowns; the families of the automaton's other words are followed all
+// the same (on the orbit part of the points): the bipedal model's running, declared in its own word, is found.
+TEST(Study, AMonitoredObservableKeepsEveryWordsFamilies) {
+  StudyOptions o;
+  o.model = "bipedal-slip";
+  o.models_directory = HYBRIDCONT_SOURCE_DIR "/models";
+  o.max_branches = 6;
+  o.monitors = {{"speed", 1}};
+  const StudyResult r = RunStudy(o);
+  std::set<std::string> names;
+  for (const StudyFamily& f : r.families) names.insert(f.name);
+  EXPECT_EQ(names, (std::set<std::string>{"walking", "stance > flight > stance > flight"})) << r.report;
+  EXPECT_NE(r.report.find("the monitored observables are located in the study's own word only"), std::string::npos);
+}
+
 // Period doubling on a model with one phase: the doubled model has two phases of one name (copies), which its
 // drawing names once; the study completes (it failed as bad input after the whole run before).
 TEST(Study, PeriodDoublingOfAOnePhaseModelIsDrawn) {

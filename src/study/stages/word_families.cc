@@ -486,11 +486,37 @@ std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, 
   if (!model.automaton()) return "";
   const std::string heading = "Phase-sequence changes (words of the automaton):\n";
   if (!setup.free.empty()) return heading + "  not followed in a run with free parameters\n";
-  if (!setup.free.observables.empty()) {
-    return heading + "  not followed in a run with observables among the unknowns (--until, --bound or --fix on an "
+  if (setup.free.observables.empty()) return WordExplorer(model, setup, special_points, record, writer, hooks).Run(diagram);
+  // Observables among the unknowns only because they are monitored (--monitor): the words are followed on the
+  // orbit part of the points (the observables are the last unknowns, shooting_layout.h); the monitored values
+  // are located in the study's own word. An observable that bounds or ends the run (--until, --bound) would have
+  // to bound every word's families too: not followed then.
+  const auto bounded = [&](const std::string& name) {
+    const ContinuationOptions& c = setup.exploration.continuation;
+    return std::any_of(c.bounds.begin(), c.bounds.end(), [&](const ComponentBound& b) { return b.component == name; }) ||
+           std::any_of(c.targets.begin(), c.targets.end(), [&](const ComponentTarget& t) { return t.component == name; });
+  };
+  if (std::any_of(setup.free.observables.begin(), setup.free.observables.end(), bounded)) {
+    return heading + "  not followed in a run bounded or ended by an observable (--until or --bound on an "
                      "observable)\n";
   }
-  return WordExplorer(model, setup, special_points, record, writer, hooks).Run(diagram);
+  const Eigen::Index n = ShootingLayout(model).num_unknowns();
+  const auto orbit_part = [n](Vector* v) {
+    if (v->size() > n) *v = Vector(v->head(n));
+  };
+  BifurcationDiagram orbits = diagram;
+  orbits.unknown_names.resize(std::min<std::size_t>(orbits.unknown_names.size(), static_cast<std::size_t>(n)));
+  for (Branch& b : orbits.branches) {
+    for (ContinuationPoint& p : b.points) orbit_part(&p.u), orbit_part(&p.tangent);
+    for (SpecialPoint& sp : b.special_points) {
+      for (Vector* v : {&sp.u, &sp.tangent, &sp.tangent_before, &sp.tangent_after, &sp.interval_width}) orbit_part(v);
+    }
+  }
+  for (SpecialPoint& sp : orbits.special_points) {
+    for (Vector* v : {&sp.u, &sp.tangent, &sp.tangent_before, &sp.tangent_after, &sp.interval_width}) orbit_part(v);
+  }
+  return WordExplorer(model, setup, special_points, record, writer, hooks).Run(orbits) +
+         "  (the monitored observables are located in the study's own word only)\n";
 }
 
 }  // namespace hybridcont::study
