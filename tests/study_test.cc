@@ -521,6 +521,15 @@ TEST(Study, AMonitoredObservableKeepsEveryWordsFamilies) {
   for (const StudyFamily& f : r.families) names.insert(f.name);
   EXPECT_EQ(names, (std::set<std::string>{"walking", "stance > flight > stance > flight"})) << r.report;
   EXPECT_NE(r.report.find("the monitored observables are located in the study's own word only"), std::string::npos);
+  // An observable that ends the run would have to end every word's families: the other words are not followed,
+  // and the study says so before it runs.
+  o.monitors.clear();
+  o.until = {{"speed", 0.3}};
+  const std::vector<std::string> notes = CheckStudyOptions(o);
+  ASSERT_FALSE(notes.empty());
+  EXPECT_NE(notes.back().find("the automaton's other words are not followed: the observable 'speed' ends the run"),
+            std::string::npos)
+      << notes.back();
 }
 
 // Period doubling on a model with one phase: the doubled model has two phases of one name (copies), which its

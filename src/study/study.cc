@@ -760,6 +760,12 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
   const HybridModel& model = *p.model;
   CheckOptionPairs(options);
   p.setup = MakeRunSetup(options, model);
+  // What the study will not do that the options ask for implicitly: said before it runs.
+  if (options.follow_word_changes) {
+    if (const std::string why = WordsNotFollowed(model, p.setup); !why.empty() && options.free.empty()) {
+      p.setup.notes.push_back("the automaton's other words are not followed: " + why);
+    }
+  }
   if (!options.parameters.empty()) {  // the model's own values of the parameters set (start_carry.h)
     StudyOptions own_options = options;
     own_options.parameters.clear();

@@ -480,26 +480,33 @@ class WordExplorer {
 
 }  // namespace
 
+std::string WordsNotFollowed(const HybridModel& model, const RunSetup& setup) {
+  if (!model.automaton()) return "";
+  if (!setup.free.empty()) return "a run with free parameters follows its own word only";
+  // An observable that bounds or ends the run (--until, --bound) would have to bound every word's families too.
+  const ContinuationOptions& c = setup.exploration.continuation;
+  for (const std::string& name : setup.free.observables) {
+    const bool bounds = std::any_of(c.bounds.begin(), c.bounds.end(), [&](const ComponentBound& b) { return b.component == name; });
+    const bool ends = std::any_of(c.targets.begin(), c.targets.end(), [&](const ComponentTarget& t) { return t.component == name; });
+    if (bounds || ends) {
+      return "the observable '" + name + "' " + (ends ? "ends the run (--until), and it would not end" :
+                                                          "bounds the run (--bound), and it would not bound") +
+             " the other words' families";
+    }
+  }
+  return "";
+}
+
 std::string ExploreWordChanges(const HybridModel& model, const RunSetup& setup, const BifurcationDiagram& diagram,
                                std::vector<StudySpecialPoint>* special_points, WordRecord* record,
                                ResultsWriter& writer, const StudyHooks& hooks) {
   if (!model.automaton()) return "";
   const std::string heading = "Phase-sequence changes (words of the automaton):\n";
-  if (!setup.free.empty()) return heading + "  not followed in a run with free parameters\n";
+  if (const std::string why = WordsNotFollowed(model, setup); !why.empty()) return heading + "  not followed: " + why + "\n";
   if (setup.free.observables.empty()) return WordExplorer(model, setup, special_points, record, writer, hooks).Run(diagram);
   // Observables among the unknowns only because they are monitored (--monitor): the words are followed on the
   // orbit part of the points (the observables are the last unknowns, shooting_layout.h); the monitored values
-  // are located in the study's own word. An observable that bounds or ends the run (--until, --bound) would have
-  // to bound every word's families too: not followed then.
-  const auto bounded = [&](const std::string& name) {
-    const ContinuationOptions& c = setup.exploration.continuation;
-    return std::any_of(c.bounds.begin(), c.bounds.end(), [&](const ComponentBound& b) { return b.component == name; }) ||
-           std::any_of(c.targets.begin(), c.targets.end(), [&](const ComponentTarget& t) { return t.component == name; });
-  };
-  if (std::any_of(setup.free.observables.begin(), setup.free.observables.end(), bounded)) {
-    return heading + "  not followed in a run bounded or ended by an observable (--until or --bound on an "
-                     "observable)\n";
-  }
+  // are located in the study's own word.
   const Eigen::Index n = ShootingLayout(model).num_unknowns();
   const auto orbit_part = [n](Vector* v) {
     if (v->size() > n) *v = Vector(v->head(n));

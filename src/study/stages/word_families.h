@@ -35,6 +35,10 @@ struct WordRecord {
   std::vector<StudyWordChange> changes;
 };
 
+// Why a study of `model` with `setup` cannot follow its automaton's other words ("" where it can, or where the
+// model has no automaton): a family in a free parameter, or an observable that bounds or ends the run.
+std::string WordsNotFollowed(const HybridModel& model, const RunSetup& setup);
+
 // `diagram` and `special_points` are the run's (time-based layout of `model`, a word of an automaton).
 // Appends the new families' special points to special_points, the words and changes to `record`, writes their
 // branches through `writer` and annotates summary.json; returns the report section ("" for a model without an
