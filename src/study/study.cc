@@ -766,13 +766,18 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
       p.setup.notes.push_back("the automaton's other words are not followed: " + why);
     }
   }
-  if (!options.parameters.empty()) {  // the model's own values of the parameters set (start_carry.h)
-    StudyOptions own_options = options;
-    own_options.parameters.clear();
-    std::ostringstream quiet;
-    StudyModelSource source;
-    const std::unique_ptr<HybridModel> own = BuildModel(own_options, given, quiet, &source);
-    for (const NamedValue& set : options.parameters) p.setup.own_parameters.push_back({set.name, own->parameter(set.name)});
+  // The model's own values of the parameters set (start_carry.h): the caller's model's, or those its file or
+  // built-in declares.
+  for (const NamedValue& set : options.parameters) {
+    double own = 0;
+    if (given != nullptr) {
+      own = given->parameter(set.name);
+    } else {
+      for (const ParameterInfo& info : model.parameters()) {
+        if (info.name == set.name) own = info.default_value;
+      }
+    }
+    p.setup.own_parameters.push_back({set.name, own});
   }
   // The period-doubled families' model is drawn too: its presentation is checked before anything runs.
   if (options.period_doubling) OrbitPresentation(RepeatedModel(model, 2), p.setup.free);

@@ -226,16 +226,8 @@ StudyBranch& ResultsWriter::Ended(int branch_id) {
 }
 
 StudyBranch ResultsWriter::Unpointed(int branch_id) const {
-  const StudyBranch& listed = branches_.at(branch_id);
-  StudyBranch b;
-  b.id = listed.id;
-  b.model = listed.model;
-  b.origin = listed.origin;
-  b.unknown_names = listed.unknown_names;
-  b.continued = listed.continued;
-  b.word = listed.word;
-  b.termination = listed.termination;
-  b.ranges.branch = listed.id;
+  StudyBranch b = branches_.at(branch_id);  // asked at the branch's first point: one point copied
+  b.points.clear();
   return b;
 }
 
