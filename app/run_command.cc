@@ -186,8 +186,12 @@ int RunCommand(const RunArguments& args, std::ostream& out, std::ostream& err) {
   out << fmt::format("results written to {}/ (summary.json, branch-*.csv, orbit-*.csv{})\n", dir,
                      report ? ", report.html: open it in a browser" : "");
   if (study.status == ExplorationStatus::kStartFailed) {
-    err << "error: no family was traced: " << study.message << "\n";
-    return 1;  // nothing to draw
+    if (study.branches.empty()) {
+      err << "error: no family was traced: " << study.message << "\n";
+    } else {  // the file word's start failed; the automaton's other starts gave the families written
+      err << "error: the model's start failed, the families of its other starts are written: " << study.message << "\n";
+    }
+    return 1;
   }
   // The figures wait for matplotlib for seconds, the computation takes a fraction of that: drawn on request.
   if (args.plots && !args.no_plots && DrawFigures(dir, err, false) == 0) {

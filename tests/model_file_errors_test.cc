@@ -413,7 +413,13 @@ const BadFile kBadFiles[] = {
      "phases.flight.ignorable: 'x' is not a coordinate", kPendulum},
     {"MechanicsWithoutCoordinates", "coordinates = [\"y\", \"theta\"]\n", "states = [\"y\", \"theta\", \"dy\", \"dtheta\"]\n", 15,
      "phases.flight.kinetic: 'kinetic' needs 'coordinates'", kPendulum},
-    {"PinnedCoordinateInTheAnchor", "anchor = \"dy\"", "pinned = [\"xp\"]\nanchor = \"dy + dxp\"", 19,
+    // (the pinned coordinate with a mass in the kinetic energy, so that the impact can be derived)
+    {"PinnedCoordinateInTheAnchor", "0.5*m1*dy^2 + 0.5*m2*((l*cos(theta)*dtheta)^2 + (dy + l*sin(theta)*dtheta)^2)\"\n"
+     "potential = \"(m1 + m2)*g*y + m2*g*l*(1 - cos(theta))\"\nimpact = { constraint = \"y\", restitution = 1 }\n"
+     "anchor = \"dy\"",
+     "0.5*m1*(dy^2 + dxp^2) + 0.5*m2*((l*cos(theta)*dtheta)^2 + (dy + l*sin(theta)*dtheta)^2)\"\n"
+     "potential = \"(m1 + m2)*g*y + m2*g*l*(1 - cos(theta))\"\nimpact = { constraint = \"y\", restitution = 1 }\n"
+     "anchor = \"dy + dxp\"\npinned = [\"xp\"]", 18,
      "phases.flight.anchor: in expression 'dy + dxp' at column 6: unknown symbol 'dxp'", kPendulum},
     {"RelabelNotACoordinate", "restitution = 1 }", "restitution = 1, relabel = { phi = \"theta\" } }", 17,
      "phases.flight.impact.relabel.phi: 'phi' is not a coordinate of phase 'flight' that is a state", kPendulum},
@@ -421,6 +427,9 @@ const BadFile kBadFiles[] = {
      "phases.flight.impact.relabel: the relabelling depends on a velocity", kPendulum},
     {"ConstraintRowWithoutCoordinates", "constraint = \"y\"", "constraint = [\"y\", \"l\"]", 17,
      "phases.flight.impact.constraint: the contact constraint g(q) (row 2) does not depend on the coordinates", kPendulum},
+    {"PinnedCoordinateWithoutMass", "coordinates = [\"y\", \"theta\"]", "coordinates = [\"y\", \"theta\"]\npinned = [\"xp\"]", 18,
+     "phases.flight.impact: the impact cannot be derived: the mass matrix is not positive definite at (y = 0.3, "
+     "theta = 0.4, xp = 0): pivot 3 of its Cholesky factorization is 0", kPendulum},
     {"StatesWithoutAVelocity", "coordinates = [\"y\", \"theta\"]", "coordinates = [\"y\", \"theta\"]\nstates = [\"y\", \"theta\", \"dy\"]", 14,
      "phases.flight.states: 'dtheta' is a coordinate or velocity but not a state", kPendulum},
 };

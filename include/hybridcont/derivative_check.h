@@ -14,7 +14,11 @@
 //
 // Error measure per derivative and point: max_ij |J_ij - FD_ij| / max(max_ij |J_ij|, 1e-8), i.e.
 // relative to the largest entry, so that structurally small entries (r^2 terms of the rod) still count
-// against the scale of the matrix they belong to. The worst over points is reported.
+// against the scale of the matrix they belong to. The worst over points is reported. A parameter's column
+// dr/dp of the shooting map is measured in relative units of p and of the unknowns (each column times
+// max(1, |value|)) against the larger of its own largest entry and the map's largest such entry over the
+// unknowns: a derivative that is exactly zero (a parameter that cancels) is then compared with differences
+// that are integration noise on the map's own scale, not on the scale of a zero column.
 #ifndef HYBRIDCONT_DERIVATIVE_CHECK_H_
 #define HYBRIDCONT_DERIVATIVE_CHECK_H_
 

@@ -76,6 +76,14 @@ double PeriodDoublingTest(const Matrix& dr, const ShootingLayout& layout);
 // event inside the phase after it has been above 0 (elsewhere it is NaN: no interior minimum, or no
 // physical family ending), and at a trial point between branch points only where the last branch point had
 // a value, so it costs integrations only on such orbits; its zeros are kept where a physical family ends.
+//
+// Last, one kZeroDuration function per phase 2..m: its duration t_i (an unknown: nothing is integrated), 0
+// where the phase vanishes from the cycle (running's flight shrinking to nothing where walking begins). At a
+// branch point it is defined where the orbit is physical, and where it fails by its durations (class
+// reversed-time or zero-duration) just after a physical branch point of the same trace: so a zero is located
+// where a physical family, followed outward, ends by a vanishing phase — not on the many families of orbits
+// that run a phase backwards (a family entering the physical region there keeps an end between two points).
+// A zero is kept where no other duration is negative (a symmetric gait's two flights vanish at one point).
 class FloquetTestFunctions : public TestFunctions {
  public:
   // Keeps a reference to model (it must outlive this object and its clones). With free parameters
@@ -160,6 +168,10 @@ class FloquetTestFunctions : public TestFunctions {
   // Phase i's own-event functions at u into values->segment(first_own_event(), m) (see above).
   void EvaluateOwnEvents(const Vector& u, const OrbitTrace* trace, Vector* values);
   int first_own_event() const;
+  // The zero-duration functions at u into values (see above); c is u's class at a branch point.
+  void EvaluateDurations(const Vector& u, bool branch_point, const Classification& c, Vector* values);
+  // Index of the first zero-duration function (phase 2's duration; m − 1 of them).
+  int first_zero_duration() const { return first_own_event() + model_->num_phases(); }
   // The event-driven replay of u (the model's own layout) returns (replay.h).
   bool Replays(const HybridModel& model, const Vector& u) const;
   ReplayResult Replay(const HybridModel& model, const Vector& u) const;
@@ -178,6 +190,7 @@ class FloquetTestFunctions : public TestFunctions {
   std::vector<Observable> own_events_;
   std::vector<char> own_defined_;  // per phase: whether the last branch point had a value
   std::optional<BranchPointAnalysis> last_branch_point_;
+  bool last_branch_physical_ = false;  // the class of the last branch point evaluated (EvaluateDurations)
   long reused_evaluations_ = 0;
 };
 

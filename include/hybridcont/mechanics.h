@@ -91,9 +91,13 @@ void CheckMechanics(const MechanicalSystem& system, const EquationsOfMotion& equ
 // expression of q (and p) per constraint row; throws ModelInputError at `where` if a row does not depend on
 // the coordinates or depends on a velocity. The restitution e is an expression of the parameters (a
 // number, or a parameter to continue in).
+// The impact's mass matrix (in the coordinates and the pinned coordinates, those at rest) goes to
+// *impact_mass_matrix where it is given: a caller checks it at values (ExplainMassMatrix), since a pinned
+// coordinate the kinetic energy gives no mass makes it singular and the impulse undefined.
 std::vector<ExprPtr> ImpactVelocities(const MechanicalSystem& system, const EquationsOfMotion& equations,
                                       const std::vector<ExprPtr>& constraints, const ExprPtr& restitution,
-                                      const SourceLocation& where);
+                                      const SourceLocation& where,
+                                      std::vector<std::vector<ExprPtr>>* impact_mass_matrix = nullptr);
 
 // The velocities after the relabelling q' = S(q): relabel[i] is S_i (null: q'_i = q_i), an expression of
 // the coordinates; the result is q̇'_i = Σ_j ∂S_i/∂q_j · velocities[j]. Throws ModelInputError at `where`

@@ -95,6 +95,9 @@ struct RunSpec {
 struct FamilyRule {
   std::string name;
   SetupValue when;
+  // A hybrid automaton's word whose orbits the rule names (transition indices, as StartSpec::word; `when`
+  // names that word's unknowns). Empty: the model's own word.
+  std::vector<int> word;
 };
 
 // A named per-point quantity, written as a column of every branch file (e.g. the rod's asymmetry).

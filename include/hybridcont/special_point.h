@@ -50,10 +50,14 @@ enum class SpecialPointType {
   kObservableValue,     // an observable reaches a value the user monitors (UZ, as AUTO's; observable.h)
   kConstraintBoundary,  // an admissibility constraint's minimum reaches 0 (CB; observable.h)
   kKreinCollision,      // two pairs of multipliers of a symplectic map collide on the unit circle (KC; floquet.h)
+  kZeroDuration,        // a phase's duration reaches 0: the phase vanishes from the cycle (ZD; the end of a
+                        // physical family where running's flight shrinks to nothing and walking begins)
 };
+// The last type: the types are the integers 0 .. kLastSpecialPointType.
+constexpr SpecialPointType kLastSpecialPointType = SpecialPointType::kZeroDuration;
 std::string ToString(SpecialPointType type);
 // The short code of reports and summary.json: "SB", "TP", "start", "BP", "PD", "test", "GR", "NS", "UZ", "CB",
-// "KC".
+// "KC", "ZD".
 std::string Code(SpecialPointType type);
 // The type of a code; false for a string that is none.
 bool FromCode(const std::string& code, SpecialPointType* type);

@@ -63,6 +63,7 @@ std::vector<SpecialPointType> FloquetTestFunctions::types() const {
   types.push_back(SpecialPointType::kNeimarkSacker);
   if (model_->num_first_integrals() > 0) types.push_back(SpecialPointType::kKreinCollision);
   types.insert(types.end(), model_->num_phases(), SpecialPointType::kGrazing);  // the own events
+  types.insert(types.end(), std::max(0, model_->num_phases() - 1), SpecialPointType::kZeroDuration);
   return types;
 }
 
@@ -162,6 +163,17 @@ void FloquetTestFunctions::EvaluateOwnEvents(const Vector& u, const OrbitTrace* 
   }
 }
 
+void FloquetTestFunctions::EvaluateDurations(const Vector& u, bool branch_point, const Classification& c,
+                                             Vector* values) {
+  const ShootingLayout base(*model_);
+  const int m = model_->num_phases();
+  const bool by_duration = c.reason == OrbitClass::kReversedTime || c.reason == OrbitClass::kZeroDuration;
+  const bool after_physical = last_branch_physical_;
+  if (branch_point) last_branch_physical_ = c.physical;
+  if (branch_point && !c.physical && !(by_duration && after_physical)) return;
+  for (int i = 1; i < m; ++i) (*values)(first_zero_duration() + i - 1) = u(base.time_index(i));
+}
+
 bool FloquetTestFunctions::Physical(const Vector& u_free) const {
   const HybridModel* model = ModelAt(u_free);
   if (model == nullptr) return false;
@@ -213,7 +225,7 @@ void FloquetTestFunctions::EvaluateOn(TimeBasedShooting* map, const Vector& at, 
   const int m = model_->num_phases();
   const int ns = 2 + m;  // the Neimark–Sacker function, then (conservative) the Krein one
   const bool krein = model_->num_first_integrals() > 0;
-  *values = Vector::Constant(ns + 1 + (krein ? 1 : 0) + m, std::numeric_limits<double>::quiet_NaN());
+  *values = Vector::Constant(ns + 1 + (krein ? 1 : 0) + m + std::max(0, m - 1), std::numeric_limits<double>::quiet_NaN());
   // A branch point's class: it decides whether the Floquet functions are defined there (physical_only) and,
   // for a conservative model, whether the crossing speeds are (see below).
   const HybridModel* model_at_u = branch_point ? ModelAt(u) : model_;
@@ -255,6 +267,7 @@ void FloquetTestFunctions::EvaluateOn(TimeBasedShooting* map, const Vector& at, 
   if ((evaluated || !needs_map) && (!branch_point || (trace && (c.physical || c.reason == OrbitClass::kMissedEvent)))) {
     EvaluateOwnEvents(u, branch_point ? trace.get() : nullptr, values);
   }
+  EvaluateDurations(u, branch_point, c, values);
   if (evaluated && speeds) {  // the crossing speed changes sign at grazing
     const HybridModel& model = map->model();  // at u's parameter values
     for (int i = 0; i < m; ++i) {
@@ -296,7 +309,7 @@ bool FloquetTestFunctions::Keep(int function, const Vector& u, std::string* note
       return false;
     }
   }
-  if (function >= first_own_event()) {
+  if (function >= first_own_event() && function < first_zero_duration()) {
     *note = "the event of phase '" + model_->phase(function - first_own_event()).name() + "' touched inside the phase";
     return MissedEventEndsPhysicalFamily(u);
   }
@@ -306,6 +319,17 @@ bool FloquetTestFunctions::Keep(int function, const Vector& u, std::string* note
     // are no motion of the system, which a conservative diagram has many of.
     if (model_->num_first_integrals() == 0) return true;
     return GrazingEndsPhysicalFamily(u);
+  }
+  if (type == SpecialPointType::kZeroDuration) {
+    // The end of a physical family: no other duration negative there (a symmetric gait's two flights vanish
+    // together). Elsewhere a duration changes sign on orbits that run some phase backwards in time.
+    const ShootingLayout base(*model_);
+    const double tolerance = ClassificationOptions{}.duration_tolerance * std::max(1.0, std::abs(base.Period(u)));
+    for (int j = 0; j < base.num_segments(); ++j) {
+      if (u(base.time_index(j)) < -tolerance) return false;
+    }
+    *note = "phase '" + model_->phase(function - first_zero_duration() + 1).name() + "' of duration 0";
+    return true;
   }
   if (type != SpecialPointType::kNeimarkSacker && type != SpecialPointType::kKreinCollision) return true;
   const FloquetResult floquet = ComputeFloquet(shooting_, u);

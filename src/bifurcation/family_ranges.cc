@@ -13,12 +13,13 @@ namespace hybridcont {
 namespace {
 
 // The special points that explain an end of a physical stretch, and of a stable one, in order of preference.
-constexpr SpecialPointType kPhysicalEnds[] = {SpecialPointType::kGrazing, SpecialPointType::kConstraintBoundary,
-                                              SpecialPointType::kTurningPoint, SpecialPointType::kSimpleBifurcation};
+constexpr SpecialPointType kPhysicalEnds[] = {SpecialPointType::kGrazing, SpecialPointType::kZeroDuration,
+                                              SpecialPointType::kConstraintBoundary, SpecialPointType::kTurningPoint,
+                                              SpecialPointType::kSimpleBifurcation};
 constexpr SpecialPointType kStabilityEnds[] = {
     SpecialPointType::kFloquetBranchPoint, SpecialPointType::kPeriodDoubling, SpecialPointType::kNeimarkSacker,
     SpecialPointType::kKreinCollision,     SpecialPointType::kTurningPoint,   SpecialPointType::kSimpleBifurcation,
-    SpecialPointType::kGrazing,            SpecialPointType::kConstraintBoundary};
+    SpecialPointType::kGrazing,            SpecialPointType::kZeroDuration,   SpecialPointType::kConstraintBoundary};
 
 template <std::size_t N>
 const SpecialPoint* Explaining(const Branch& b, int after, const SpecialPointType (&types)[N]) {

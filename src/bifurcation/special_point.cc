@@ -20,6 +20,7 @@ constexpr internal::EnumName<SpecialPointType> kSpecialPointTypeNames[] = {
     {SpecialPointType::kConstraintBoundary, "constraint-boundary"},
     {SpecialPointType::kKreinCollision, "krein-collision"},
     {SpecialPointType::kUserTestFunction, "test-function-zero"},
+    {SpecialPointType::kZeroDuration, "zero-duration"},
 };
 
 constexpr internal::EnumName<LocationStatus> kLocationStatusNames[] = {
@@ -44,12 +45,13 @@ std::string Code(SpecialPointType type) {
     case SpecialPointType::kObservableValue: return "UZ";
     case SpecialPointType::kConstraintBoundary: return "CB";
     case SpecialPointType::kKreinCollision: return "KC";
+    case SpecialPointType::kZeroDuration: return "ZD";
   }
   return "?";
 }
 
 bool FromCode(const std::string& code, SpecialPointType* type) {
-  for (int t = 0; t <= static_cast<int>(SpecialPointType::kKreinCollision); ++t) {
+  for (int t = 0; t <= static_cast<int>(kLastSpecialPointType); ++t) {
     if (Code(static_cast<SpecialPointType>(t)) == code) {
       *type = static_cast<SpecialPointType>(t);
       return true;

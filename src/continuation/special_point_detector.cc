@@ -170,13 +170,12 @@ SpecialPoint SpecialPointDetector::LocateOn(const Curve& curve, const Continuati
 
 // The estimate evaluated again with the problem's refined copy: with the error of an evaluation
 // proportional to the tolerances, the change Δ of a quantity is (1 − factor) of its error at the
-// problem's own tolerances. The test function's error over its slope is how far the exact root may lie
-// from the computed one (δs, along the branch), the refined Newton correction how far the exact curve
-// may lie from the point (δu). Where δs or δu exceed the bracket, the interval and the componentwise
+// problem's own tolerances. The test function's error — its refined value's change, plus its change over
+// the refined Newton correction δu (where the exact curve lies) — over its slope is how far the exact root
+// may lie from the computed one (δs, along the branch), δu how far the exact curve may lie from the point. Where δs or δu exceed the bracket, the interval and the componentwise
 // widths grow to cover them, and the message says so.
 void SpecialPointDetector::AddIntegrationError(ZeroProblem* problem, Segment* segment, const RootLocation& root, const Test& test,
                                                const Test& refined_test, SpecialPoint* point) {
-  (void)test;
   constexpr double kFactor = ContinuationOptions::kIntegrationErrorFactor;
   constexpr double kScale = ContinuationOptions::kIntegrationErrorScale;
   const std::unique_ptr<ZeroProblem> refined = problem->Refined(kFactor);
@@ -193,7 +192,14 @@ void SpecialPointDetector::AddIntegrationError(ZeroProblem* problem, Segment* se
   const bool ok = segment->RefinedProbe(refined.get(), root.estimate, &fine, &du);
   problem->AddWorkOf(*refined);
   if (!ok) return not_estimated("the evaluation at 0.1x the tolerances failed");
-  const double change = std::abs(refined_test(fine) - root.test), refined_step = du.norm();
+  // The test function changes with its own evaluation's error and with the point: on the exact curve, du away,
+  // it differs by about g(u + du) − g(u). A function of the unknowns alone (a phase's duration) moves only so;
+  // where the root is ill-conditioned (the function changes slowly along the branch) that is what matters.
+  Segment::Probe shifted = root.estimate;
+  shifted.u += du;
+  const double moved = test(shifted) - root.test;
+  const double change = std::abs(refined_test(fine) - root.test) + (std::isfinite(moved) ? std::abs(moved) : 0.0);
+  const double refined_step = du.norm();
   du *= kScale;
   const double ds = kScale * change / std::abs(root.slope);
   if (!std::isfinite(ds)) return not_estimated("not finite");

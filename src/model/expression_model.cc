@@ -164,10 +164,15 @@ ExpressionModelSpec ExpressionWordSpec(const ExpressionModelSpec& spec, const Wo
     w.setup.start = StartSpec{};
     w.setup.more_starts.clear();
     w.setup.word_starts.clear();
-    w.setup.families.clear();
     w.setup.quantities.clear();
     w.setup.figures.clear();
   }
+  // The family rules of this word: the file word's own, or those declared for it.
+  auto& rules = w.setup.families;
+  rules.erase(std::remove_if(rules.begin(), rules.end(),
+                             [&](const FamilyRule& r) { return file_word ? !r.word.empty() : r.word != word; }),
+              rules.end());
+  for (FamilyRule& r : rules) r.word.clear();
   // Drawings of the modes the word visits (a file's drawing keyed by mode covers all of its words); those
   // for given segments of the file's word do not apply to another.
   auto& drawings = w.setup.drawing.phases;

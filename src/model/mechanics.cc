@@ -175,7 +175,8 @@ void CheckMechanics(const MechanicalSystem& s, const EquationsOfMotion& eq, int 
 
 std::vector<ExprPtr> ImpactVelocities(const MechanicalSystem& s, const EquationsOfMotion& eq,
                                       const std::vector<ExprPtr>& constraints, const ExprPtr& restitution,
-                                      const SourceLocation& where) {
+                                      const SourceLocation& where,
+                                      std::vector<std::vector<ExprPtr>>* impact_mass_matrix) {
   const int n = static_cast<int>(s.coordinates.size());
   const int k = static_cast<int>(constraints.size());
   // The extended coordinates (q, p), their velocities (q̇, ṗ) with ṗ⁻ = 0, and M_e.
@@ -209,6 +210,7 @@ std::vector<ExprPtr> ImpactVelocities(const MechanicalSystem& s, const Equations
       }
     }
   }
+  if (impact_mass_matrix != nullptr) *impact_mass_matrix = M;
   std::vector<ExprPtr> dq(ne);
   for (int i = 0; i < ne; ++i) dq[i] = i < n ? MakeInput(velocities[i]) : MakeConstant(0.0);
   // G (k × ne) and W = M_e⁻¹ Gᵀ (its columns).

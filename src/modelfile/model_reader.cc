@@ -32,7 +32,15 @@ ExpressionModelSpec Reader::Read() {
   ReadQuantities();
   ReadObservables();
   ReadConstraints();
-  for (const FamilyRule& rule : spec_.setup.families) CheckSetupValue(rule.when, OrbitSymbols());
+  for (const FamilyRule& rule : spec_.setup.families) {
+    if (rule.word.empty()) {
+      CheckSetupValue(rule.when, OrbitSymbols());
+    } else {  // another word's rule: its unknowns and period (quantities are the file word's)
+      std::vector<std::string> symbols = UnknownNames(rule.word);
+      symbols.push_back("T");
+      CheckSetupValue(rule.when, symbols);
+    }
+  }
   ReadFigures();
   ReadDrawing();
   if (!transition_tables_.empty()) {  // an automaton: the catalogue kept, the spec that of the file's word

@@ -172,6 +172,9 @@ class Reader {
   // kinetic/potential or mass_matrix/forces/potential, and impact: derives the equations of motion
   // (mechanics.h), checks them and stores M for explanations.
   Mechanics ReadMechanics(int i);
+  void CheckImpactMassMatrix(const std::vector<std::vector<ExprPtr>>& mass, const std::vector<Vector>& states,
+                             const std::vector<double>& values, const toml::table& impact, const std::string& field,
+                             int i) const;
   // Phase i's (table t, field pf) kinetic and potential (T, V), or mass_matrix (M, n × n rows of expressions),
   // and forces (Q, keyed by coordinate; null where not given), with where each came from, into *system.
   void ReadEnergiesAndForces(int i, const toml::table& t, const std::string& pf, MechanicalSystem* system);

@@ -213,6 +213,38 @@ std::vector<ExprPtr> Reader::ReadRelabelling(int i, const toml::table& rl, const
   return relabel;
 }
 
+// The impact's mass matrix (coordinates, then pinned coordinates) positive definite at the check states: a
+// pinned coordinate whose velocity the kinetic energy does not contain has no mass, and no impulse can be
+// derived (the impact would divide by zero).
+void Reader::CheckImpactMassMatrix(const std::vector<std::vector<ExprPtr>>& mass, const std::vector<Vector>& states,
+                                   const std::vector<double>& values, const toml::table& impact,
+                                   const std::string& field, int i) const {
+  const MechanicalNames& names = mechanical_names_[i];
+  if (names.pinned.empty()) return;  // the phase's own mass matrix, checked where the motion is integrated
+  const ExpressionPhaseSpec& p = spec_.phases[i];
+  const int ne = static_cast<int>(mass.size());
+  std::vector<ExprPtr> entries;
+  for (const auto& row : mass) entries.insert(entries.end(), row.begin(), row.end());
+  const ExpressionProgram program(entries, static_cast<int>(p.state_names.size()), false, {});
+  std::vector<std::string> coordinate_names = names.coordinates;
+  coordinate_names.insert(coordinate_names.end(), names.pinned.begin(), names.pinned.end());
+  for (const Vector& x : states) {
+    std::vector<double> m(ne * ne);
+    for (int k = 0; k < ne * ne; ++k) m[k] = program.EvaluateScalar(x.data(), values.data(), k);
+    std::vector<double> q(ne, 0.0);  // the coordinates' values, for the message (pinned ones at rest: 0)
+    for (int k = 0; k < static_cast<int>(names.coordinates.size()); ++k) {
+      const int s = StateIndex(names.ignorable, p.state_names, names.coordinates[k]);
+      if (s >= 0 && s < x.size()) q[k] = x(s);
+    }
+    const std::string why = ExplainMassMatrix(m, coordinate_names, q);
+    if (!why.empty()) {
+      Fail(&impact, field, "the impact cannot be derived: " + why + " (the coordinates, then the pinned ones " +
+                               JoinNames(names.pinned) + "); every pinned coordinate's velocity must enter 'kinetic' " +
+                               "with the mass it moves, or the impulse that stops the new contact is undefined");
+    }
+  }
+}
+
 Reader::Mechanics Reader::ReadMechanics(int i) {
   Mechanics out;
   const MechanicalNames& names = mechanical_names_[i];
@@ -265,7 +297,9 @@ Reader::Mechanics Reader::ReadMechanics(int i) {
 
   if (impact) {
     const ExprPtr e = ReadRestitution(*impact, field);
-    std::vector<ExprPtr> after = ImpactVelocities(system, eq, constraints, e, out.constraint_where);
+    std::vector<std::vector<ExprPtr>> impact_mass;
+    std::vector<ExprPtr> after = ImpactVelocities(system, eq, constraints, e, out.constraint_where, &impact_mass);
+    CheckImpactMassMatrix(impact_mass, states, values, *impact, field, i);
     std::vector<ExprPtr> relabel(n);
     if (const toml::table* rl = OptionalTable(*impact, "relabel", field)) {
       relabel = ReadRelabelling(i, *rl, field);

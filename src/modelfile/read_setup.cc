@@ -303,9 +303,22 @@ void Reader::ReadFamilies() {
     const std::string field = "families[" + std::to_string(i) + "]";
     if (!a.get(i)->is_table()) Fail(a.get(i), field, "expected a [[families]] table");
     const toml::table& t = *a.get(i)->as_table();
-    CheckKeys(t, field, {"name", "when"});
+    CheckKeys(t, field, {"name", "when", "word"});
     FamilyRule rule;
     rule.name = RequiredString(t, "name", field);
+    if (const toml::node* w = t.get("word")) {
+      if (transition_tables_.empty()) {
+        Fail(w, field + ".word", "'word' names a word of an automaton ([[modes]] and [[transitions]])");
+      }
+      try {
+        rule.word = HybridAutomaton::Graph(spec_.name, automaton_.modes, automaton_.transitions, automaton_.anchor_mode)
+                        ->WordOf(StringArray(*w, field + ".word"));
+      } catch (const std::invalid_argument& e) {
+        const std::string what = e.what();
+        Fail(w, field + ".word", what.substr(what.find(": ") + 2));
+      }
+      if (rule.word == automaton_.word) rule.word.clear();
+    }
     CheckText(t.get("name"), field + ".name", rule.name);
     const toml::node* when = t.get("when");
     rule.when = when ? AsSetupValue(*when, field + ".when") : SetupValue("1", At(&t, field));

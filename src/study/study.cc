@@ -221,7 +221,7 @@ std::string FloquetReport(const BifurcationDiagram& diagram, const ShootingLayou
   for (const SpecialPointType type : {SpecialPointType::kFloquetBranchPoint, SpecialPointType::kPeriodDoubling,
                                       SpecialPointType::kGrazing, SpecialPointType::kNeimarkSacker,
                                       SpecialPointType::kKreinCollision, SpecialPointType::kConstraintBoundary,
-                                      SpecialPointType::kObservableValue}) {
+                                      SpecialPointType::kZeroDuration, SpecialPointType::kObservableValue}) {
     const std::string code = Code(type);  // special_point.h: the one definition of the codes
     for (const SpecialPoint& sp : diagram.special_points) {
       if (sp.type != type || sp.u.size() == 0) continue;
@@ -695,50 +695,67 @@ void AttachGuide(const StudyOptions& options, PreparedStudy* p) {
   });
 }
 
+// The bound of the coordinate the study's families are followed in (empty component: none).
+ComponentBound LevelBound(const RunSetup& setup, const HybridModel& model) {
+  const std::string level = ShootingLayout(model, setup.free).continued_name();
+  for (const ComponentBound& b : setup.exploration.continuation.bounds) {
+    if (b.component == level) return b;
+  }
+  return {};
+}
+
+// At parameters the user set (options.parameters) the start is carried there from the model's own values
+// (start_carry.h): Newton from the file's guess at other values may fail, or converge to another family's
+// orbit. True when that settled the start: carried, or (the carry failing) Newton's own start at the values set
+// kept with a note, or the study's status set to a failed start (a numerical outcome at valid parameters,
+// never bad input). False where the start fails at the model's own values too: the ordinary check then speaks.
+bool CarryToSetValues(const StudyOptions& options, const StudyHooks& hooks, bool converged, const std::string& why,
+                      PreparedStudy* p) {
+  const HybridModel& model = *p->model;
+  HybridModel own = model.Clone();
+  for (const NamedValue& v : p->setup.own_parameters) own.SetParameter(v.name, v.value);
+  StudyOptions own_options = options;
+  own_options.parameters.clear();
+  const RunSetup own_setup = MakeRunSetup(own_options, own);
+  const std::unique_ptr<ModelExploration> at_own = MakeExploration(own_options, own, own_setup);
+  std::string own_why;
+  if (!at_own->PrepareStart(&own_why) || !IsPhysical(own, at_own->prepared_start(), p->setup.integrator)) return false;
+  const CarriedStart carried = CarryStart(model, p->setup.own_parameters, at_own->prepared_start(),
+                                          p->setup.integrator, {p->setup.free, LevelBound(p->setup, model)});
+  const auto note = [&](const std::string& text) {
+    p->start_note = text;
+    if (hooks.on_note) hooks.on_note(text);
+  };
+  if (carried.ok) {  // said as the start's report while the study runs, and in its answer
+    p->exploration->SetStart(carried.u, carried.report + "\n");
+    p->start_note = carried.report;
+    return true;
+  }
+  if (converged && IsPhysical(model, p->exploration->prepared_start(), p->setup.integrator)) {
+    note(carried.why + "; the study starts from the orbit Newton finds from the model's start at the values set, "
+         "which need not be of the same family");
+    return true;
+  }
+  std::string first = converged ? std::string("the start converges to an orbit that is not physical")
+                                : why.substr(0, why.find('\n'));
+  while (!first.empty() && (first.back() == ':' || first.back() == ' ')) first.pop_back();
+  p->exploration->SetStartFailure(first + "; " + carried.why);
+  if (hooks.on_note) hooks.on_note(first + "; " + carried.why);
+  return true;
+}
+
 // The ordinary run's start, checked (a guess corrected) before anything is written: a start that is not an
 // orbit is an error of the model's input, said per part of the cycle that does not close (or, where a start
-// may fail, a note and the study's status).
-// At parameters the user set (options.parameters), a start that does not converge is carried there from the
-// model's own values (start_carry.h); one that cannot be is a numerical outcome (the study's status), not bad
-// input. The model's own values come from the model built without options.parameters.
-void CheckStart(const StudyOptions& options, const StudyHooks& hooks, const HybridModel* given, PreparedStudy* p) {
+// may fail, a note and the study's status). At parameters the user set, a guess or a simulated start is
+// carried there (CarryToSetValues).
+void CheckStart(const StudyOptions& options, const StudyHooks& hooks, PreparedStudy* p) {
   const HybridModel& model = *p->model;
   if (!p->setup.free.empty() || model.num_first_integrals() == 0 || options.restart) return;
   std::string why;
   const bool converged = p->exploration->PrepareStart(&why);
   const StartSpec::Kind kind = model.setup().start.kind;
   const bool carried_kind = kind == StartSpec::Kind::kGuess || kind == StartSpec::Kind::kSimulation;
-  // At parameters the user set, a start that does not converge, or converges to an orbit that is not physical
-  // while the model's own is, is carried from the model's own values.
-  if (!p->setup.own_parameters.empty() && carried_kind &&
-      (!converged || !IsPhysical(model, p->exploration->prepared_start(), p->setup.integrator))) {
-    StudyOptions own_options = options;
-    own_options.parameters.clear();
-    std::ostringstream quiet;
-    StudyModelSource source;
-    const std::unique_ptr<HybridModel> own = BuildModel(own_options, given, quiet, &source);
-    const RunSetup own_setup = MakeRunSetup(own_options, *own);
-    const std::unique_ptr<ModelExploration> at_own = MakeExploration(own_options, *own, own_setup);
-    std::string own_why;
-    if (at_own->PrepareStart(&own_why) && IsPhysical(*own, at_own->prepared_start(), p->setup.integrator)) {
-      const CarriedStart carried =
-          CarryStart(model, p->setup.own_parameters, at_own->prepared_start(), p->setup.integrator);
-      if (carried.ok) {
-        p->exploration->SetStart(carried.u, carried.report + "\n");
-        p->start_note = carried.report;
-        if (hooks.on_note) hooks.on_note(carried.report);
-        return;
-      }
-      // A numerical outcome at valid parameters: the study's status says it (kStartFailed), nothing is refused.
-      std::string first = converged ? std::string("the start converges to an orbit that is not physical")
-                                    : why.substr(0, why.find('\n'));
-      while (!first.empty() && (first.back() == ':' || first.back() == ' ')) first.pop_back();
-      why = first + "; " + carried.why;
-      p->exploration->SetStartFailure(why);
-      if (hooks.on_note) hooks.on_note(why);
-      return;
-    }
-  }
+  if (!p->setup.own_parameters.empty() && carried_kind && CarryToSetValues(options, hooks, converged, why, p)) return;
   if (converged) return;
   SourceLocation where = model.setup().start.where;
   if (where.field.empty()) where.field = "start";
@@ -785,7 +802,7 @@ PreparedStudy Prepare(const StudyOptions& options, const StudyHooks& hooks, cons
   CheckConservationAtStart(model, options.model, p.exploration->shooting().layout(), p.setup.scenario.start);
   CheckAutomatonWords(model, options.model);
   if (!options.families_of.empty()) AttachGuide(options, &p);
-  CheckStart(options, hooks, given, &p);
+  CheckStart(options, hooks, &p);
   return p;
 }
 

@@ -9,6 +9,7 @@
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/simulation_start.h"
 #include "hybridcont/timebased_shooting.h"
+#include "study/engine/start_carry.h"
 
 namespace hybridcont::study {
 namespace {
@@ -96,24 +97,49 @@ bool OneStart(const HybridModel& model, const RunSetup& setup, const StartSpec& 
   return true;
 }
 
+// The start found at `model`'s parameter values, given the free parameters' values (free_layout).
+bool StartInLayout(const HybridModel& model, const RunSetup& setup, const StartSpec& spec,
+                   const ShootingLayout& free_layout, Vector* point, std::string* report) {
+  Vector u;
+  if (!OneStart(model, setup, spec, &u, report)) return false;
+  *point = Vector::Zero(free_layout.num_unknowns());
+  point->head(u.size()) = u;
+  for (int p = 0; p < free_layout.num_free_parameters(); ++p) {
+    (*point)(free_layout.parameter_index(p)) = model.parameter_value(free_layout.parameter_model_index(p));
+  }
+  return true;
+}
+
 }  // namespace
 
 OrbitStarts FindOrbitStarts(const HybridModel& model, const RunSetup& setup, const ShootingLayout& free_layout) {
   OrbitStarts starts;
   std::vector<StartSpec> specs = {model.setup().start};
   specs.insert(specs.end(), model.setup().more_starts.begin(), model.setup().more_starts.end());
+  // At parameters the user set, each start is found at the model's own values and carried (start_carry.h).
+  HybridModel own = model.Clone();
+  for (const NamedValue& v : setup.own_parameters) own.SetParameter(v.name, v.value);
+  ComponentBound level;
+  for (const ComponentBound& b : setup.exploration.continuation.bounds) {
+    if (b.component == free_layout.continued_name()) level = b;
+  }
   for (std::size_t i = 0; i < specs.size(); ++i) {
-    Vector u;
+    Vector point;
     std::string report;
-    const bool ok = OneStart(model, setup, specs[i], &u, &report);
-    starts.report += fmt::format("  start {}: {}\n", i + 1, report);
-    if (!ok) continue;
-    Vector point = Vector::Zero(free_layout.num_unknowns());
-    point.head(u.size()) = u;
-    for (int p = 0; p < free_layout.num_free_parameters(); ++p) {
-      point(free_layout.parameter_index(p)) = model.parameter_value(free_layout.parameter_model_index(p));
+    bool ok = false;
+    if (!setup.own_parameters.empty()) {
+      std::string own_report;
+      if (StartInLayout(own, setup, specs[i], free_layout, &point, &own_report)) {
+        const CarriedStart carried =
+            CarryStart(model, setup.own_parameters, point, setup.integrator, {setup.free, level});
+        ok = carried.ok;
+        if (ok) point = carried.u, report = own_report + "; " + carried.report;
+        if (!ok) report = carried.why + "; at the values set: ";
+      }
     }
-    starts.points.push_back(point);
+    if (!ok) ok = StartInLayout(model, setup, specs[i], free_layout, &point, &report);
+    starts.report += fmt::format("  start {}: {}\n", i + 1, report);
+    if (ok) starts.points.push_back(point);
   }
   return starts;
 }

@@ -116,7 +116,7 @@ ResultsWriter::ResultsWriter(fs::path dir, const HybridModel& model, nlohmann::j
   document_["phases"] = phases;
   // The special-point codes and what they mean, from their one definition (special_point.h).
   nlohmann::json codes = nlohmann::json::object();
-  for (int t = 0; t <= static_cast<int>(SpecialPointType::kKreinCollision); ++t) {
+  for (int t = 0; t <= static_cast<int>(kLastSpecialPointType); ++t) {
     std::string meaning = ToString(static_cast<SpecialPointType>(t));
     std::replace(meaning.begin(), meaning.end(), '-', ' ');
     codes[Code(static_cast<SpecialPointType>(t))] = meaning;

@@ -53,7 +53,7 @@ nlohmann::json SpecialPointJson(const SpecialPoint& p) {
 SpecialPoint SpecialPointFrom(const nlohmann::json& j, const std::string& where) {
   SpecialPoint p;
   p.id = JsonInt(j, "id", where);
-  p.type = EnumFrom(j, "type", where, SpecialPointType::kKreinCollision);
+  p.type = EnumFrom(j, "type", where, kLastSpecialPointType);
   p.status = EnumFrom(j, "status", where, LocationStatus::kBracketed);
   p.branch_id = JsonInt(j, "branch_id", where);
   p.index = JsonInt(j, "index", where);

@@ -93,6 +93,32 @@ std::string ClassMeaning(OrbitClass c) {
   }
 }
 
+// For each explored word of an automaton that repeats a shorter cycle of modes (the bipedal model's walking,
+// stance > double twice: two steps), what T and the multipliers are of: the whole word, so a multiplier of one
+// step's map is squared in them (a one-step flip, -1, shows as +1: a BP or SB point of the two-step cycle).
+std::string RepeatedWordNote(const StudyResult& study) {
+  std::string out;
+  for (const StudyWord& w : study.words) {
+    const std::size_t n = w.modes.size();
+    if (w.branches.empty() || n < 2) continue;
+    std::size_t period = n;
+    for (std::size_t p = 1; p < n && period == n; ++p) {
+      if (n % p != 0) continue;
+      bool repeats = true;
+      for (std::size_t i = p; i < n && repeats; ++i) repeats = w.modes[i] == w.modes[i % p];
+      if (repeats) period = p;
+    }
+    if (period == n) continue;
+    std::string cycle;
+    for (std::size_t i = 0; i < period; ++i) cycle += (i ? " > " : "") + w.modes[i];
+    const std::size_t times = n / period;
+    out += fmt::format("  (word {}: T and the multipliers are of the whole word, {} {} times: {} steps; a multiplier "
+                       "of one step's map appears squared, so a one-step flip shows as a BP/SB point)\n",
+                       w.name, cycle, times, times);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string OneScreenAnswer(const StudyResult& study, double seconds) {
@@ -117,6 +143,7 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
       out += fmt::format("  {}: physical {} {}; stable {}\n", f.name, f.continued, list(f.physical),
                          f.stable.empty() ? std::string("nowhere") : f.continued + " " + list(f.stable));
     }
+    out += RepeatedWordNote(study);
   }
   // Which branches leave each special point: the families a point connects.
   std::map<int, std::vector<int>> children;
@@ -149,11 +176,18 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
     } else {
       out += head + ")\n";
     }
+    // A branch whose stretches belong to different families (one that turns at a fold from late to early
+    // impacts) names the family of each stretch that is not the branch's.
+    const auto of = [&](const Range& r) {
+      return r.family.empty() || r.family == b.family ? std::string() : "  " + r.family;
+    };
     for (const Range& r : b.ranges.physical) {
-      out += fmt::format("  physical  {} {}\n", c, RangeText(r, study.special_points));
+      out += fmt::format("  physical  {} {}{}\n", c, RangeText(r, study.special_points), of(r));
     }
     if (b.ranges.stable.empty()) out += "  stable    nowhere\n";
-    for (const Range& r : b.ranges.stable) out += fmt::format("  stable    {} {}\n", c, RangeText(r, study.special_points));
+    for (const Range& r : b.ranges.stable) {
+      out += fmt::format("  stable    {} {}{}\n", c, RangeText(r, study.special_points), of(r));
+    }
     if (image_of_family) continue;
     // Its located special points on physical stretches, and where other families leave them.
     std::string located, leads;

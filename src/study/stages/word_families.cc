@@ -299,11 +299,17 @@ class WordExplorer {
       special_points_->push_back(std::move(p));
     }
     const std::string word_name = automaton_.WordName(w.word);
+    // The word's family rules ([[families]] with its `word`) name its orbits; where none holds, the word does.
+    const OrbitPresentation presentation(*w.model);
+    const FamilyNamer namer = [&](const Vector& u) {
+      const std::string family = presentation.Family(u);
+      return family == kUnnamedFamily ? word_name : family;
+    };
     for (const Branch& b : d.branches) {
       if (writer_.FindBranch(b.id) == nullptr) writer_.SetBranchModel(b.id, *w.model, word_name);  // without points
       writer_.EndBranch(b);
       w.branches.branches.push_back(b);
-      word_ranges_ += AssignBranchFamily(b, word_layout, [&](const Vector&) { return word_name; }, writer_);
+      word_ranges_ += AssignBranchFamily(b, word_layout, namer, writer_);
     }
     return d;
   }
@@ -325,18 +331,28 @@ class WordExplorer {
       Corrector corrector(&map);
       Vector u;
       const CorrectorResult corrected = corrector.CorrectFixedComponent(guess, layout.H_index(), guess(layout.H_index()), &u);
-      // At parameters the user set, a start that fails there (or gives an orbit that is not physical) is carried
-      // from the model's own values (start_carry.h).
-      if (!setup_.own_parameters.empty() && (!corrected.converged() || !IsPhysical(word_model, u, integrator_))) {
-        const CarriedStart carried = CarryGuess(word_model, setup_.own_parameters, guess, integrator_);
+      // At parameters the user set the start is carried there from the model's own values (start_carry.h); where
+      // that fails, Newton's orbit from the guess at the values set is kept if it is physical.
+      if (!setup_.own_parameters.empty()) {
+        ComponentBound level;
+        for (const ComponentBound& b : setup_.exploration.continuation.bounds) {
+          if (b.component == "H") level = b;
+        }
+        const CarriedStart carried = CarryGuess(word_model, setup_.own_parameters, guess, integrator_, {{}, level});
         if (carried.ok) {
           u = carried.u;
           report_ += fmt::format("  start in word {}: {}\n", name, carried.report);
           Say(fmt::format("word {}: {}", name, carried.report));
-        } else if (!corrected.converged()) {
-          report_ += fmt::format("  start in word {}: the guess does not converge to an orbit at H = {}: {}; {}\n", name,
-                                 guess(layout.H_index()), corrected.message, carried.why);
+        } else if (!corrected.converged() || !IsPhysical(word_model, u, integrator_)) {
+          report_ += fmt::format("  start in word {}: {}; {}\n", name,
+                                 corrected.converged() ? std::string("the guess converges to an orbit that is not physical")
+                                                       : fmt::format("the guess does not converge to an orbit at H = {}: {}",
+                                                                     guess(layout.H_index()), corrected.message),
+                                 carried.why);
           continue;
+        } else {
+          report_ += fmt::format("  start in word {}: {}; Newton's orbit from the guess at the values set is the start\n",
+                                 name, carried.why);
         }
       } else if (!corrected.converged()) {
         report_ += fmt::format("  start in word {}: the guess does not converge to an orbit at H = {}: {}\n", name,
