@@ -496,7 +496,12 @@ TEST(Study, AStartIsCarriedToTheParametersSetOrSaysWhereItsFamilyTurnsBack) {
             "start carried from the model's own k = 25.4842, beta = 0.366519 to 15, 0.42 at H = 1.044852192 (23 "
             "continuation steps)");
   EXPECT_EQ(families(carried), (std::set<std::string>{"walking", "running"}));
-  EXPECT_NE(OneScreenAnswer(carried, 0).find(carried.start_note), std::string::npos);
+  const std::string answer = OneScreenAnswer(carried, 0);
+  EXPECT_NE(answer.find(carried.start_note), std::string::npos);
+  // Both gaits are two steps: the answer says what T and the multipliers are of.
+  EXPECT_NE(answer.find("(T and the multipliers are of the whole cycle: stance > double twice, stance > flight twice;"),
+            std::string::npos)
+      << answer;
   o.parameters = {{"k", 40}, {"beta", 0.2}};
   const StudyResult folded = RunStudy(o);
   EXPECT_EQ(folded.status, ExplorationStatus::kStartFailed);
@@ -506,6 +511,15 @@ TEST(Study, AStartIsCarriedToTheParametersSetOrSaysWhereItsFamilyTurnsBack) {
   EXPECT_NE(folded.message.find("its orbits are no longer physical beyond beta = 0.23706"), std::string::npos)
       << folded.message;
   EXPECT_EQ(families(folded), (std::set<std::string>{"running"}));
+}
+
+// The vibrating table's branch from its start turns at a fold from late to early impacts: each stretch of the
+// answer names its family where it is not the branch's.
+TEST(Study, TheAnswerNamesTheFamilyOfEachStretch) {
+  StudyOptions o;
+  o.model = HYBRIDCONT_SOURCE_DIR "/models/vibrating-table.toml";
+  const std::string answer = OneScreenAnswer(RunStudy(o), 0);
+  EXPECT_NE(answer.find("(TP0 .. CB1)  period one, early impact\n"), std::string::npos) << answer;
 }
 
 // Every declared start is carried, not only one that fails at the values set: at m = 2, gamma = 0.01 Newton from

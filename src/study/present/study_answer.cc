@@ -97,7 +97,7 @@ std::string ClassMeaning(OrbitClass c) {
 // stance > double twice: two steps), what T and the multipliers are of: the whole word, so a multiplier of one
 // step's map is squared in them (a one-step flip, -1, shows as +1: a BP or SB point of the two-step cycle).
 std::string RepeatedWordNote(const StudyResult& study) {
-  std::string out;
+  std::vector<std::string> cycles;
   for (const StudyWord& w : study.words) {
     const std::size_t n = w.modes.size();
     if (w.branches.empty() || n < 2) continue;
@@ -112,11 +112,14 @@ std::string RepeatedWordNote(const StudyResult& study) {
     std::string cycle;
     for (std::size_t i = 0; i < period; ++i) cycle += (i ? " > " : "") + w.modes[i];
     const std::size_t times = n / period;
-    out += fmt::format("  (word {}: T and the multipliers are of the whole word, {} {} times: {} steps; a multiplier "
-                       "of one step's map appears squared, so a one-step flip shows as a BP/SB point)\n",
-                       w.name, cycle, times, times);
+    cycles.push_back(fmt::format("{} {}", cycle, times == 2 ? std::string("twice") : fmt::format("{} times", times)));
   }
-  return out;
+  if (cycles.empty()) return "";
+  std::string list;
+  for (std::size_t i = 0; i < cycles.size(); ++i) list += (i ? ", " : "") + cycles[i];
+  return fmt::format("  (T and the multipliers are of the whole cycle: {};\n   a one-step flip, -1 over one step, "
+                     "is +1 over the cycle: a BP or SB point)\n",
+                     list);
 }
 
 }  // namespace
