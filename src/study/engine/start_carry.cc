@@ -194,7 +194,8 @@ class ParameterCarry {
   }
 
   // Orbits of the family through u (base layout) at parameter value `value` at other levels, within the
-  // study's bound of the level: a few spread over each direction, nearest first, physical ones where there are.
+  // study's bound of the level: a few along each direction, nearest first, the physical ones of each direction
+  // before the others.
   std::vector<Vector> OtherLevels(const Vector& u, double value, int* steps) const {
     const HybridModel at = At(value);
     TimeBasedShooting map(at, integrator_, base_);
@@ -211,18 +212,17 @@ class ParameterCarry {
       *steps += static_cast<int>(b.points.size());
       std::vector<Vector> side;
       const ShootingLayout plain(at);
-      for (int k = 1; k <= 4; ++k) {
-        const std::size_t i = b.points.size() * k / 4;
-        if (i == 0 || i > b.points.size()) continue;
-        const Vector& v = b.points[i - 1].u;
-        if (side.empty() || (side.back() - v).norm() > 0) side.push_back(v);
+      // Near levels first, then farther ones (indices growing geometrically along the trace).
+      for (const std::size_t i : {2, 5, 10, 20, 40, 80, 119}) {
+        if (i >= b.points.size()) break;
+        side.push_back(b.points[i].u);
       }
       std::stable_partition(side.begin(), side.end(),
                             [&](const Vector& v) { return IsPhysical(at, Relayout(layout, v, plain), integrator_); });
       sides.push_back(std::move(side));
     }
     std::vector<Vector> out;
-    for (std::size_t k = 0; k < 4; ++k) {
+    for (std::size_t k = 0; k < 7; ++k) {
       for (const std::vector<Vector>& side : sides) {
         if (k < side.size()) out.push_back(side[k]);
       }
