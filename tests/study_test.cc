@@ -473,10 +473,10 @@ TEST(Study, OptionErrorsNameTheFieldAndWriteNothing) {
 
 // The bipedal model's walking guess (written for k = 25.5, beta = 0.367) does not converge at k = 15,
 // beta = 0.42, and its running guess converges there to an orbit that runs backward in time: both are carried
-// from the model's own values (start_carry.h), and walking and running are found. At k = 40, beta = 0.2 walking
-// reaches k = 40 at another level (its family at the start's level turns back at k = 34.13), but its orbits stop
-// being physical at beta = 0.237 on the way to 0.2 at every level tried: a numerical outcome at valid parameters
-// (the study's status, never bad input), and the running start still gives running.
+// from the model's own values (start_carry.h), and walking and running are found. At k = 40, beta = 0.1 (a leg
+// nearly vertical at touch-down) walking reaches k = 40 at another level (its family at the start's level turns
+// back at k = 34.13), but its orbits stop being physical at beta = 0.235 on the way to 0.1 at every level tried:
+// a numerical outcome at valid parameters (the study's status, never bad input).
 TEST(Study, AStartIsCarriedToTheParametersSetOrSaysWhereItsFamilyTurnsBack) {
   StudyOptions o;
   o.model = "bipedal-slip";
@@ -502,15 +502,15 @@ TEST(Study, AStartIsCarriedToTheParametersSetOrSaysWhereItsFamilyTurnsBack) {
   EXPECT_NE(answer.find("(T and the multipliers are of the whole cycle: stance > double twice, stance > flight twice;"),
             std::string::npos)
       << answer;
-  o.parameters = {{"k", 40}, {"beta", 0.2}};
+  o.parameters = {{"k", 40}, {"beta", 0.1}};
   const StudyResult folded = RunStudy(o);
   EXPECT_EQ(folded.status, ExplorationStatus::kStartFailed);
-  EXPECT_NE(folded.message.find("the start could not be carried from beta = 0.3665191429 to 0.2: at H = "),
+  EXPECT_NE(folded.message.find("the start could not be carried from beta = 0.3665191429 to 0.1: at H = "),
             std::string::npos)
       << folded.message;
-  EXPECT_NE(folded.message.find("its orbits are no longer physical beyond beta = 0.23706"), std::string::npos)
+  EXPECT_NE(folded.message.find("its orbits are no longer physical beyond beta = 0.2353"), std::string::npos)
       << folded.message;
-  EXPECT_EQ(families(folded), (std::set<std::string>{"running"}));
+  EXPECT_TRUE(families(folded).empty());
 }
 
 // The vibrating table's branch from its start turns at a fold from late to early impacts: each stretch of the

@@ -18,7 +18,7 @@ import pytest
 import hybridcont as hc
 from hybridcont import sweeps
 
-GRID = {"k": (20, 80, 4), "w2": (3, 7, 4)}  # 16 grid points of the SLIP
+GRID = {"k": (20, 80, 3), "w2": (3, 7, 2)}  # 6 grid points of the SLIP
 OPTIONS = {"until": {"H": 1.7}}
 
 
@@ -59,9 +59,9 @@ def test_a_killed_worker_costs_no_grid_point(tmp_path):
             "slip", GRID, out, scheduler=address, progress=False, **OPTIONS)))
         runner.start()
         deadline = time.time() + 120
-        while len(complete_points(out)) < 3 and time.time() < deadline:
+        while len(complete_points(out)) < 2 and time.time() < deadline:
             time.sleep(0.05)
-        assert len(complete_points(out)) < 16, "the sweep ended before a worker could be killed"
+        assert len(complete_points(out)) < 6, "the sweep ended before a worker could be killed"
         os.killpg(workers[0].pid, signal.SIGKILL)  # mid-way: its running task is lost with it
         runner.join(timeout=300)
         assert not runner.is_alive()
@@ -73,11 +73,11 @@ def test_a_killed_worker_costs_no_grid_point(tmp_path):
         assert not [p for p in os.listdir(os.path.join(out, "points")) if p.startswith(".partial")]
         # The grid's parameters by name; hopping in place exists at every point, stable over a range of H.
         hopping = table[table.family == "hopping in place"]
-        assert len(hopping) == 16 and hopping.exists.all() and hopping.stable.all()
-        assert set(hopping["k"]) == {20.0, 40.0, 60.0, 80.0}
+        assert len(hopping) == 6 and hopping.exists.all() and hopping.stable.all()
+        assert set(hopping["k"]) == {20.0, 50.0, 80.0} and set(hopping["w2"]) == {3.0, 7.0}
         # The same numbers a study at that grid point gives alone.
-        row = hopping[(hopping.k == 40.0) & (hopping.w2 == 3 + 4 / 3)].iloc[0]
-        alone = hc.run("slip", set={"k": 40.0, "w2": 3 + 4 / 3}, progress=False, **OPTIONS)
+        row = hopping[(hopping.k == 50.0) & (hopping.w2 == 7.0)].iloc[0]
+        alone = hc.run("slip", set={"k": 50.0, "w2": 7.0}, progress=False, **OPTIONS)
         stable = alone.families.query("family == 'hopping in place' and kind == 'stable'")
         assert row.stable_from == pytest.approx(stable["from"].min(), abs=1e-12)
     finally:
@@ -92,17 +92,17 @@ def test_a_killed_worker_costs_no_grid_point(tmp_path):
 def test_an_interrupted_sweep_resumes_to_the_table_of_an_uninterrupted_one(tmp_path):
     whole = hc.sweep("slip", GRID, str(tmp_path / "whole"), workers=2, progress=False, **OPTIONS)
     out = str(tmp_path / "cut")
-    command = [sys.executable, "-m", "hybridcont.sweeps", "slip", "--grid", "k=20:80:4", "--grid", "w2=3:7:4",
+    command = [sys.executable, "-m", "hybridcont.sweeps", "slip", "--grid", "k=20:80:3", "--grid", "w2=3:7:2",
                "--until", "H=1.7", "--workers", "1", "--quiet", "--out", out]
     proc = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=dict(os.environ),
                             start_new_session=True)
     deadline = time.time() + 120
-    while len(complete_points(out)) < 4 and time.time() < deadline and proc.poll() is None:
+    while len(complete_points(out)) < 2 and time.time() < deadline and proc.poll() is None:
         time.sleep(0.05)
     os.killpg(proc.pid, signal.SIGKILL)  # the sweep, its cluster and its workers
     proc.wait()
     done = len(complete_points(out))
-    assert 0 < done < 16
+    assert 0 < done < 6
     proc = subprocess.run(command + ["--resume"], capture_output=True, text=True, env=dict(os.environ))
     assert proc.returncode == 0, proc.stderr
     resumed = pd.read_csv(os.path.join(out, "table.csv"))
@@ -243,7 +243,7 @@ def test_continuing_the_neighbours_families_gives_the_whole_explorations_table(t
     """Strategy "continue" (each grid point traces only the half-branches that led to its neighbour's families)
     against "explore" (every grid point explored whole) over the SLIP's (k, w2) from 10 to 160 and 2 to 10: the
     same rows, range for range and special point for special point (their ids are each study's own)."""
-    grid = {"k": (10, 160, 4), "w2": (2, 10, 4)}
+    grid = {"k": (10, 160, 3), "w2": (2, 10, 3)}
     tables = {s: hc.sweep("slip", grid, str(tmp_path / s), workers=2, progress=False, maps=False, strategy=s)
               for s in ("continue", "explore")}
     kinds = tables["continue"].strategy.str.split(" ").str[0].value_counts().to_dict()
