@@ -172,18 +172,20 @@ def test_neighbours_orbits_start_a_grid_point_the_models_own_start_cannot(tmp_pa
     """The bipedal model's walking guess, written for k = 25.5 and beta = 0.367, does not converge at k = 17.857,
     beta = 0.30: a study there carries it from the model's own values; the sweep covers the grid from the point
     nearest the model's own parameters outwards and starts each point from the orbits its neighbour found: every
-    point walks."""
-    alone = hc.run("bipedal-slip", set={"k": 17.857, "beta": 0.30}, progress=False, max_branches=6)
+    point walks. The file's word alone (one_word): the neighbours' orbits are walking's, and the other words'
+    families, most of a study's time on this model, are followed in the studies of tests/study_test.cc."""
+    alone = hc.run("bipedal-slip", set={"k": 17.857, "beta": 0.30}, progress=False, max_branches=6,
+                   one_word=True)
     assert "start carried from the model's own k = 25.4842, beta = 0.366519 to 17.857, 0.3" in str(alone)
     assert "walking" in set(alone.families.family)
     table = hc.sweep("bipedal-slip", {"beta": (0.30, 0.3665, 4)}, str(tmp_path / "walk"), progress=False,
-                     max_branches=6, set={"k": 17.857}, maps=False)
+                     max_branches=6, one_word=True, set={"k": 17.857}, maps=False)
     walking = table[table.family == "walking"].sort_values("beta")
     assert list(walking.exists) == [True] * 4
     assert list(walking.strategy) == ["explore from %d's orbits" % i for i in (1, 2, 3)] + ["explore"]
     # Continuing: a study stopped at max_branches guides no other, so each point is explored whole, and says why.
     table = hc.sweep("bipedal-slip", {"beta": (0.30, 0.3665, 4)}, str(tmp_path / "walk2"), progress=False,
-                     max_branches=6, set={"k": 17.857}, maps=False, strategy="continue")
+                     max_branches=6, one_word=True, set={"k": 17.857}, maps=False, strategy="continue")
     walking = table[table.family == "walking"].sort_values("beta")
     assert list(walking.strategy) == ["explore from %d's orbits (%d did not complete)" % (i, i) for i in (1, 2, 3)] + \
         ["explore"]
