@@ -80,9 +80,11 @@ double PeriodDoublingTest(const Matrix& dr, const ShootingLayout& layout);
 // Last, one kZeroDuration function per phase 2..m: its duration t_i (an unknown: nothing is integrated), 0
 // where the phase vanishes from the cycle (running's flight shrinking to nothing where walking begins). At a
 // branch point it is defined where the orbit is physical, and where it fails by its durations (class
-// reversed-time or zero-duration) just after a physical branch point of the same trace: so a zero is located
-// where a physical family, followed outward, ends by a vanishing phase — not on the many families of orbits
-// that run a phase backwards (a family entering the physical region there keeps an end between two points).
+// reversed-time or zero-duration) just after a physical branch point of the same trace, or where t_i and its
+// symmetric copies (equal to it) are its only durations not positive: so a zero is located only between a
+// physical point and one that fails by that phase alone, where a physical family ends (followed outward or
+// inward) by a vanishing phase — not on the many families of orbits that run some phase backwards, nor on
+// those whose phase lasts no time (t_i rounding about 0).
 // A zero is kept where no other duration is negative (a symmetric gait's two flights vanish at one point).
 class FloquetTestFunctions : public TestFunctions {
  public:

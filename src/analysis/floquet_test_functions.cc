@@ -170,8 +170,25 @@ void FloquetTestFunctions::EvaluateDurations(const Vector& u, bool branch_point,
   const bool by_duration = c.reason == OrbitClass::kReversedTime || c.reason == OrbitClass::kZeroDuration;
   const bool after_physical = last_branch_physical_;
   if (branch_point) last_branch_physical_ = c.physical;
-  if (branch_point && !c.physical && !(by_duration && after_physical)) return;
-  for (int i = 1; i < m; ++i) (*values)(first_zero_duration() + i - 1) = u(base.time_index(i));
+  if (branch_point && !c.physical && !by_duration) return;
+  const double T = base.Period(u);
+  const double same = 1e-9 * std::max(1.0, std::abs(T));
+  const double zero = ClassificationOptions{}.duration_tolerance * std::max(1.0, std::abs(T));
+  for (int i = 1; i < m; ++i) {
+    const double t = u(base.time_index(i));
+    bool defined = !branch_point || c.physical || after_physical;
+    // (a duration within the classification's zero of 0 is no side of a crossing: families whose phase lasts
+    // no time, t_i rounding about 0, locate nothing)
+    if (!defined && !(t < -zero)) continue;
+    // Before a physical point of the trace: t_i and its symmetric copies (a gait's two flights) are the only
+    // durations not positive, so that this point and a physical neighbour bracket the end of the family.
+    for (int j = 0; j <= m && !defined; ++j) {
+      const double tj = u(base.time_index(j));
+      if (j != i && tj <= 0 && std::abs(tj - t) > same) break;
+      if (j == m) defined = true;
+    }
+    if (defined) (*values)(first_zero_duration() + i - 1) = t;
+  }
 }
 
 bool FloquetTestFunctions::Physical(const Vector& u_free) const {
