@@ -184,6 +184,7 @@ class FloquetTestFunctions : public TestFunctions {
   FreeParameters free_;
   TimeBasedShooting shooting_;
   int base_unknowns_;                            // u without the free parameters
+  std::vector<int> time_index_;                  // index of t_{i+1} in u, segment i (EvaluateDurations)
   std::unique_ptr<HybridModel> point_model_;     // with free parameters: set to u's values to classify
   Matrix dr_;
   Vector r_;

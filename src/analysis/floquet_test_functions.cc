@@ -55,6 +55,8 @@ FloquetTestFunctions::FloquetTestFunctions(const HybridModel& model, const Integ
       base_unknowns_(ShootingLayout(model).num_unknowns()),
       point_model_(free_.empty() ? nullptr : std::make_unique<HybridModel>(model.Clone())) {
   shooting_.set_threads(1);  // a stepper's own copy works on the stepper's thread
+  const ShootingLayout base(model);
+  for (int i = 0; i < base.num_segments(); ++i) time_index_.push_back(base.time_index(i));
 }
 
 std::vector<SpecialPointType> FloquetTestFunctions::types() const {
@@ -165,17 +167,17 @@ void FloquetTestFunctions::EvaluateOwnEvents(const Vector& u, const OrbitTrace* 
 
 void FloquetTestFunctions::EvaluateDurations(const Vector& u, bool branch_point, const Classification& c,
                                              Vector* values) {
-  const ShootingLayout base(*model_);
   const int m = model_->num_phases();
   const bool by_duration = c.reason == OrbitClass::kReversedTime || c.reason == OrbitClass::kZeroDuration;
   const bool after_physical = last_branch_physical_;
   if (branch_point) last_branch_physical_ = c.physical;
   if (branch_point && !c.physical && !by_duration) return;
-  const double T = base.Period(u);
+  double T = 0.0;
+  for (const int k : time_index_) T += u(k);
   const double same = 1e-9 * std::max(1.0, std::abs(T));
   const double zero = ClassificationOptions{}.duration_tolerance * std::max(1.0, std::abs(T));
   for (int i = 1; i < m; ++i) {
-    const double t = u(base.time_index(i));
+    const double t = u(time_index_[i]);
     bool defined = !branch_point || c.physical || after_physical;
     // (a duration within the classification's zero of 0 is no side of a crossing: families whose phase lasts
     // no time, t_i rounding about 0, locate nothing)
@@ -183,7 +185,7 @@ void FloquetTestFunctions::EvaluateDurations(const Vector& u, bool branch_point,
     // Before a physical point of the trace: t_i and its symmetric copies (a gait's two flights) are the only
     // durations not positive, so that this point and a physical neighbour bracket the end of the family.
     for (int j = 0; j <= m && !defined; ++j) {
-      const double tj = u(base.time_index(j));
+      const double tj = u(time_index_[j]);
       if (j != i && tj <= 0 && std::abs(tj - t) > same) break;
       if (j == m) defined = true;
     }

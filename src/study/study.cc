@@ -695,15 +695,6 @@ void AttachGuide(const StudyOptions& options, PreparedStudy* p) {
   });
 }
 
-// The bound of the coordinate the study's families are followed in (empty component: none).
-ComponentBound LevelBound(const RunSetup& setup, const HybridModel& model) {
-  const std::string level = ShootingLayout(model, setup.free).continued_name();
-  for (const ComponentBound& b : setup.exploration.continuation.bounds) {
-    if (b.component == level) return b;
-  }
-  return {};
-}
-
 // At parameters the user set (options.parameters) the start is carried there from the model's own values
 // (start_carry.h): Newton from the file's guess at other values may fail, or converge to another family's
 // orbit. True when that settled the start: carried, or (the carry failing) Newton's own start at the values set
@@ -721,7 +712,7 @@ bool CarryToSetValues(const StudyOptions& options, const StudyHooks& hooks, bool
   std::string own_why;
   if (!at_own->PrepareStart(&own_why) || !IsPhysical(own, at_own->prepared_start(), p->setup.integrator)) return false;
   const CarriedStart carried = CarryStart(model, p->setup.own_parameters, at_own->prepared_start(),
-                                          p->setup.integrator, {p->setup.free, LevelBound(p->setup, model)});
+                                          p->setup.integrator, {p->setup.free, LevelBound(p->setup, ShootingLayout(model, p->setup.free).continued_name())});
   const auto note = [&](const std::string& text) {
     p->start_note = text;
     if (hooks.on_note) hooks.on_note(text);

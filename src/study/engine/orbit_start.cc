@@ -119,10 +119,7 @@ OrbitStarts FindOrbitStarts(const HybridModel& model, const RunSetup& setup, con
   // At parameters the user set, each start is found at the model's own values and carried (start_carry.h).
   HybridModel own = model.Clone();
   for (const NamedValue& v : setup.own_parameters) own.SetParameter(v.name, v.value);
-  ComponentBound level;
-  for (const ComponentBound& b : setup.exploration.continuation.bounds) {
-    if (b.component == free_layout.continued_name()) level = b;
-  }
+  const ComponentBound level = LevelBound(setup, free_layout.continued_name());
   for (std::size_t i = 0; i < specs.size(); ++i) {
     Vector point;
     std::string report;

@@ -333,4 +333,11 @@ RunSetup MakeRunSetup(const StudyOptions& given, const HybridModel& model) {
   return setup;
 }
 
+ComponentBound LevelBound(const RunSetup& setup, const std::string& level) {
+  for (const ComponentBound& b : setup.exploration.continuation.bounds) {
+    if (b.component == level) return b;
+  }
+  return {};
+}
+
 }  // namespace hybridcont::study

@@ -43,6 +43,9 @@ struct RunSetup {
 // refuses or that makes no sense for a study (see docs/bad-input.md).
 RunSetup MakeRunSetup(const StudyOptions& options, const HybridModel& model);
 
+// The exploration's bound on the coordinate `level` (H, or the run's parameter); an empty component: none.
+ComponentBound LevelBound(const RunSetup& setup, const std::string& level);
+
 }  // namespace hybridcont::study
 
 #endif  // HYBRIDCONT_STUDY_RUN_SETUP_H_

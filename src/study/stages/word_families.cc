@@ -334,11 +334,8 @@ class WordExplorer {
       // At parameters the user set the start is carried there from the model's own values (start_carry.h); where
       // that fails, Newton's orbit from the guess at the values set is kept if it is physical.
       if (!setup_.own_parameters.empty()) {
-        ComponentBound level;
-        for (const ComponentBound& b : setup_.exploration.continuation.bounds) {
-          if (b.component == "H") level = b;
-        }
-        const CarriedStart carried = CarryGuess(word_model, setup_.own_parameters, guess, integrator_, {{}, level});
+        const CarriedStart carried =
+            CarryGuess(word_model, setup_.own_parameters, guess, integrator_, {{}, LevelBound(setup_, "H")});
         if (carried.ok) {
           u = carried.u;
           report_ += fmt::format("  start in word {}: {}\n", name, carried.report);
