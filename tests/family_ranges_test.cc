@@ -114,5 +114,22 @@ TEST(FamilyRanges, APhysicalStartPointAloneIsAStretchOfOnePoint) {
   EXPECT_DOUBLE_EQ(r.physical[0].to.value, r.physical[0].from.value);
 }
 
+// Orbits the integration does not resolve (a family whose period grows without bound): they belong to no
+// stretch, and the stretches before them end at their own last point, exactly, saying so.
+TEST(FamilyRanges, AStretchEndsAtTheLastOrbitTheIntegrationResolves) {
+  const Branch b = EightPoints();
+  const std::vector<bool> physical(8, true), stable(8, true), boundary(8, false);
+  const std::vector<bool> unresolved = {false, false, false, false, false, true, true, true};
+  const BranchRanges r = RangesOnBranch(b, physical, stable, boundary, 0, unresolved);
+  ASSERT_EQ(r.physical.size(), 1u);
+  ASSERT_EQ(r.stable.size(), 1u);
+  for (const Range* range : {&r.physical[0], &r.stable[0]}) {
+    EXPECT_EQ(range->last_point, 4);
+    EXPECT_TRUE(range->to.located);
+    EXPECT_DOUBLE_EQ(range->to.value, 4.0);
+    EXPECT_EQ(range->to.how, "point 4, the last orbit the integration resolves");
+  }
+}
+
 }  // namespace
 }  // namespace hybridcont

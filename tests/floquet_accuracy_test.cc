@@ -149,5 +149,41 @@ TEST(FloquetAccuracy, StabilityClassNamesTheKindOfInstability) {
   EXPECT_EQ(classify(rotation), "neutrally stable");
 }
 
+// The multipliers' error is twice the monodromy's measured defect on its known eigenvector (floquet.h,
+// "Accuracy of the multipliers"): a monodromy that maps the flow direction e0 to (1 + d) e0 is off by d, its
+// multipliers said to be within 2d. What they cannot tell at that error is withheld; what they can is said.
+TEST(FloquetAccuracy, WhatTheMultipliersCannotTellIsWithheld) {
+  const Vector f0 = Vector::Unit(3, 0);
+  const auto analyze = [&](double defect, double mu1, double mu2) {
+    Matrix P = Matrix::Zero(3, 3);
+    P.diagonal() << 1.0 + defect, mu1, mu2;
+    return AnalyzeMonodromy(P, f0, RowVector());
+  };
+  const FloquetResult exact = analyze(0.0, 0.99, 0.5);  // as before: a verdict at circle_tolerance
+  EXPECT_EQ(exact.multiplier_error, 0.0);
+  EXPECT_EQ(exact.stability.ToString(), "asymptotically stable");
+
+  const FloquetResult near = analyze(0.025, 0.99, 0.5);  // 0.99 lies within 0.05 of the circle
+  EXPECT_NEAR(near.multiplier_error, 0.05, 1e-15);
+  EXPECT_TRUE(near.stability.undetermined);
+  EXPECT_EQ(near.stability.ToString(), "undetermined (multipliers uncertain to 5e-02)");
+  EXPECT_FALSE(near.stable);
+  EXPECT_FALSE(near.asymptotically_stable);
+  EXPECT_TRUE(std::isfinite(near.bp_test));  // the values stay; a branch point's are withheld by the tests
+
+  const FloquetResult clear = analyze(0.025, 0.68, 0.5);  // inside by far more than the error
+  EXPECT_EQ(clear.stability.ToString(), "asymptotically stable");
+
+  const FloquetResult outside = analyze(0.025, 0.99, 1.5);  // one clearly outside: unstable whatever 0.99 is
+  EXPECT_EQ(outside.stability.ToString(), "unstable (saddle)");
+
+  EXPECT_TRUE(analyze(0.025, -0.97, 0.5).stability.undetermined);
+
+  // Below circle_tolerance the error changes nothing: the verdict at the tolerance stands.
+  const FloquetResult small = analyze(4e-7, 1.0 + 5e-7, 0.5);
+  EXPECT_FALSE(small.stability.undetermined);
+  EXPECT_EQ(small.stability.ToString(), "neutrally stable");
+}
+
 }  // namespace
 }  // namespace hybridcont

@@ -53,9 +53,14 @@ struct BranchRanges {
 // physical or stable stretch next to it ends at it, exactly. `coordinate` indexes u. A stable stretch of the
 // branch's start point alone, where the branch leaves a special point (the bifurcation itself, neutral
 // there), is no stretch and is left out; a physical one, with no special point before the next point, is the
-// family's only physical orbit and ends where it starts.
+// family's only physical orbit and ends where it starts. unresolved[i] (empty: none) marks a point the
+// integration does not resolve (OrbitAnalysis::resolved: its multipliers and class are not to be trusted,
+// e.g. orbits passing ever nearer an equilibrium as the period grows without bound): it belongs to no
+// stretch, and a stretch next to it ends at its own last point ("point 185, the last orbit the integration
+// resolves").
 BranchRanges RangesOnBranch(const Branch& b, const std::vector<bool>& physical, const std::vector<bool>& stable,
-                            const std::vector<bool>& boundary, int coordinate);
+                            const std::vector<bool>& boundary, int coordinate,
+                            const std::vector<bool>& unresolved = {});
 
 // "1.2467401100 (BP #1, located, precision 1.8e-10)" for a report line.
 std::string ToString(const RangeEnd& end);

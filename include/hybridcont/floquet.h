@@ -39,6 +39,24 @@
 // the kind of the multipliers outside: a real one above +1 (saddle), a real one below −1 (flip), a complex
 // pair (oscillatory).
 //
+// Accuracy of the multipliers (FloquetResult::multiplier_error). Phi_T is known to fix f and (with a first
+// integral) dH exactly, so the defects |Phi_T f - f| / |f| and |dH Phi_T - dH| / |dH| measure the error of
+// the computed Phi_T itself, in the units of its eigenvalues: a well-conditioned multiplier is off by about
+// that much. They are ~1e-11 on ordinary orbits and grow with the orbit's sensitivity: an orbit that passes
+// near an equilibrium (the slow end of a family whose period grows without bound) multiplies the
+// integrator's error by e^{λT}. The same error bounds the multipliers near the unit circle taken from the
+// inverse product: the inverse's own defect does not (the rimless wheel's multiplier cos²2α from the inverse
+// is off by ~tol·|Phi_T|, the forward defect, at T = 10, while the inverse's defect is 300 times smaller);
+// far inside the circle the inverse product's are accurate relative to their size, better than this bound.
+// The defect is an estimate (the wheel's multiplier is off by 0.5 to 1.2 times it as T grows to 24), so the
+// error stated is twice it (kMultiplierErrorSafety), as a located point's integration error is doubled
+// (continuation.h). Where that error exceeds circle_tolerance and reaches the distance of a multiplier from
+// the unit circle (and none lies clearly outside it), the stability verdict is withheld
+// (StabilityClass::undetermined). Beyond kUnresolvedMultiplierError the orbit is not resolved at all: the
+// Floquet test functions take no value at such a branch point (floquet_test_functions.h), so that no special
+// point is bracketed on noise. The defects hold on periodic orbits: off the curve (a point displaced for a
+// difference quotient) the orbit does not close and Phi_T f differs from f by that too.
+//
 // Tolerances (FloquetOptions) and why:
 //   unit_tolerance   = 1e-6:  a nontrivial multiplier within this of +1 counts as a further unit multiplier
 //                             (normal := none does). Simple multipliers are accurate to ~1e-9 at rtol 1e-10;
@@ -95,6 +113,13 @@
 
 namespace hybridcont {
 
+// FloquetResult::multiplier_error over the monodromy's measured defect (see "Accuracy of the multipliers").
+inline constexpr double kMultiplierErrorSafety = 2;
+// Beyond this error of its multipliers an orbit is not resolved by the integration at its tolerances: the
+// monodromy keeps fewer than three digits, and the orbit's replay and class (a crossing found early or late
+// by the amplified error) are no better. The shipped examples' orbits stay below 1e-5.
+inline constexpr double kUnresolvedMultiplierError = 1e-3;
+
 struct FloquetOptions {
   double unit_tolerance = 1e-6;      // |mu - 1| for a further unit multiplier (see the header comment)
   double circle_tolerance = 1e-6;    // |mu| <= 1 + this for linear stability
@@ -137,9 +162,13 @@ struct StabilityClass {
   int saddle = 0;                 // real multipliers > 1 + tolerance (not counting the trivial ones)
   int flip = 0;                   // real multipliers < −1 − tolerance
   int oscillatory = 0;            // complex pairs outside the unit circle
+  // The multipliers are not known well enough to tell (see "Accuracy of the multipliers"): none lies clearly
+  // outside the unit circle and one lies within its error of it. Every other field is then false or 0.
+  bool undetermined = false;
+  double uncertainty = 0;         // that error, where undetermined
   bool unstable() const { return saddle + flip + oscillatory > 0; }
   // "asymptotically stable", "neutrally stable", "unstable (saddle)", "unstable (flip and 2 oscillatory)",
-  // ...: no comma, the text is a cell of the branch files' CSV.
+  // "undetermined (multipliers uncertain to 3e-02)" ...: no comma, the text is a cell of the branch files' CSV.
   std::string ToString() const;
 };
 
@@ -183,6 +212,9 @@ struct FloquetResult {
   // error on a periodic orbit; large values mean u is not a periodic orbit at xi = 0.
   double flow_residual = 0;
   double first_integral_residual = 0;
+  // The estimated absolute error of the nontrivial multipliers (see "Accuracy of the multipliers"); 0 where
+  // there are none.
+  double multiplier_error = 0;
 
   bool ok() const { return status == FloquetStatus::kSuccess; }
   std::string BriefReport() const;

@@ -110,6 +110,17 @@ class FloquetTestFunctions : public TestFunctions {
   void EvaluateAtImage(const Vector& u, const double* preimage_residual, Vector* values);
   // Branch points whose values came from another map's evaluation (EvaluateAtBranchPoint).
   long reused_evaluations() const { return reused_evaluations_; }
+  // At a trial point: the multipliers' functions from the map with its Jacobian (everything, as Evaluate);
+  // a crossing speed from the map's value alone (no sensitivities: ~1/(n+1) of the work); an own event's
+  // extremum from its own integration; a duration from u. Where the map cannot be evaluated at u, Evaluate
+  // gives NaN throughout while a duration or an own event may still have a value here.
+  double EvaluateOne(int function, const Vector& u) override;
+  // An own event's zero, and a conservative model's grazing zero, is kept only where a physical family ends
+  // (Keep): it is located only where one of the two points around it is physical or of the class of such an
+  // end (grazing; missed-event for an own event). On the many steps of a diagram whose orbits are no motion of the system a
+  // crossing speed flips sign by a jump (the event crossed the other way), which the root finder bisects.
+  // Branch points' classes are taken from their evaluation; other points are classified.
+  bool MayKeepZeroBetween(int function, const Vector& a, const Vector& b) override;
   // A zero of the Neimark–Sacker function is kept where a complex pair lies on the unit circle (within
   // kUnitPairTolerance); a zero from two real multipliers of product 1 (a neutral saddle) is dropped.
   bool Keep(int function, const Vector& u, std::string* note) override;
@@ -194,6 +205,8 @@ class FloquetTestFunctions : public TestFunctions {
   std::vector<char> own_defined_;  // per phase: whether the last branch point had a value
   std::optional<BranchPointAnalysis> last_branch_point_;
   bool last_branch_physical_ = false;  // the class of the last branch point evaluated (EvaluateDurations)
+  // The classes of the last few branch points evaluated, by their u (MayKeepZeroBetween).
+  std::vector<std::pair<Vector, Classification>> recent_classes_;
   long reused_evaluations_ = 0;
 };
 

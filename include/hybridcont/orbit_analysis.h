@@ -50,6 +50,14 @@ struct OrbitAnalysis {
   bool floquet = false;                        // the multipliers below were computed
   std::string stability;                       // StabilityClass::ToString ("asymptotically stable", ...)
   bool stable = false;                         // asymptotically or neutrally stable
+  // The multipliers cannot tell stable from unstable (StabilityClass::undetermined): stable is false then,
+  // and not a verdict.
+  bool stability_undetermined = false;
+  double multiplier_error = kUndefined;        // FloquetResult::multiplier_error
+  // Whether the integration resolves the orbit (floquet.h, kUnresolvedMultiplierError). Where a family's
+  // orbits pass ever nearer an equilibrium (its period grows without bound) its ranges end at the last
+  // resolved orbit (family_ranges.h).
+  bool resolved() const { return !(floquet && multiplier_error > kUnresolvedMultiplierError); }
   bool normal = false;                         // FloquetResult::normal
   int num_unit = 0;                            // multipliers on the unit circle
   double max_multiplier = kUndefined;          // largest modulus of the nontrivial multipliers

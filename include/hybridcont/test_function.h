@@ -51,6 +51,16 @@ class TestFunctions {
   // branch_point: u is an accepted branch point (a provider checks there what must hold along a whole step,
   // e.g. that the orbit is physical); otherwise u is a trial point of the root finder between two of them.
   virtual void Evaluate(const Vector& u, bool branch_point, Vector* values) = 0;
+  // g_j(u) of function `function` alone at a trial point (Evaluate's branch_point false), for the root finder
+  // that locates one of its zeros: a provider whose functions need different work (a multiplier needs the
+  // map's Jacobian, an event's crossing speed its value alone, a phase's duration nothing but u) computes
+  // only what that one needs. Equal to Evaluate(u, false, values)(function) up to the provider's own
+  // precision (an integration without the sensitivities takes other steps). The default is exactly that.
+  virtual double EvaluateOne(int function, const Vector& u) {
+    Vector values;
+    Evaluate(u, false, &values);
+    return values(function);
+  }
   // The continued problem as the corrector left it at an accepted branch point u: `problem` (the stepper's
   // own copy) last evaluated r and dr at `at`, the corrector's last iterate, at most
   // CorrectorOptions::max_jacobian_distance·(1 + ||u||) from u (corrector.h, evaluated_point()). A provider
@@ -73,6 +83,14 @@ class TestFunctions {
   // message. The default keeps every zero.
   virtual bool Keep(int function, const Vector& u, std::string* note) {
     (void)function, (void)u, (void)note;
+    return true;
+  }
+  // Asked before a zero of function `function` is located between the curve points a and b (a sign change
+  // or a dip of |g| there): false when Keep would drop every zero between them (a zero that marks nothing
+  // where neither end is of a class next to which the special point can lie), so that the location's work
+  // is not spent. The default is true.
+  virtual bool MayKeepZeroBetween(int function, const Vector& a, const Vector& b) {
+    (void)function, (void)a, (void)b;
     return true;
   }
   // At a branch point u of a branch mapped by a symmetry of the continued problem (exploration.h), the image

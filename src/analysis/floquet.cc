@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -110,6 +111,11 @@ bool FloquetResult::HasUnitComplexPair(double tolerance) const {
 }
 
 std::string StabilityClass::ToString() const {
+  if (undetermined) {
+    char text[64];
+    std::snprintf(text, sizeof text, "undetermined (multipliers uncertain to %.0e)", uncertainty);
+    return text;
+  }
   if (asymptotically_stable) return on_level ? "asymptotically stable on its energy level" : "asymptotically stable";
   if (!unstable()) return neutrally_stable ? "neutrally stable" : "stable";
   std::string kinds;
@@ -233,6 +239,11 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
     return ma != mb ? ma > mb : a.imag() > b.imag();
   });
 
+  // The multipliers' error (header, "Accuracy of the multipliers").
+  if (!res.nontrivial.empty()) {
+    res.multiplier_error = kMultiplierErrorSafety * std::max(res.flow_residual, res.first_integral_residual);
+  }
+
   std::complex<double> bp = 1.0, pd = conservative ? 4.0 : 2.0;
   res.num_unit = res.num_trivial;
   res.max_modulus = 1.0;
@@ -275,6 +286,24 @@ FloquetResult AnalyzeMonodromy(const Matrix& monodromy, const Vector& f0, const 
   KreinTest(options.pair_tolerance, &res);
   res.bp_test = bp.real();  // conjugate pairs make the products real up to round-off
   res.pd_test = pd.real();
+
+  // Where the multipliers' error exceeds the tolerances, a verdict they cannot support is withheld (header,
+  // "Accuracy of the multipliers").
+  bool clearly_outside = false, near_circle = false;
+  for (std::size_t i = 0; i < res.nontrivial.size(); ++i) {
+    if (colliding[i]) continue;
+    const std::complex<double>& mu = res.nontrivial[i];
+    const double e = res.multiplier_error;
+    if (std::abs(mu) - 1.0 > std::max(e, options.circle_tolerance)) clearly_outside = true;
+    if (e > options.circle_tolerance && !(std::abs(std::abs(mu) - 1.0) > e)) near_circle = true;
+  }
+  if (near_circle && !clearly_outside) {
+    res.stable = res.asymptotically_stable = false;
+    res.stability = StabilityClass{};
+    res.stability.on_level = conservative;
+    res.stability.undetermined = true;
+    res.stability.uncertainty = res.multiplier_error;
+  }
   res.normal = res.num_unit == res.num_trivial;
   return res;
 }

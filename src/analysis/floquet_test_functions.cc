@@ -216,6 +216,30 @@ void FloquetTestFunctions::Evaluate(const Vector& u, bool branch_point, Vector* 
   EvaluateOn(&shooting_, u, u, branch_point, values);
 }
 
+double FloquetTestFunctions::EvaluateOne(int function, const Vector& u) {
+  const int m = model_->num_phases();
+  const int n = static_cast<int>(types().size());
+  if (function < 0 || function >= n) throw std::out_of_range("FloquetTestFunctions::EvaluateOne: no such function");
+  Vector values = Vector::Constant(n, std::numeric_limits<double>::quiet_NaN());
+  if (function >= first_zero_duration()) {
+    EvaluateDurations(u, false, Classification{}, &values);
+  } else if (function >= first_own_event()) {
+    EvaluateOwnEvents(u, nullptr, &values);
+  } else if (function >= 2 && function < 2 + m) {  // phase i's crossing speed, as EvaluateOn has it
+    if (!shooting_.Evaluate(u, &r_, nullptr).ok) return std::numeric_limits<double>::quiet_NaN();
+    const int i = function - 2;
+    const Vector& x = shooting_.segment_flow(i).x;
+    RowVector de;
+    Vector f;
+    shooting_.model().phase(i).Event(x, &de);
+    shooting_.model().phase(i).VectorField(x, &f, nullptr);
+    return de.dot(f) / std::max(de.norm() * f.norm(), 1e-300);
+  } else {
+    EvaluateOn(&shooting_, u, u, false, &values);
+  }
+  return values(function);
+}
+
 void FloquetTestFunctions::EvaluateAtImage(const Vector& u, const double* preimage_residual, Vector* values) {
   EvaluateOn(&shooting_, u, u, true, values, preimage_residual);
 }
@@ -250,7 +274,12 @@ void FloquetTestFunctions::EvaluateOn(TimeBasedShooting* map, const Vector& at, 
   const HybridModel* model_at_u = branch_point ? ModelAt(u) : model_;
   Classification c;
   std::unique_ptr<OrbitTrace> trace;
-  if (branch_point && model_at_u != nullptr) c = Classify(*model_at_u, u.head(base_unknowns_), &trace);
+  if (branch_point && model_at_u != nullptr) {
+    c = Classify(*model_at_u, u.head(base_unknowns_), &trace);
+    constexpr std::size_t kRecent = 4;  // a step's two ends, and those of the step before
+    if (recent_classes_.size() == kRecent) recent_classes_.erase(recent_classes_.begin());
+    recent_classes_.emplace_back(u, c);
+  }
   // The crossing speeds of every orbit of a model without first integral; of a conservative model, at
   // branch points that are physical or fail only by an event's direction (wrong-direction, grazing): where
   // a physical family ends at grazing its next point is of that class, and the zeros elsewhere, on orbits
@@ -310,6 +339,9 @@ void FloquetTestFunctions::EvaluateOn(TimeBasedShooting* map, const Vector& at, 
     last_branch_point_->floquet_known = true;
   }
   if (!floquet.ok()) return;
+  // A branch point the integration does not resolve (floquet.h, "Accuracy of the multipliers"): its
+  // multipliers' functions are noise there, and no zero is bracketed next to it.
+  if (branch_point && floquet.multiplier_error > kUnresolvedMultiplierError) return;
   (*values)(0) = floquet.bp_test;
   if (evaluated) (*values)(1) = PeriodDoublingTest(dr_, map->layout());  // dr_ from the evaluation above
   // On a symplectic map ns_test is 0 up to the multipliers' errors everywhere: no sign there (NaN) at
@@ -317,6 +349,24 @@ void FloquetTestFunctions::EvaluateOn(TimeBasedShooting* map, const Vector& at, 
   // branch points around it and keeps its values in between.
   (*values)(ns) = branch_point && std::abs(floquet.ns_test) < kNeimarkSackerUndefined ? std::nan("") : floquet.ns_test;
   if (krein) (*values)(ns + 1) = floquet.krein_test;  // NaN where the map is not symplectic
+}
+
+bool FloquetTestFunctions::MayKeepZeroBetween(int function, const Vector& a, const Vector& b) {
+  // As Keep decides: an own event's zero where a physical family ends by it (any model), a crossing speed's
+  // where a conservative model's physical family ends by grazing.
+  if (types()[function] != SpecialPointType::kGrazing) return true;
+  const bool own_event = function >= first_own_event() && function < first_zero_duration();
+  if (!own_event && model_->num_first_integrals() == 0) return true;
+  const auto may_end = [&](const Vector& u) {
+    const auto known = std::find_if(recent_classes_.begin(), recent_classes_.end(),
+                                    [&](const auto& entry) { return entry.first.size() == u.size() && entry.first == u; });
+    if (known == recent_classes_.end()) {
+      return own_event ? MissedEventEndsPhysicalFamily(u) : GrazingEndsPhysicalFamily(u);
+    }
+    const Classification& c = known->second;
+    return c.physical || c.reason == OrbitClass::kGrazing || (own_event && c.reason == OrbitClass::kMissedEvent);
+  };
+  return may_end(a) || may_end(b);
 }
 
 bool FloquetTestFunctions::Keep(int function, const Vector& u, std::string* note) {

@@ -46,6 +46,8 @@ void AnalyzePhysical(const HybridModel& model, TimeBasedShooting& floquet_map, c
   a->floquet = true;
   a->stability = floquet.stability.ToString();
   a->stable = floquet.stable;
+  a->stability_undetermined = floquet.stability.undetermined;
+  a->multiplier_error = floquet.multiplier_error;
   a->normal = floquet.normal;
   a->num_unit = floquet.num_unit;
   a->max_multiplier = floquet.max_modulus;

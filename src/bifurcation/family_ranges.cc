@@ -73,9 +73,17 @@ RangeEnd Between(const Branch& b, int after, int coordinate, const SpecialPointT
   return end;
 }
 
+// The last point before orbits the integration does not resolve (RangesOnBranch): a run ends there, exactly.
+RangeEnd BeforeUnresolved(const Branch& b, int i, int coordinate) {
+  RangeEnd end = AtPoint(b, i, coordinate, false);
+  end.how = fmt::format("point {}, the last orbit the integration resolves", i);
+  return end;
+}
+
 template <std::size_t N>
 std::vector<Range> Runs(const Branch& b, const std::vector<bool>& in, int coordinate, const SpecialPointType (&types)[N],
-                        const std::vector<bool>& boundary) {
+                        const std::vector<bool>& boundary, const std::vector<bool>& unresolved) {
+  const auto is_unresolved = [&](int k) { return !unresolved.empty() && unresolved[k]; };
   std::vector<Range> runs;
   const int n = static_cast<int>(std::min(in.size(), b.points.size()));
   for (int i = 0; i < n;) {
@@ -87,9 +95,12 @@ std::vector<Range> Runs(const Branch& b, const std::vector<bool>& in, int coordi
     while (j + 1 < n && in[j + 1]) ++j;
     Range r;
     r.first_point = i, r.last_point = j;
-    r.from = i == 0 ? AtPoint(b, 0, coordinate, true) : Between(b, i - 1, coordinate, types, boundary, i - 1);
+    r.from = i == 0                 ? AtPoint(b, 0, coordinate, true)
+             : is_unresolved(i - 1) ? BeforeUnresolved(b, i, coordinate)
+                                    : Between(b, i - 1, coordinate, types, boundary, i - 1);
     r.to = j + 1 == static_cast<int>(b.points.size()) ? AtPoint(b, j, coordinate, false)
-                                                       : Between(b, j, coordinate, types, boundary, j + 1);
+           : is_unresolved(j + 1)                     ? BeforeUnresolved(b, j, coordinate)
+                                                      : Between(b, j, coordinate, types, boundary, j + 1);
     // A branch that leaves a special point (a change of the phase sequence, a bifurcation) and is physical
     // there only, its next point not, without a special point between them: the family is physical at that
     // point alone (a stance-only oscillation that meets hopping where the flight shrinks to zero).
@@ -119,16 +130,21 @@ std::vector<Range> Runs(const Branch& b, const std::vector<bool>& in, int coordi
 }  // namespace
 
 BranchRanges RangesOnBranch(const Branch& b, const std::vector<bool>& physical, const std::vector<bool>& stable,
-                            const std::vector<bool>& boundary, int coordinate) {
+                            const std::vector<bool>& boundary, int coordinate, const std::vector<bool>& unresolved) {
   HYBRIDCONT_DEMAND(physical.size() == stable.size() && physical.size() == boundary.size());
+  HYBRIDCONT_DEMAND(unresolved.empty() || unresolved.size() == physical.size());
   BranchRanges out;
   out.branch = b.id;
   if (b.points.empty()) return out;
   HYBRIDCONT_DEMAND(coordinate >= 0 && coordinate < b.points.front().u.size());
   std::vector<bool> both(stable.size());
-  for (std::size_t i = 0; i < stable.size(); ++i) both[i] = physical[i] && stable[i];
-  out.physical = Runs(b, physical, coordinate, kPhysicalEnds, boundary);
-  out.stable = Runs(b, both, coordinate, kStabilityEnds, boundary);
+  std::vector<bool> resolved(physical.size());
+  for (std::size_t i = 0; i < stable.size(); ++i) {
+    resolved[i] = physical[i] && (unresolved.empty() || !unresolved[i]);
+    both[i] = resolved[i] && stable[i];
+  }
+  out.physical = Runs(b, resolved, coordinate, kPhysicalEnds, boundary, unresolved);
+  out.stable = Runs(b, both, coordinate, kStabilityEnds, boundary, unresolved);
   if (!out.stable.empty() && b.parent_special_point >= 0 && out.stable.front().last_point == 0) {
     out.stable.erase(out.stable.begin());  // the bifurcation point the branch leaves, neutral there
   }

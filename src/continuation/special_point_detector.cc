@@ -261,10 +261,7 @@ void SpecialPointDetector::PlaceTurningPointsAtSbPoints(double step, const std::
 
 // ---- Test functions (test_function.h)
 
-double SpecialPointDetector::TestValue(int j, const Vector& u) {
-  functions_->Evaluate(u, false, &values_);
-  return values_(j);
-}
+double SpecialPointDetector::TestValue(int j, const Vector& u) { return functions_->EvaluateOne(j, u); }
 
 // A point of the curve inside the interval l–r: the cubic Hermite interpolant of the two samples at σ
 // (τ_lᵀ(u − u_l) = σ), corrected on that hyperplane (Segment::Evaluate).
@@ -331,9 +328,7 @@ SpecialPoint SpecialPointDetector::LocateTestZero(int j, const CurveSample& l, c
   }
   const Test test = [this, j](const Segment::Probe& p) { return TestValue(j, p.u); };
   const Test refined = [this, j, &test](const Segment::Probe& p) {
-    if (!refined_functions_) return test(p);
-    refined_functions_->Evaluate(p.u, false, &values_);
-    return values_(j);
+    return refined_functions_ ? refined_functions_->EvaluateOne(j, p.u) : test(p);
   };
   std::vector<SpecialPoint> unused;
   SpecialPoint point = LocateOn(TestCurve(), l.point, r.point, function_types_[j], j, test, &refined, l.step, branch, &unused);
@@ -583,9 +578,12 @@ void SpecialPointDetector::DetectTestFunctions(size_t index, bool from_singular,
     // The first interval from a bifurcation point: a test that vanishes there marks the parent's point.
     const bool skip_first = from_singular && samples.size() > first + 1 && defined(first + 1) &&
                             !(std::abs(g(first)) > kStartNoise * std::abs(g(first + 1)));
+    const auto may_keep = [&](size_t lo, size_t hi) {
+      return functions_->MayKeepZeroBetween(j, samples[lo].point.u, samples[hi].point.u);
+    };
     for (size_t k = first; k + 1 < samples.size(); ++k) {
       if (k == first && skip_first) continue;
-      if (defined(k) && defined(k + 1) && std::signbit(g(k)) != std::signbit(g(k + 1))) {
+      if (defined(k) && defined(k + 1) && std::signbit(g(k)) != std::signbit(g(k + 1)) && may_keep(k, k + 1)) {
         found.push_back(LocateTestZero(j, samples[k], samples[k + 1], branch));
       }
     }
@@ -598,6 +596,7 @@ void SpecialPointDetector::DetectTestFunctions(size_t index, bool from_singular,
       // model's multipliers) has such "minima" at a third of its samples.
       const double rim = std::min(std::abs(g(k - 1)), std::abs(g(k + 1)));
       if (rim - std::abs(g(k)) <= kNoiseDip * std::abs(g(k))) continue;
+      if (!may_keep(k - 1, k + 1)) continue;
       CurveMinimum minimum = MinimizeOnCurve(j, std::signbit(g(k)) ? -1.0 : 1.0, samples[k - 1], samples[k], samples[k + 1]);
       const CurveSample& lo = minimum.left ? samples[k - 1] : samples[k];
       const CurveSample& hi = minimum.left ? samples[k] : samples[k + 1];

@@ -165,7 +165,6 @@ class SpecialPointDetector {
   std::unique_ptr<Corrector> test_corrector_;
   BorderedSolver test_solver_;
   std::vector<SpecialPointType> function_types_;
-  Vector values_;  // scratch
 };
 
 // SpecialPointDetector::RedetectTestFunctions with a corrector and solver of its own on `problem`, for a

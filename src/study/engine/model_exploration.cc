@@ -193,6 +193,21 @@ class EngineFloquetTests : public TestFunctions {
     values->conservativeResize(values->size() + more.size());
     values->tail(more.size()) = more;
   }
+  // One function at a trial point: the Floquet provider's own (the time-based formulation: the state-based
+  // one's point is expanded by an integration, and its functions come all at once).
+  double EvaluateOne(int function, const Vector& v) override {
+    const int floquet = static_cast<int>(floquet_->types().size());
+    Vector u;
+    if (state_ || function >= floquet || !TimeBased(v, &u)) return TestFunctions::EvaluateOne(function, v);
+    return floquet_->EvaluateOne(function, u);
+  }
+  bool MayKeepZeroBetween(int function, const Vector& a, const Vector& b) override {
+    const int floquet = static_cast<int>(floquet_->types().size());
+    Vector ua, ub;
+    if (!TimeBased(a, &ua) || !TimeBased(b, &ub)) return true;
+    return function < floquet ? floquet_->MayKeepZeroBetween(function, ua, ub)
+                              : observables_->MayKeepZeroBetween(function - floquet, ua, ub);
+  }
   bool Keep(int function, const Vector& v, std::string* note) override {
     Vector u;
     if (!TimeBased(v, &u)) return true;

@@ -30,9 +30,12 @@ std::vector<std::pair<std::string, double>> ExtraColumns(const HybridModel& mode
   const double nan = std::nan("");
   const auto flag = [&](bool value) { return a.floquet ? (value ? 1.0 : 0.0) : nan; };
   std::vector<std::pair<std::string, double>> extra = {
-      {"replay_error", a.replay_error}, {"stable", flag(a.stable)},  {"normal", flag(a.normal)},
+      {"replay_error", a.replay_error},
+      {"stable", flag(a.stable)},
+      {"normal", flag(a.normal)},
       {"num_unit", a.floquet ? a.num_unit : nan}, {"max_multiplier", a.max_multiplier},
-      {"bp_test", a.bp_test},           {"pd_test", a.pd_test}};
+      {"bp_test", a.bp_test},           {"pd_test", a.pd_test},
+      {"multiplier_error", a.floquet ? a.multiplier_error : nan}};
   // A column pair per nontrivial multiplier (floquet.h: the flow direction, and with a first integral its
   // level, are the trivial ones), whether or not this point has multipliers: every row has the same header.
   const int trivial = model.num_first_integrals() > 0 ? 2 : 1;

@@ -137,6 +137,8 @@ std::vector<StudyPoint> ReadBranchFile(const fs::path& file, const std::vector<s
     const double unit = optional("num_unit");
     a.num_unit = std::isfinite(unit) && unit >= 0 && unit < 1e6 ? static_cast<int>(unit) : 0;
     a.max_multiplier = optional("max_multiplier");
+    a.multiplier_error = optional("multiplier_error");  // since 0.11.0
+    a.stability_undetermined = a.stability.rfind("undetermined", 0) == 0;
     a.bp_test = optional("bp_test");
     a.pd_test = optional("pd_test");
     for (int j = 1; optional_column("mu" + std::to_string(j) + "_re") >= 0; ++j) {

@@ -84,6 +84,7 @@ std::vector<StudyColumn> StudyPointColumns(const StudyResult& study) {
       rows.Number("max_multiplier", a.max_multiplier);
       rows.Number("bp_test", a.bp_test);
       rows.Number("pd_test", a.pd_test);
+      rows.Number("multiplier_error", a.floquet ? a.multiplier_error : kNaN);
       for (std::size_t j = 0; j < multipliers; ++j) {
         const bool known = j < a.multipliers.size();
         rows.Number("mu" + std::to_string(j + 1) + "_re", known ? a.multipliers[j].real() : kNaN);
