@@ -19,7 +19,8 @@ def first_crossing(rhs, x0, watched, horizon=20.0, chunk=0.5, grid=400):
     while t0 < horizon:
         sol = solve_ivp(rhs, [t0, t0 + chunk], x, method="DOP853", rtol=1e-12, atol=1e-12, dense_output=True)
         ts = np.linspace(t0, t0 + chunk, grid)
-        values = [[g(sol.sol(t)) for _, g, _, _ in watched] for t in ts]
+        states = sol.sol(ts)  # the dense output at every grid time at once (one call, not `grid`)
+        values = [[g(states[:, k]) for _, g, _, _ in watched] for k in range(grid)]
         for k in range(1, grid):
             hits = []
             for j in range(len(watched)):

@@ -130,6 +130,11 @@ def test_every_classification_is_the_simulation_s(tmp_path, k, beta, walk, run):
     physical, refused = check_every_classification(biped, out, summary)
     print(f"k = {k}, beta = {beta}: {physical} physical orbits confirmed, {refused} non-physical ones refused")
     assert physical >= 10 and refused >= 5
+    # A branch abandoned for want of physical orbits has none, and says so.
+    for b in summary["branches"]:
+        if b["termination"] == "abandoned":
+            assert b["message"] == "no physical orbit over an arclength of 150 of the scenario's largest steps", b
+            assert "physical_ranges" not in b and b["points"] >= 150, b
     if (k, beta) == (22.0, 0.33):
         # A stable stretch of walking next to the lift-off guards' boundary: from a located Neimark-Sacker
         # point to the located boundary (H = 1.00712 to 1.01159), both named in the ranges. On these symmetric

@@ -375,6 +375,24 @@ TEST(ContinuationTest, SumBoundAndUserPredicate) {
   EXPECT_LE(branch.points[branch.points.size() - 2].u(1), 1.5);
 }
 
+// The caller's abandon hook sees the branch so far after every accepted point: its reason ends the branch there,
+// as the message of kAbandoned, with the points kept.
+TEST(ContinuationTest, AnAbandonedBranchEndsWhereItsCallerSaysWhy) {
+  Pitchfork pitchfork;
+  ContinuationOptions options;
+  int calls = 0;
+  options.abandon = [&calls](const Branch& b) -> std::string {
+    ++calls;
+    return b.points.size() == 7 ? "seven points are enough" : "";
+  };
+  const Branch branch = TraceBranch(&pitchfork, Eigen::Vector2d(1, 1), options);
+  EXPECT_EQ(branch.termination, TerminationReason::kAbandoned);
+  EXPECT_EQ(branch.message, "seven points are enough");
+  EXPECT_EQ(branch.points.size(), 7u);
+  EXPECT_EQ(calls, 6);  // once per accepted point after the start
+  EXPECT_EQ(ToString(TerminationReason::kAbandoned), "abandoned");
+}
+
 TEST(ContinuationTest, MaxPointsAndStepTooSmallKeepTheBranch) {
   Pitchfork pitchfork;
   ContinuationOptions options;

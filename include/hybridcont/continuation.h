@@ -44,6 +44,8 @@
 
 namespace hybridcont {
 
+struct Branch;
+
 enum class TerminationReason {
   kNotFinished,     // the stepper can still take steps
   kMaxPoints,       // max_points reached
@@ -54,6 +56,7 @@ enum class TerminationReason {
   kClosedLoop,      // the branch returned to its start point (last point == first point)
   kKnownBranch,     // exploration: the branch runs along a branch already traced
   kStartFailed,     // the start point could not be corrected or is singular (see message)
+  kAbandoned,       // ContinuationOptions::abandon gave a reason for the branch so far (the message)
 };
 std::string ToString(TerminationReason reason);
 
@@ -191,6 +194,10 @@ struct ContinuationOptions {
   // Called with each accepted point; returning true ends the branch there (kUserStop). E.g. a maximum
   // period computed from u by the caller.
   std::function<bool(const Vector& u)> stop_predicate;
+  // Called with the branch so far after each accepted point, on the tracing thread (so thread-safe): a
+  // non-empty reason ends the branch there (kAbandoned, with that reason as its message). E.g. an
+  // exploration that gives up a branch whose orbits, so far, are no motion of the system.
+  std::function<std::string(const Branch& branch)> abandon;
   // Asked before every step, on the tracing thread (so thread-safe): true ends the branch at its last
   // point (kUserStop, "cancelled"), and an exploration launches no further branch (kCancelled). E.g. a
   // results writer whose disk is full, or a user's interrupt.

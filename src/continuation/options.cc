@@ -17,6 +17,7 @@ constexpr internal::EnumName<TerminationReason> kTerminationReasonNames[] = {
     {TerminationReason::kTargetReached, "target-reached"},
     {TerminationReason::kBoundReached, "bound-reached"},
     {TerminationReason::kUserStop, "user-stop"},
+    {TerminationReason::kAbandoned, "abandoned"},
     {TerminationReason::kStepTooSmall, "step-too-small"},
     {TerminationReason::kClosedLoop, "closed-loop"},
     {TerminationReason::kKnownBranch, "known-branch"},

@@ -148,9 +148,13 @@ class ContinuationStepper::Impl {
       }
       controller_.set_h(next_h);
       if (reason == TerminationReason::kNotFinished) {
+        std::string why;
         if (options_.stop_predicate && options_.stop_predicate(branch_.points.back().u)) {
           reason = TerminationReason::kUserStop;
           message = "stop_predicate returned true";
+        } else if (options_.abandon && !(why = options_.abandon(branch_)).empty()) {
+          reason = TerminationReason::kAbandoned;
+          message = std::move(why);
         } else if (static_cast<int>(count) >= options_.max_points) {
           reason = TerminationReason::kMaxPoints;
           message = "max_points = " + std::to_string(options_.max_points) + " reached";

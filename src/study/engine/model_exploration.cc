@@ -384,6 +384,7 @@ Vector ModelExploration::FindPhysicalStart(std::string* why) {
     return found.size() > 0;
   };
   ModelExploration time_based(model_, scenario_, integrator_, options, Formulation::kTimeBased);
+  time_based.abandon_without_physical_ = false;
   time_based.Run();
   if (found.size() == 0) *why = "no physical orbit on the time-based branches from the start point";
   return found;
@@ -394,6 +395,26 @@ ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point
   ContinuationOptions& c = options.continuation;
   if (c.stop_predicate) {  // the engine sees scaled unknowns; the predicate is written for model units
     c.stop_predicate = [this, user = c.stop_predicate](const Vector& v) { return user(scaled_->FromScaled(v)); };
+  }
+  if (abandon_without_physical_ && !state_ && c.test_functions) {
+    // What the test functions learnt of each point (its class) decides; a point they did not publish keeps
+    // the branch (kPointsWithoutPhysicalOrbit).
+    // An arclength of the scenario's: the same for any step size the caller sets (a point count is not).
+    const double length = kPointsWithoutPhysicalOrbit * scenario_.max_step;
+    c.abandon = [this, length](const Branch& b) -> std::string {
+      const std::size_t n = b.points.size();
+      if (n < 2 || !(b.points[n - 1].arclength >= length && b.points[n - 2].arclength < length)) return {};
+      for (const ContinuationPoint& p : b.points) {
+        const auto known = test_work_->Find(scaled_->FromScaled(p.u));
+        if (!known) return {};
+        const OrbitClass reason = known->classification.reason;
+        if (known->classification.physical || reason == OrbitClass::kZeroDuration || reason == OrbitClass::kGrazing) {
+          return {};
+        }
+      }
+      return "no physical orbit over an arclength of " + std::to_string(kPointsWithoutPhysicalOrbit) +
+             " of the scenario's largest steps";
+    };
   }
   if (on_point) {
     c.progress_components.clear();  // ProgressInfo::values = all of u

@@ -40,6 +40,16 @@ struct TestFunctionWork {
 // point_offset (a period-doubled family's, another word's).
 void RenumberDiagram(int branch_offset, int point_offset, BifurcationDiagram* d);
 
+// A branch of an exploration (time-based formulation, with the Floquet test functions) that holds no physical
+// orbit, nor one on the physical orbits' boundary (zero-duration, grazing), over an arclength of this many of
+// the scenario's largest steps (Scenario::max_step: whatever step sizes a caller sets, the same length) is
+// abandoned there ("abandoned: no physical orbit over an arclength of 150 ..."): the exploration's families are its
+// physical ones, and on every shipped example and the bipedal model at six (k, alpha0) a branch that holds a
+// physical orbit has one by its 18th point, and no physical family leaves a special point of a branch before
+// that branch's first physical point (bench/README.md, "Branches without physical orbits"). The branches it
+// ends are the wandering reversed-time ones that ran to max_points (600) before.
+inline constexpr int kPointsWithoutPhysicalOrbit = 150;
+
 // Bounds, step sizes, depth and branch limits of the scenario.
 ExplorationOptions ScenarioExplorationOptions(const Scenario& scenario);
 
@@ -180,6 +190,9 @@ class ModelExploration {
   std::function<bool(const Vector& u, const Vector& v)> ray_filter_;  // model units
   ExplorationOptions time_options_;  // the time-based scenario's (model units), to find a state start
   std::shared_ptr<TestWorkSink> test_work_;
+  // Branches with no physical orbit among their first kPointsWithoutPhysicalOrbit points are abandoned there
+  // (EngineOptions); off for the search of a physical start (FindPhysicalStart), which walks such branches.
+  bool abandon_without_physical_ = true;
   bool start_prepared_ = false;
   Vector prepared_start_;        // the time-based start (model units), a guess corrected
   std::string start_failure_;    // why the prepared start failed (empty: it did not)
