@@ -340,6 +340,7 @@ py::dict Floquet(const ModelHandle& model, const std::vector<double>& u, const M
   out["stability"] = f.stability.ToString();
   out["bp_test"] = f.bp_test;
   out["pd_test"] = f.pd_test;
+  out["multiplier_error"] = f.multiplier_error;
   return out;
 }
 

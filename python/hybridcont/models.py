@@ -118,7 +118,9 @@ class Model:
 
     def floquet(self, u, free=None, fix=None, rtol=None, atol=None):
         """The orbit's monodromy matrix Φ_T (at the start of its first phase) and Floquet multipliers:
-        {"monodromy", "multipliers", "nontrivial", "stable", "stability", "bp_test", "pd_test", "ok", "message"}."""
+        {"monodromy", "multipliers", "nontrivial", "stable", "stability", "bp_test", "pd_test", "multiplier_error"
+        (the multipliers' estimated error: twice the monodromy's defect on its known eigenvectors), "ok",
+        "message"}."""
         out = dict(self._native.floquet(np.asarray(u, dtype=float).tolist(), self._spec(free, fix), rtol, atol))
         out["multipliers"] = np.array(out["multipliers"], dtype=complex)
         out["nontrivial"] = np.array(out["nontrivial"], dtype=complex)

@@ -362,3 +362,16 @@ def test_ctrl_c_during_a_model_compile_ends_the_command_at_once(tmp_path):
     proc = run()  # compiles again, and removes what the interrupted compile left
     assert proc.wait(timeout=300) == 0
     assert not [p for p in left if p.exists()]
+
+
+def test_multipliers_come_with_their_error(tmp_path):
+    """Every physical point's multipliers carry their estimated error (the branch files' multiplier_error), small
+    on the SLIP's ordinary orbits, and Model.floquet / Study.floquet give it too."""
+    study = hc.run("slip", out=tmp_path / "s", progress=False)
+    physical = study.points[study.points.physical == 1]
+    assert len(physical) > 10
+    assert (physical.multiplier_error >= 0).all() and (physical.multiplier_error < 1e-5).all()
+    row = physical.iloc[len(physical) // 2]
+    f = study.floquet(int(row.branch), int(row["index"]))
+    assert f["ok"] and 0 <= f["multiplier_error"] < 1e-5
+    assert not f["stability"].startswith("undetermined")
