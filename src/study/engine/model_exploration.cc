@@ -401,17 +401,27 @@ ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point
     // the branch (kPointsWithoutPhysicalOrbit).
     // An arclength of the scenario's: the same for any step size the caller sets (a point count is not).
     const double length = kPointsWithoutPhysicalOrbit * scenario_.max_step;
-    c.abandon = [this, length](const Branch& b) -> std::string {
+    const double unfolded_length = kStepsOfUnfoldedOrbits * scenario_.max_step;
+    c.abandon = [this, length, unfolded_length](const Branch& b) -> std::string {
       const std::size_t n = b.points.size();
-      if (n < 2 || !(b.points[n - 1].arclength >= length && b.points[n - 2].arclength < length)) return {};
-      for (const ContinuationPoint& p : b.points) {
-        const auto known = test_work_->Find(scaled_->FromScaled(p.u));
+      const auto crossed = [&](double l) { return n >= 2 && b.points[n - 1].arclength >= l && b.points[n - 2].arclength < l; };
+      const bool at_unfolded = crossed(unfolded_length), at_length = crossed(length);
+      if (!at_unfolded && !at_length) return {};
+      bool unfolded = true;  // every point after the start an orbit of the unfolded system only (xi != 0)
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto known = test_work_->Find(scaled_->FromScaled(b.points[i].u));
         if (!known) return {};
         const OrbitClass reason = known->classification.reason;
         if (known->classification.physical || reason == OrbitClass::kZeroDuration || reason == OrbitClass::kGrazing) {
           return {};
         }
+        if (i > 0 && reason != OrbitClass::kDissipative) unfolded = false;
       }
+      if (at_unfolded && unfolded) {
+        return "its orbits are the unfolded system's (xi != 0), none the model's, over an arclength of " +
+               std::to_string(kStepsOfUnfoldedOrbits) + " of the scenario's largest steps";
+      }
+      if (!at_length) return {};
       return "no physical orbit over an arclength of " + std::to_string(kPointsWithoutPhysicalOrbit) +
              " of the scenario's largest steps";
     };
