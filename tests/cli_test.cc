@@ -213,6 +213,40 @@ TEST(Cli, AnAnswerWithoutPhysicalOrbitsNamesTheirClassAndWhatItMeans) {
   fs::remove_all(dir);
 }
 
+// A model without first integral whose start is simulated, with its event's sign wrong (a rimless wheel whose
+// stance would end where its spoke angle falls through alpha): the start fails, exit 1, and the answer says why
+// and asks about the sign.
+TEST(Cli, AStartThatNeverEndsItsPhaseSaysWhyInTheAnswer) {
+  const fs::path dir = TempDir("wrong_sign_simulated");
+  fs::create_directories(dir);
+  std::ofstream(dir / "wheel.toml") << R"toml(hybridcont = 1
+name = "wheel"
+conservative = false
+[parameters]
+gamma = { value = 0.08, range = "[0, 0.5]" }
+alpha = { value = 0.3, range = "(0, 1.5)" }
+[[phases]]
+name = "stance"
+states = ["theta", "dtheta"]
+ode = { theta = "dtheta", dtheta = "sin(theta + gamma)" }
+event = "theta - alpha"
+anchor = "-theta"
+reset = { theta = "-alpha", dtheta = "cos(2*alpha)*dtheta" }
+[start]
+kind = "simulation"
+values = { x1_theta = 0, x1_dtheta = 0.6 }
+[run]
+parameter = "gamma"
+bounds = { gamma = [0.0, 0.3], period = [0, 200] }
+)toml";
+  const CliResult r = RunTool({"run", (dir / "wheel.toml").string(), "--out", (dir / "out").string(), "--no-plots"});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.out.find("no start point: start 1: event-driven simulation did not settle"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("the event stays above 0, where a phase goes on: is its sign the intended one?"),
+            std::string::npos) << r.out;
+  fs::remove_all(dir);
+}
+
 TEST(Cli, RunBouncingBallWritesClassifiedBranchesThatMatchTheClosedForm) {
   const fs::path dir = TempDir("ball");
   const CliResult r = RunTool({"run", "bouncing-ball", "--out", dir.string(), "--quiet", "--no-plots"});

@@ -260,6 +260,9 @@ struct EventFlowRun {
       std::ostringstream os;
       os << where << ": not crossed within max_duration = " << options.max_duration << " (g = " << g_new
          << " at t = " << t_new << ")";
+      // A phase ends where its event falls through 0 from above: one that stays above never ends it (a model
+      // file's event written with the opposite sign does so).
+      if (g_new > 0) os << "; the event stays above 0, where a phase goes on: is its sign the intended one?";
       return Finish(EventFlowStatus::kGuardNotReached, os.str(), t_new, z_new, g_new, g_dot_new);
     }
     if (dense.current_time_step() < options.integrator.min_step) {

@@ -56,6 +56,21 @@
 namespace hybridcont::study {
 namespace {
 
+// A report of several indented lines as one: lines joined by "; ", their indentation dropped.
+std::string OneLine(const std::string& report) {
+  std::string out;
+  std::size_t begin = 0;
+  while (begin < report.size()) {
+    std::size_t end = report.find('\n', begin);
+    if (end == std::string::npos) end = report.size();
+    std::string line = report.substr(begin, end - begin);
+    line.erase(0, line.find_first_not_of(' '));
+    if (!line.empty()) out += (out.empty() ? "" : "; ") + line;
+    begin = end + 1;
+  }
+  return out;
+}
+
 // The physicality of the accepted points, per branch id and in the order of the points (false where a point
 // could not be converted to the time-based layout).
 struct PointLog {
@@ -328,10 +343,12 @@ ExploredFamilies ExploreFamilies(const HybridModel& model, const RunSetup& setup
     const OrbitStarts starts = FindOrbitStarts(model, setup, layout);
     say("start", starts.report);
     diagram = exploration.RunFromStarts(starts.points, on_point, &skipped);
+    if (starts.points.empty()) diagram.message = "no start point: " + OneLine(starts.report);  // why, in the answer
     out.starts_report = starts.report + fmt::format("  {} of them on branches traced from earlier starts\n", skipped);
   } else {
     const ParameterStarts starts = FindParameterStarts(model, setup, exploration.shooting());
     diagram = exploration.RunFromStarts(starts.points, on_point, &skipped);
+    if (starts.points.empty()) diagram.message = "no start point: " + OneLine(starts.report);
     out.starts_report = starts.report + fmt::format("  {} of them on branches traced from earlier starts\n", skipped);
     say("start", out.starts_report);
     out.parameter_starts = StudyParameterStarts{starts.crossings, static_cast<int>(starts.points.size()), skipped,
