@@ -58,6 +58,9 @@ enum class TerminationReason {
   kStartFailed,     // the start point could not be corrected or is singular (see message)
   kAbandoned,       // ContinuationOptions::abandon gave a reason for the branch so far (the message)
 };
+// The last reason: an interrupted run's store keeps them by number, so new reasons are appended after it and
+// named here.
+inline constexpr TerminationReason kLastTerminationReason = TerminationReason::kAbandoned;
 std::string ToString(TerminationReason reason);
 
 enum class PredictorType {

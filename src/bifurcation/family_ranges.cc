@@ -73,10 +73,11 @@ RangeEnd Between(const Branch& b, int after, int coordinate, const SpecialPointT
   return end;
 }
 
-// The last point before orbits the integration does not resolve (RangesOnBranch): a run ends there, exactly.
-RangeEnd BeforeUnresolved(const Branch& b, int i, int coordinate) {
-  RangeEnd end = AtPoint(b, i, coordinate, false);
-  end.how = fmt::format("point {}, the last orbit the integration resolves", i);
+// The point of a run next to orbits the integration does not resolve (RangesOnBranch): the run ends there,
+// exactly; `first`: the run begins there (the unresolved orbits come before it along the branch).
+RangeEnd NextToUnresolved(const Branch& b, int i, int coordinate, bool first) {
+  RangeEnd end = AtPoint(b, i, coordinate, first);
+  end.how = fmt::format("point {}, the {} orbit the integration resolves", i, first ? "first" : "last");
   return end;
 }
 
@@ -96,10 +97,10 @@ std::vector<Range> Runs(const Branch& b, const std::vector<bool>& in, int coordi
     Range r;
     r.first_point = i, r.last_point = j;
     r.from = i == 0                 ? AtPoint(b, 0, coordinate, true)
-             : is_unresolved(i - 1) ? BeforeUnresolved(b, i, coordinate)
+             : is_unresolved(i - 1) ? NextToUnresolved(b, i, coordinate, true)
                                     : Between(b, i - 1, coordinate, types, boundary, i - 1);
     r.to = j + 1 == static_cast<int>(b.points.size()) ? AtPoint(b, j, coordinate, false)
-           : is_unresolved(j + 1)                     ? BeforeUnresolved(b, j, coordinate)
+           : is_unresolved(j + 1)                     ? NextToUnresolved(b, j, coordinate, false)
                                                       : Between(b, j, coordinate, types, boundary, j + 1);
     // A branch that leaves a special point (a change of the phase sequence, a bifurcation) and is physical
     // there only, its next point not, without a special point between them: the family is physical at that

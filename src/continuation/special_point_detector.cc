@@ -596,7 +596,7 @@ void SpecialPointDetector::DetectTestFunctions(size_t index, bool from_singular,
       // model's multipliers) has such "minima" at a third of its samples.
       const double rim = std::min(std::abs(g(k - 1)), std::abs(g(k + 1)));
       if (rim - std::abs(g(k)) <= kNoiseDip * std::abs(g(k))) continue;
-      if (!may_keep(k - 1, k + 1)) continue;
+      if (!may_keep(k - 1, k) && !may_keep(k, k + 1)) continue;  // the middle sample may be the physical one
       CurveMinimum minimum = MinimizeOnCurve(j, std::signbit(g(k)) ? -1.0 : 1.0, samples[k - 1], samples[k], samples[k + 1]);
       const CurveSample& lo = minimum.left ? samples[k - 1] : samples[k];
       const CurveSample& hi = minimum.left ? samples[k] : samples[k + 1];

@@ -398,9 +398,9 @@ ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point
   }
   if (abandon_without_physical_ && !state_ && c.test_functions) {
     // What the test functions learnt of each point (its class) decides; a point they did not publish keeps
-    // the branch (kPointsWithoutPhysicalOrbit).
+    // the branch (kStepsWithoutPhysicalOrbit).
     // An arclength of the scenario's: the same for any step size the caller sets (a point count is not).
-    const double length = kPointsWithoutPhysicalOrbit * scenario_.max_step;
+    const double length = kStepsWithoutPhysicalOrbit * scenario_.max_step;
     const double unfolded_length = kStepsOfUnfoldedOrbits * scenario_.max_step;
     c.abandon = [this, length, unfolded_length](const Branch& b) -> std::string {
       const std::size_t n = b.points.size();
@@ -422,7 +422,7 @@ ExplorationOptions ModelExploration::EngineOptions(const PointCallback& on_point
                std::to_string(kStepsOfUnfoldedOrbits) + " of the scenario's largest steps";
       }
       if (!at_length) return {};
-      return "no physical orbit over an arclength of " + std::to_string(kPointsWithoutPhysicalOrbit) +
+      return "no physical orbit over an arclength of " + std::to_string(kStepsWithoutPhysicalOrbit) +
              " of the scenario's largest steps";
     };
   }

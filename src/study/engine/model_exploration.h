@@ -48,7 +48,7 @@ void RenumberDiagram(int branch_offset, int point_offset, BifurcationDiagram* d)
 // physical orbit has one by its 18th point, and no physical family leaves a special point of a branch before
 // that branch's first physical point (bench/README.md, "Branches without physical orbits"). The branches it
 // ends are the wandering reversed-time ones that ran to max_points (600) before.
-inline constexpr int kPointsWithoutPhysicalOrbit = 150;
+inline constexpr int kStepsWithoutPhysicalOrbit = 150;
 // Sooner where every orbit of the branch after its start is one of the unfolded system only (xi != 0, class
 // dissipative): no orbit of the model at all, which the unfolding leaves only where a family degenerates (the
 // bipedal model's running word has such a branch, 497 points at steps of ~1e-3 before: 4 of its 5.3 s).
@@ -194,8 +194,9 @@ class ModelExploration {
   std::function<bool(const Vector& u, const Vector& v)> ray_filter_;  // model units
   ExplorationOptions time_options_;  // the time-based scenario's (model units), to find a state start
   std::shared_ptr<TestWorkSink> test_work_;
-  // Branches with no physical orbit among their first kPointsWithoutPhysicalOrbit points are abandoned there
-  // (EngineOptions); off for the search of a physical start (FindPhysicalStart), which walks such branches.
+  // Branches without a physical orbit over an arclength of kStepsWithoutPhysicalOrbit largest steps (or of
+  // kStepsOfUnfoldedOrbits, orbits of the unfolded system only) are abandoned there (EngineOptions); off for the
+  // search of a physical start (FindPhysicalStart), which walks such branches.
   bool abandon_without_physical_ = true;
   bool start_prepared_ = false;
   Vector prepared_start_;        // the time-based start (model units), a guess corrected

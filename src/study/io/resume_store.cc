@@ -185,7 +185,7 @@ Branch BranchFromJson(const nlohmann::json& j, const std::string& where) {
     }
     b.special_points.push_back(std::move(p));
   }
-  b.termination = EnumFrom(j, "termination", where, TerminationReason::kStartFailed);
+  b.termination = EnumFrom(j, "termination", where, kLastTerminationReason);
   b.message = JsonText(j, "message", where);
   b.newton_iterations = JsonInt(j, "newton_iterations", where);
   b.rejected_steps = JsonInt(j, "rejected_steps", where);
