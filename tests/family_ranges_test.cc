@@ -131,5 +131,21 @@ TEST(FamilyRanges, AStretchEndsAtTheLastOrbitTheIntegrationResolves) {
   }
 }
 
+// A physical point whose multipliers cannot tell its stability: the stable stretch before it ends at the last
+// point whose stability is known, saying so; the physical stretch goes on through it.
+TEST(FamilyRanges, AStableStretchEndsWhereTheMultipliersStopTellingItsStability) {
+  const Branch b = EightPoints();
+  const std::vector<bool> physical(8, true), stable = {true, true, true, false, false, false, false, false};
+  const std::vector<bool> boundary(8, false), unresolved;
+  const std::vector<bool> undetermined = {false, false, false, true, false, false, false, false};
+  const BranchRanges r = RangesOnBranch(b, physical, stable, boundary, 0, unresolved, undetermined);
+  ASSERT_EQ(r.physical.size(), 1u);
+  EXPECT_EQ(r.physical[0].last_point, 7);
+  ASSERT_EQ(r.stable.size(), 1u);
+  EXPECT_EQ(r.stable[0].last_point, 2);
+  EXPECT_TRUE(r.stable[0].to.located);
+  EXPECT_EQ(r.stable[0].to.how, "point 2, the last orbit whose multipliers tell its stability");
+}
+
 }  // namespace
 }  // namespace hybridcont

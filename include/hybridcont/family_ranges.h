@@ -57,10 +57,12 @@ struct BranchRanges {
 // integration does not resolve (OrbitAnalysis::resolved: its multipliers and class are not to be trusted,
 // e.g. orbits passing ever nearer an equilibrium as the period grows without bound): it belongs to no
 // stretch, and a stretch next to it ends at its own last point ("point 185, the last orbit the integration
-// resolves").
+// resolves"). undetermined[i] (empty: none) marks a physical point whose multipliers cannot tell its
+// stability (StabilityClass::undetermined): it belongs to no stable stretch, and one next to it ends at its own
+// point ("point 40, the last orbit whose multipliers tell its stability"), not between the two.
 BranchRanges RangesOnBranch(const Branch& b, const std::vector<bool>& physical, const std::vector<bool>& stable,
                             const std::vector<bool>& boundary, int coordinate,
-                            const std::vector<bool>& unresolved = {});
+                            const std::vector<bool>& unresolved = {}, const std::vector<bool>& undetermined = {});
 
 // "1.2467401100 (BP #1, located, precision 1.8e-10)" for a report line.
 std::string ToString(const RangeEnd& end);

@@ -73,18 +73,27 @@ RangeEnd Between(const Branch& b, int after, int coordinate, const SpecialPointT
   return end;
 }
 
-// The point of a run next to orbits the integration does not resolve (RangesOnBranch): the run ends there,
-// exactly; `first`: the run begins there (the unresolved orbits come before it along the branch).
-RangeEnd NextToUnresolved(const Branch& b, int i, int coordinate, bool first) {
+// Orbits a run cannot say anything of (RangesOnBranch): not resolved by the integration, or (for stability)
+// of multipliers that cannot tell; empty vectors: none.
+struct Unknown {
+  const std::vector<bool>& unresolved;
+  const std::vector<bool>& undetermined;
+  bool at(int k) const { return (!unresolved.empty() && unresolved[k]) || (!undetermined.empty() && undetermined[k]); }
+};
+
+// The point i of a run next to such an orbit k: the run ends there, exactly; `first`: it begins there.
+RangeEnd NextToUnknown(const Branch& b, int i, int k, int coordinate, bool first, const Unknown& unknown) {
   RangeEnd end = AtPoint(b, i, coordinate, first);
-  end.how = fmt::format("point {}, the {} orbit the integration resolves", i, first ? "first" : "last");
+  const bool unresolved = !unknown.unresolved.empty() && unknown.unresolved[k];
+  const char* which = first ? "first" : "last";
+  end.how = unresolved ? fmt::format("point {}, the {} orbit the integration resolves", i, which)
+                       : fmt::format("point {}, the {} orbit whose multipliers tell its stability", i, which);
   return end;
 }
 
 template <std::size_t N>
 std::vector<Range> Runs(const Branch& b, const std::vector<bool>& in, int coordinate, const SpecialPointType (&types)[N],
-                        const std::vector<bool>& boundary, const std::vector<bool>& unresolved) {
-  const auto is_unresolved = [&](int k) { return !unresolved.empty() && unresolved[k]; };
+                        const std::vector<bool>& boundary, const Unknown& unknown) {
   std::vector<Range> runs;
   const int n = static_cast<int>(std::min(in.size(), b.points.size()));
   for (int i = 0; i < n;) {
@@ -97,10 +106,10 @@ std::vector<Range> Runs(const Branch& b, const std::vector<bool>& in, int coordi
     Range r;
     r.first_point = i, r.last_point = j;
     r.from = i == 0                 ? AtPoint(b, 0, coordinate, true)
-             : is_unresolved(i - 1) ? NextToUnresolved(b, i, coordinate, true)
+             : unknown.at(i - 1)    ? NextToUnknown(b, i, i - 1, coordinate, true, unknown)
                                     : Between(b, i - 1, coordinate, types, boundary, i - 1);
     r.to = j + 1 == static_cast<int>(b.points.size()) ? AtPoint(b, j, coordinate, false)
-           : is_unresolved(j + 1)                     ? NextToUnresolved(b, j, coordinate, false)
+           : unknown.at(j + 1)                        ? NextToUnknown(b, j, j + 1, coordinate, false, unknown)
                                                       : Between(b, j, coordinate, types, boundary, j + 1);
     // A branch that leaves a special point (a change of the phase sequence, a bifurcation) and is physical
     // there only, its next point not, without a special point between them: the family is physical at that
@@ -131,9 +140,11 @@ std::vector<Range> Runs(const Branch& b, const std::vector<bool>& in, int coordi
 }  // namespace
 
 BranchRanges RangesOnBranch(const Branch& b, const std::vector<bool>& physical, const std::vector<bool>& stable,
-                            const std::vector<bool>& boundary, int coordinate, const std::vector<bool>& unresolved) {
+                            const std::vector<bool>& boundary, int coordinate, const std::vector<bool>& unresolved,
+                            const std::vector<bool>& undetermined) {
   HYBRIDCONT_DEMAND(physical.size() == stable.size() && physical.size() == boundary.size());
   HYBRIDCONT_DEMAND(unresolved.empty() || unresolved.size() == physical.size());
+  HYBRIDCONT_DEMAND(undetermined.empty() || undetermined.size() == physical.size());
   BranchRanges out;
   out.branch = b.id;
   if (b.points.empty()) return out;
@@ -142,10 +153,11 @@ BranchRanges RangesOnBranch(const Branch& b, const std::vector<bool>& physical, 
   std::vector<bool> resolved(physical.size());
   for (std::size_t i = 0; i < stable.size(); ++i) {
     resolved[i] = physical[i] && (unresolved.empty() || !unresolved[i]);
-    both[i] = resolved[i] && stable[i];
+    both[i] = resolved[i] && stable[i] && (undetermined.empty() || !undetermined[i]);
   }
-  out.physical = Runs(b, resolved, coordinate, kPhysicalEnds, boundary, unresolved);
-  out.stable = Runs(b, both, coordinate, kStabilityEnds, boundary, unresolved);
+  const std::vector<bool> none;
+  out.physical = Runs(b, resolved, coordinate, kPhysicalEnds, boundary, Unknown{unresolved, none});
+  out.stable = Runs(b, both, coordinate, kStabilityEnds, boundary, Unknown{unresolved, undetermined});
   if (!out.stable.empty() && b.parent_special_point >= 0 && out.stable.front().last_point == 0) {
     out.stable.erase(out.stable.begin());  // the bifurcation point the branch leaves, neutral there
   }

@@ -17,17 +17,18 @@ namespace hybridcont::study {
 BranchFamily FamilyOfBranch(const Branch& b, const std::vector<StudyPoint>& points, int coordinate,
                             const FamilyNamer& name_of) {
   if (points.size() != b.points.size() || points.empty()) return {};  // not every point analysed
-  std::vector<bool> physical, stable, boundary, unresolved;
+  std::vector<bool> physical, stable, boundary, unresolved, undetermined;
   for (const StudyPoint& p : points) {
     const Classification& c = p.analysis.classification;
     physical.push_back(c.physical);
     stable.push_back(c.physical && p.analysis.floquet && p.analysis.stable);
     boundary.push_back(c.reason == OrbitClass::kZeroDuration || c.reason == OrbitClass::kGrazing);
     unresolved.push_back(!p.analysis.resolved());
+    undetermined.push_back(c.physical && p.analysis.floquet && p.analysis.stability_undetermined);
   }
   if (std::none_of(physical.begin(), physical.end(), [](bool p) { return p; })) return {};
   BranchFamily f;
-  f.ranges = RangesOnBranch(b, physical, stable, boundary, coordinate, unresolved);
+  f.ranges = RangesOnBranch(b, physical, stable, boundary, coordinate, unresolved, undetermined);
   if (f.ranges.physical.empty()) return {};  // physical only where the integration does not resolve the orbits
   // A stretch is named at its middle point: its ends may be shared with another family (an SB point where
   // hopping in place and forward hopping meet, a fold where two families of a forced system meet).
