@@ -1495,12 +1495,14 @@ def figure_curves(res, svg, written):
     p = ((res.summary.get("options") or {}).get("curves") or {}).get("parameter")
     if not entries or not isinstance(p, str):
         return
+    # The families' coordinate: H, or the run's free parameter (summaries before it was written: H).
+    a = entries[0].get("coordinate") if isinstance(entries[0].get("coordinate"), str) else "H"
     fig, ax = plt.subplots(figsize=(7.0, 4.6))
     by_id = {sp.get("id"): sp for sp in res.special_points}
     for c in entries:
         with open(os.path.join(res.dir, c["file"]), newline="") as f:
             rows = list(csv.DictReader(f))
-        xs, ys = [to_float(r.get(p)) for r in rows], [to_float(r.get("H")) for r in rows]
+        xs, ys = [to_float(r.get(p)) for r in rows], [to_float(r.get(a)) for r in rows]
         kind = str(c.get("type"))
         sp = by_id.get(c.get("special_point"))
         branch = res.by_id.get(sp.get("branch")) if sp else None
@@ -1512,7 +1514,7 @@ def figure_curves(res, svg, written):
                                    " (%s)" % branch["family"] if branch and branch["family"] else "")
         ax.plot(xs, ys, color=colour, lw=1.8, ls=CURVE_DASHES.get(kind, "-"), label=label)
         for q in c.get("codim_two") or []:
-            ax.plot([to_float(q.get(p))], [to_float(q.get("H"))], "*", color="black", ms=8)
+            ax.plot([to_float(q.get(p))], [to_float(q.get(a))], "*", color="black", ms=8)
     # Regions, physical ones first: one fill per set of points (mirror images that coincide are one region,
     # named after both families, in the first one's colour).
     fills = {}
@@ -1537,9 +1539,10 @@ def figure_curves(res, svg, written):
     if finite(value):
         ax.axvline(value, color="0.55", lw=0.8, ls=":", zorder=0)
     ax.set_xlabel(axis_label(p, res), fontsize=9)
-    ax.set_ylabel(axis_label("H", res), fontsize=9)
+    ax.set_ylabel(axis_label(a, res), fontsize=9)
     ax.grid(True, color="0.9", lw=0.6)
-    ax.set_title(r"special points continued in $(%s, \bar{H})$: " % p + model_title(res), fontsize=10)
+    ax.set_title(r"special points continued in $(%s, %s)$: " % (p, r"\bar{H}" if a == "H" else a) + model_title(res),
+                 fontsize=10)
     handles = ax.get_legend_handles_labels()[0]
     from matplotlib.patches import Patch
     handles += [Patch(color=c, alpha=a, lw=0, label=name) for name, (c, a) in legend_regions.items()]

@@ -256,14 +256,15 @@
               };
             }));
 
-  // The parameter plane (a study with curves): where each family continued in H̄ is physical (light) and
-  // stable (darker), between the curves of the special points that end its ranges or the bound of H̄ it
-  // reached, and every curve, dashed by kind. Regions of mirror images that coincide are drawn once.
+  // The parameter plane (a study with curves): where each family continued in H̄ (or a free parameter) is
+  // physical (light) and stable (darker), between the curves of the special points that end its ranges or the
+  // bound it reached, and every curve, dashed by kind. Regions of mirror images that coincide are drawn once.
   function drawPlane() {
     const plane = study.plane;
     if (!plane) return;
     document.getElementById('plane-panel').hidden = false;
-    document.getElementById('plane-title').textContent = 'Parameter plane (' + plane.parameter + ', H)';
+    const coordinate = plane.coordinate || 'H';  // the families' coordinate (H̄ or a free parameter)
+    document.getElementById('plane-title').textContent = 'Parameter plane (' + plane.parameter + ', ' + coordinate + ')';
     document.getElementById('plane-note').textContent =
         'Shaded: where a family exists with physical orbits (light) and where they are stable (dark), between ' +
         'the curves of the special points that end its ranges; the dotted line is this run\'s ' + plane.parameter +
@@ -291,7 +292,7 @@
     }
     Plotly.react('plane', traces, {
       margin: {l: 60, r: 10, t: 10, b: 50}, hovermode: 'closest', legend: {font: {size: 11}},
-      xaxis: {title: {text: plane.parameter}, zeroline: false}, yaxis: {title: {text: 'H'}, zeroline: false},
+      xaxis: {title: {text: plane.parameter}, zeroline: false}, yaxis: {title: {text: coordinate}, zeroline: false},
       shapes: [{type: 'line', xref: 'x', yref: 'paper', x0: plane.value, x1: plane.value, y0: 0, y1: 1,
                 line: {color: '#888', width: 1, dash: 'dot'}}],
     }, {responsive: true, displaylogo: false, scrollZoom: true});

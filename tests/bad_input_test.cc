@@ -297,8 +297,8 @@ const std::vector<BadInputCase>& Cases() {
       {"FreeUntilOutsideBound", Run("slip", {"--free", "k", "--fix", "H=1.5", "--bound", "k=10:20", "--until", "k=50"}),
        2, "--until 'k=50' lies outside --bound 'k=10:20'"},
       {"CurvesUnknownParameter", Run("slip", {"--curves", "zz"}), 2, "--curves 'zz': model 'slip' has no such parameter"},
-      {"CurvesWithFree", Run("slip", {"--curves", "w2", "--free", "k", "--fix", "H=1.5"}), 2,
-       "--curves 'w2': not with --free"},
+      {"CurvesInTheFreeParameter", Run("slip", {"--curves", "k", "--free", "k", "--fix", "H=1.5"}), 2,
+       "--curves 'k': the families are continued in k already; the curves need a second parameter"},
       {"CurvesBoundExcludesValue", Run("slip", {"--curves", "w2", "--bound", "w2=6:10"}), 2,
        "--bound 'w2=6:10': excludes the model's w2 = 5"},
       // ---------------------------------------------------------------- CLI: malformed values

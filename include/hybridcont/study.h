@@ -161,8 +161,10 @@ struct StudyOrbit {
 };
 
 // A two-parameter curve of the study (options.curves = p): a special point of a physical family continued in
-// (H̄, p) — a fold, a branch point, a period doubling or Neimark–Sacker point (the zero of its Floquet test
-// function) — or a boundary of the physical families (a duration or a constraint at 0).
+// (a, p), a the coordinate the study's families are continued in (H̄; with `free`, that parameter at the fixed
+// unknown, e.g. k at H̄ = 1.5; without first integral, the model's run parameter) — a fold, a branch point, a
+// period doubling or Neimark–Sacker point (the zero of its Floquet test function) — or a boundary of the
+// physical families (a duration or a constraint at 0).
 struct StudyCurve {
   int id = 0;
   std::string type;         // "fold", "branch-point", "period-doubling", "neimark-sacker", "boundary"
@@ -176,11 +178,11 @@ struct StudyCurve {
   // leaves the physical region (special_point_curve.h, CodimTwoPoint).
   struct CodimTwo {
     std::string type, name, status;
-    double H = 0, p = 0;
+    double a = 0, p = 0;  // a: the families' coordinate (columns.front()), p: the curves' parameter
     bool operator==(const CodimTwo&) const = default;
   };
   std::vector<CodimTwo> codim_two;
-  std::vector<std::string> columns;  // "H", p, then the curve's other unknowns
+  std::vector<std::string> columns;  // a ("H" or the free parameter), p, then the curve's other unknowns
   std::vector<Vector> points;        // in curve order, each in `columns` order
 };
 

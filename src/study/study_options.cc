@@ -179,8 +179,9 @@ std::vector<StudyOptionSpec> Declare() {
                             "ordinary run",
                         true)),
       Member(Spec("curves", "--curves", "curves", K::kText, kResult, "PARAMETER",
-                  "after the run, continue every turning and SB point of the physical families in (H, PARAMETER), "
-                  "e.g. w2 (bounds: " + M("bounds") + " PARAMETER=LO:HI)", false),
+                  "after the run, continue every turning, SB, PD and NS point and every boundary of the physical "
+                  "families in two parameters: (H, PARAMETER), or with " + M("free") + " (PARAMETER of " + M("free") +
+                  ", PARAMETER) at the fixed value, e.g. w2 (bounds: " + M("bounds") + " PARAMETER=LO:HI)", false),
              &O::curves),
       Negated(Spec("use_symmetries", "--no-symmetry", "no_symmetry", K::kSwitch, kResult, "",
                    "trace every half-branch, also those that are images of traced ones under the model's symmetries",

@@ -8,25 +8,33 @@
 namespace hybridcont::study {
 
 std::vector<DurationCrossing> DurationCrossings(const HybridModel& model, const BifurcationDiagram& d,
-                                                const IntegratorOptions& integrator, bool zero_points) {
-  const ShootingLayout layout(model);
+                                                const IntegratorOptions& integrator, bool zero_points,
+                                                const FreeParameters& free) {
+  const ShootingLayout layout(model), run(model, free);
+  HybridModel at_point = model.Clone();  // the model at a point's free parameters
+  const auto physical = [&](const Vector& u_run) {
+    SetFreeParameters(run, u_run, &at_point);
+    return IsPhysical(at_point, u_run.head(layout.num_unknowns()), integrator);
+  };
   std::vector<DurationCrossing> crossings;
   for (const Branch& b : d.branches) {
     if (b.image_of >= 0) continue;  // an image's ends are the images of its source's
     for (std::size_t i = 0; i + 1 < b.points.size(); ++i) {
-      const Vector ua = b.points[i].u.head(layout.num_unknowns()), ub = b.points[i + 1].u.head(layout.num_unknowns());
+      const Vector& va = b.points[i].u;
+      const Vector& vb = b.points[i + 1].u;
       for (int s = 0; s < layout.num_segments(); ++s) {
-        const double ta = ua(layout.time_index(s)), tb = ub(layout.time_index(s));
+        const double ta = va(layout.time_index(s)), tb = vb(layout.time_index(s));
         const bool za = zero_points && std::abs(ta) <= kZeroDuration, zb = zero_points && std::abs(tb) <= kZeroDuration;
         if (za && zb) continue;  // a family with that duration 0 throughout: its crossings are branch points
         if (!(ta * tb < 0 || za || zb)) continue;
-        if (!IsPhysical(model, ua, integrator) && !IsPhysical(model, ub, integrator)) continue;
+        if (!physical(va) && !physical(vb)) continue;
         DurationCrossing c;
         c.branch = b.id;
         c.point = static_cast<int>(i);
         c.segment = s;
         c.at_point = za || zb;
-        c.u = za ? ua : zb ? ub : Vector(ua + (ta / (ta - tb)) * (ub - ua));
+        c.u_run = za ? va : zb ? vb : Vector(va + (ta / (ta - tb)) * (vb - va));
+        c.u = c.u_run.head(layout.num_unknowns());
         crossings.push_back(std::move(c));
       }
     }

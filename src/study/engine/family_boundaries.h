@@ -14,6 +14,7 @@
 #include "hybridcont/exploration.h"
 #include "hybridcont/model.h"
 #include "hybridcont/orbit_observables.h"
+#include "hybridcont/shooting_layout.h"
 
 namespace hybridcont::study {
 
@@ -27,13 +28,17 @@ struct DurationCrossing {
   int segment = -1;
   Vector u;              // the linear interpolant at t = 0, or the point itself where its duration is 0
   bool at_point = false; // an end point has the zero duration (|t| <= kZeroDuration)
+  Vector u_run;          // the same in the layout of d's points (`free`): with the free parameters' values
 };
 
 // The crossings on the branches of d that are not images (an image's are its source's images), in the
-// model's own layout (u's head). With `zero_points`, an end point whose duration is already 0 counts too
-// (not where both ends are 0: a family with that duration 0 throughout); else only strict sign changes.
+// model's own layout (u's head); d's points are in the layout of `free` (the run's free parameters, fixed
+// unknowns and observables), and each point is classified at its own parameter values. With `zero_points`,
+// an end point whose duration is already 0 counts too (not where both ends are 0: a family with that
+// duration 0 throughout); else only strict sign changes.
 std::vector<DurationCrossing> DurationCrossings(const HybridModel& model, const BifurcationDiagram& d,
-                                                const IntegratorOptions& integrator, bool zero_points);
+                                                const IntegratorOptions& integrator, bool zero_points,
+                                                const FreeParameters& free = {});
 
 // The observable accepted by `wanted` whose value at u is closest to 0 and below 1e-6 in size, or -1; for
 // an extremum, interior_only asks that the extremum lie inside its interval (the constraint's boundary, not

@@ -281,7 +281,13 @@ void ApplyCurveParameter(const StudyOptions& args, const HybridModel& model, Stu
     Refuse("curves", -1, fmt::format("'{}': model '{}' has no parameter derivatives", args.curves,
                                             model.name()));
   }
-  if (!args.free.empty()) Refuse("curves", -1, "'" + args.curves + "': not with " + MentionOption("free"));
+  // The curves are drawn in (a, p), a the coordinate the families are continued in: p must be another one.
+  const std::string continued = !args.free.empty() ? args.free
+                                : model.num_first_integrals() > 0 ? std::string("H") : model.setup().run.parameter;
+  if (args.curves == continued) {
+    Refuse("curves", -1, fmt::format("'{}': the families are continued in {} already; the curves need a second "
+                                     "parameter", args.curves, continued));
+  }
   setup->curve_parameter = args.curves;
   setup->curve_bound = DefaultParameterBound(model, args.curves);
   std::erase_if(run_args->bounds, [&](const NamedInterval& b) {

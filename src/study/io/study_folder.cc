@@ -188,13 +188,15 @@ void ReadCurves(const nlohmann::json& summary, const fs::path& dir, StudyResult*
     curve.message = e.contains("message") && e["message"].is_string() ? e["message"].get<std::string>() : std::string();
     using study::JsonNumber, study::JsonText, study::JsonTexts;
     if (e.contains("termination")) curve.termination = JsonTexts(e, "termination", at);
+    // The families' coordinate the curve's points are in besides p (before it was written: H).
+    const std::string coordinate = e.contains("coordinate") ? JsonText(e, "coordinate", at) : std::string("H");
     if (e.contains("codim_two")) {
       if (!e["codim_two"].is_array()) throw std::invalid_argument(at + ".codim_two: expected a list");
       for (std::size_t k = 0; k < e["codim_two"].size(); ++k) {
         const nlohmann::json& q = e["codim_two"][k];
         const std::string where = at + ".codim_two[" + std::to_string(k) + "]";
         curve.codim_two.push_back({JsonText(q, "type", where), JsonText(q, "name", where, ""), JsonText(q, "status", where),
-                                   JsonNumber(q, "H", where), JsonNumber(q, r->curve_parameter, where)});
+                                   JsonNumber(q, coordinate, where), JsonNumber(q, r->curve_parameter, where)});
       }
     }
     std::ifstream f = OpenRegular(dir / file);

@@ -220,8 +220,9 @@ nlohmann::json CurvesJson(const std::string& parameter, const std::vector<StudyC
   nlohmann::json list = nlohmann::json::array();
   for (const StudyCurve& c : curves) {
     nlohmann::json codim_two = nlohmann::json::array();
+    const std::string a = c.columns.empty() ? std::string("H") : c.columns.front();
     for (const StudyCurve::CodimTwo& q : c.codim_two) {
-      codim_two.push_back({{"type", q.type}, {"name", q.name}, {"status", q.status}, {"H", q.H}, {parameter, q.p}});
+      codim_two.push_back({{"type", q.type}, {"name", q.name}, {"status", q.status}, {a, q.a}, {parameter, q.p}});
     }
     nlohmann::json j = {{"id", c.id},
                         {"file", "curve_" + std::to_string(c.id) + ".csv"},
@@ -230,6 +231,7 @@ nlohmann::json CurvesJson(const std::string& parameter, const std::vector<StudyC
                         {"status", c.status},
                         {"message", c.message},
                         {"points", c.points.size()},
+                        {"coordinate", a},
                         {"codim_two", codim_two}};
     if (!c.name.empty()) j["name"] = c.name;
     if (!c.termination.empty()) j["termination"] = c.termination;

@@ -152,8 +152,9 @@ json SpecialPointJson(const StudySpecialPoint& sp, const StudyResult& study) {
           {"message", sp.message}, {"columns", std::move(columns)}};
 }
 
-// The (p, H̄) plane of a study with curves (options.curves = p): each curve as (p, H̄) pairs, and the regions
-// where a family continued in H̄ is physical and where stable, wherever both ends of its range are edges
+// The (p, a) plane of a study with curves (options.curves = p; a the coordinate its families are continued
+// in, H̄ or a free parameter): each curve as (p, a) pairs, and the regions where a family is physical and
+// where stable, wherever both ends of its range are edges
 // known over p: a curve through the end (the curve of that special point, or of one at the same orbit) or
 // the bound of H̄ the branch reached. A range with an end of neither kind (a singular start, a point not
 // located) has no region: its edge over p is not known.
@@ -169,8 +170,9 @@ json PlaneJson(const StudyResult& study) {
   std::vector<Edge> curve_edges;
   json curves = json::array();
   double p_min = HUGE_VAL, p_max = -HUGE_VAL;
+  const std::string a = study.curves.front().columns.empty() ? std::string("H") : study.curves.front().columns.front();
   for (const StudyCurve& c : study.curves) {
-    const auto h = std::find(c.columns.begin(), c.columns.end(), "H") - c.columns.begin();
+    const auto h = std::find(c.columns.begin(), c.columns.end(), a) - c.columns.begin();
     const auto q = std::find(c.columns.begin(), c.columns.end(), study.curve_parameter) - c.columns.begin();
     Edge e;
     json points = json::array();
@@ -209,7 +211,7 @@ json PlaneJson(const StudyResult& study) {
   const auto bound = [&](const RangeEnd& end) { return end.how.find("bound-reached") != std::string::npos; };
   json regions = json::array();
   for (const StudyBranch& b : study.branches) {
-    if (b.family.empty() || b.continued != "H" || !b.origin.empty()) continue;
+    if (b.family.empty() || b.continued != a || !b.origin.empty()) continue;
     for (const auto& [kind, ranges] : {std::pair<std::string, const std::vector<Range>*>{"physical", &b.ranges.physical},
                                        {"stable", &b.ranges.stable}}) {
       for (const Range& r : *ranges) {
@@ -238,7 +240,7 @@ json PlaneJson(const StudyResult& study) {
       }
     }
   }
-  return {{"parameter", study.curve_parameter}, {"value", Number(p0)}, {"curves", std::move(curves)},
+  return {{"parameter", study.curve_parameter}, {"coordinate", a}, {"value", Number(p0)}, {"curves", std::move(curves)},
           {"regions", std::move(regions)}};
 }
 

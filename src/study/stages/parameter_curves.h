@@ -1,25 +1,30 @@
-// `hybridcont run MODEL --curves p`: the located turning points (in H̄) and SB points of the physical
-// families, each continued in (H̄, p) as a two-parameter curve (special_point_curve.h), written as
-// curve_<n>.csv and listed in summary.json under "curves".
+// `hybridcont run MODEL --curves p`: the located turning points, SB, PD, NS and grazing points of the physical
+// families, each continued in (a, p) as a two-parameter curve (special_point_curve.h), a the coordinate the
+// run's families are continued in: H̄, or with --free the free parameter at the fixed unknown (`--free k --fix
+// H=1.5 --curves w2`: curves in (k, w2) at H̄ = 1.5), or for a model without first integral its run parameter.
+// Each written as curve_<n>.csv and listed in summary.json under "curves".
 //
 //   std::vector<StudyCurve> curves = TraceParameterCurves(model, setup, diagram, writer.dir(), &report);
 //
-// Base map of every curve: the time-based map with p free and held at its value by a fixing row
-// (FreeParameters{{p}, {{p, p0}}}): the family in H̄ at fixed p, whose turning points are folds and whose
-// SB points are branch points; dropping the fixing row lets (H̄, p) move along the curve. Each point of the
-// run's diagram becomes a point of that map by appending p0. PD curves need a PD test function of the
-// library and are not traced.
+// Base map of every curve: the time-based map of the run (its free parameters, fixed unknowns and joined
+// observables) with p free as well and held at its value by one more fixing row: the run's family at fixed p,
+// whose turning points in a are folds and whose SB points are branch points; dropping that row lets (a, p)
+// move along the curve. Each point of the run's diagram becomes a point of that map with p0 inserted (by the
+// unknowns' names). PD and NS points are continued as zeros of their Floquet test functions, grazing points
+// (a phase's event crossed tangentially) as zeros of the event's crossing speed. A special point on a traced
+// curve of its type (a mirror image's, the other end of one grazing curve) is not traced again.
 //
 // Boundaries of the physical families are traced too: where a physical family's phase duration t_i passes 0
 // (between two branch points) and where it crosses a constraint's boundary (a located CB point), the map
 // with p free and that quantity held at 0 (a constraint joins the unknowns: shooting_layout.h) is a curve
-// in (H̄, p) — the boundary of the region where the family exists and is physical. One curve per boundary
+// in (a, p) — the boundary of the region where the family exists and is physical. One curve per boundary
 // quantity and place (a start on a traced curve of the same quantity is skipped).
 //
-// summary.json (summary_json.h, CurvesJson): "curves": [{"id", "type" ("fold" | "branch-point" | "boundary"), "file", "special_point"
-// (null for a boundary), "name" (a boundary's "t2 = 0", "clearance = 0"), "status", "points", "termination":
-// [backward, forward], "codim_two": [{"type", "name", "status", "H", p}]}].
-// curve_<n>.csv: H, p, then the other curve unknowns (those of the map, and beta for branch points).
+// summary.json (summary_json.h, CurvesJson): "curves": [{"id", "type" ("fold" | "branch-point" |
+// "period-doubling" | "neimark-sacker" | "grazing" | "boundary"), "file", "special_point" (null for a
+// boundary), "name" (a boundary's "t2 = 0", "clearance = 0"), "status", "points", "coordinate" (a),
+// "termination": [backward, forward], "codim_two": [{"type", "name", "status", a, p}]}].
+// curve_<n>.csv: a, p, then the other curve unknowns (those of the map, and beta for branch points).
 #ifndef HYBRIDCONT_STUDY_PARAMETER_CURVES_H_
 #define HYBRIDCONT_STUDY_PARAMETER_CURVES_H_
 
