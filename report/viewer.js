@@ -10,7 +10,7 @@
   const PALETTE = ['#0072B2', '#D55E00', '#009E73', '#CC79A7', '#E69F00', '#56B4E9', '#000000', '#F0E442'];
   const NONPHYSICAL = '#b0b0b0';
   const SYMBOLS = {SB: 'circle', TP: 'circle-open', BP: 'square', PD: 'diamond', NS: 'hexagon', KC: 'star-diamond',
-                   GR: 'triangle-down', CB: 'triangle-up', UZ: 'cross', start: 'star'};
+                   GR: 'triangle-down', CB: 'triangle-up', UZ: 'cross', EX: 'x', start: 'star'};
 
   // Branches by id; special points on a branch the study lists.
   const branchById = new Map(study.branches.map((b) => [b.id, b]));

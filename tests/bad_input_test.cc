@@ -299,6 +299,8 @@ const std::vector<BadInputCase>& Cases() {
       {"CurvesUnknownParameter", Run("slip", {"--curves", "zz"}), 2, "--curves 'zz': model 'slip' has no such parameter"},
       {"CurvesInTheFreeParameter", Run("slip", {"--curves", "k", "--free", "k", "--fix", "H=1.5"}), 2,
        "--curves 'k': the families are continued in k already; the curves need a second parameter"},
+      {"ExtremumNotAnObservable", Run("slip", {"--extremum", "zz"}), 2,
+       "--extremum 'zz': not an observable of model 'slip' (it declares none)"},
       {"CurvesBoundExcludesValue", Run("slip", {"--curves", "w2", "--bound", "w2=6:10"}), 2,
        "--bound 'w2=6:10': excludes the model's w2 = 5"},
       // ---------------------------------------------------------------- CLI: malformed values

@@ -52,12 +52,15 @@ enum class SpecialPointType {
   kKreinCollision,      // two pairs of multipliers of a symplectic map collide on the unit circle (KC; floquet.h)
   kZeroDuration,        // a phase's duration reaches 0: the phase vanishes from the cycle (ZD; the end of a
                         // physical family where running's flight shrinks to nothing and walking begins)
+  kExtremum,            // an observable the user asked about is largest or smallest along the family (EX): a
+                        // turning point of its component, which the continuation locates as such and the study
+                        // names (the fastest gait of a family, its highest apex)
 };
 // The last type: the types are the integers 0 .. kLastSpecialPointType.
-constexpr SpecialPointType kLastSpecialPointType = SpecialPointType::kZeroDuration;
+constexpr SpecialPointType kLastSpecialPointType = SpecialPointType::kExtremum;
 std::string ToString(SpecialPointType type);
 // The short code of reports and summary.json: "SB", "TP", "start", "BP", "PD", "test", "GR", "NS", "UZ", "CB",
-// "KC", "ZD".
+// "KC", "ZD", "EX".
 std::string Code(SpecialPointType type);
 // The type of a code; false for a string that is none.
 bool FromCode(const std::string& code, SpecialPointType* type);

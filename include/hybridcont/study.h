@@ -132,7 +132,10 @@ struct StudySpecialPoint {
   double precision_arclength = 0;  // the same interval along the branch, in the engine's scaled arclength
   double precision_H = 0;          // its width in H̄ (NaN without a first integral or widths)
   double residual = 0;
-  std::string component;     // a boundary's or target's component
+  std::string component;     // a boundary's or target's component; an EX point's observable
+  // An EX point (options.extrema): +1 where `component` is largest along the family (it rises, then falls, along
+  // the branch), -1 where smallest; 0 for every other type.
+  int extremum = 0;
   int duplicate_of = -1;
   std::string message;
   Vector u;

@@ -84,6 +84,7 @@ struct StudyOptions {
   std::vector<NamedValue> until;       // each branch ends exactly where an unknown or observable reaches the value
   std::vector<NamedInterval> bounds;   // replace the model's bound on an unknown ("period": sum of durations)
   std::vector<NamedValue> monitors;    // observables whose values are located (UZ points)
+  std::vector<std::string> extrema;    // observables whose largest and smallest values along each family are located (EX)
   std::optional<double> rtol, atol;    // integrator tolerances (unset: the library's 1e-10)
   std::optional<int> max_branches;     // half-branches traced at most (unset: the model's scenario)
   Formulation formulation = Formulation::kTimeBased;
@@ -92,7 +93,7 @@ struct StudyOptions {
   bool period_doubling = false;        // explore the period-doubled family of every located PD point
   std::string free;                    // a parameter continued as an unknown instead of H
   std::optional<NamedValue> fix;       // the unknown held fixed while `free` varies (H=1.5, t2=0, speed=1)
-  std::string curves;                  // a parameter: special points continued in (H, it) after the run
+  std::string curves;                  // a parameter: special points continued in (H or `free`, it) after the run
   std::optional<RestartSpec> restart;  // begin at a labelled point of a saved study instead of the model's start
   // A saved study of the same model at nearby parameter values (a sweep's neighbouring grid point): trace only
   // the half-branches whose counterpart there led to a family; the others, which found no physical orbit

@@ -454,6 +454,7 @@ py::list SpecialPointRows(const StudyResult& study) {
     for (const NamedValue& v : sp.named_unknowns) row[py::str(v.name)] = v.value;
     if (!sp.word.empty()) row["word"] = sp.word;
     if (sp.period_doubled_from >= 0) row["period_doubled_from"] = sp.period_doubled_from;
+    if (sp.extremum != 0) row["extremum"] = sp.extremum > 0 ? "maximum" : "minimum";
     if (!sp.observables.empty()) {
       py::dict observables;
       for (const NamedValue& v : sp.observables) observables[py::str(v.name)] = v.value;

@@ -226,7 +226,7 @@ class Study:
         """One row per located (or bracketed) special point: label, id, type, branch, index, H, T, status,
         precision (also along the branch and in H), residual, component, message, u (the point in the study's
         unknowns), each free parameter or observable among the unknowns by name, and where they apply word,
-        period_doubled_from and observables."""
+        period_doubled_from, observables and extremum (an EX point's "maximum" or "minimum" of its component)."""
         return self._table("special_points", lambda: pd.DataFrame(self._rows["special_points"]))
 
     @property

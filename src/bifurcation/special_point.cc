@@ -21,6 +21,7 @@ constexpr internal::EnumName<SpecialPointType> kSpecialPointTypeNames[] = {
     {SpecialPointType::kKreinCollision, "krein-collision"},
     {SpecialPointType::kUserTestFunction, "test-function-zero"},
     {SpecialPointType::kZeroDuration, "zero-duration"},
+    {SpecialPointType::kExtremum, "extremum"},
 };
 
 constexpr internal::EnumName<LocationStatus> kLocationStatusNames[] = {
@@ -46,6 +47,7 @@ std::string Code(SpecialPointType type) {
     case SpecialPointType::kConstraintBoundary: return "CB";
     case SpecialPointType::kKreinCollision: return "KC";
     case SpecialPointType::kZeroDuration: return "ZD";
+    case SpecialPointType::kExtremum: return "EX";
   }
   return "?";
 }

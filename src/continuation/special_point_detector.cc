@@ -80,7 +80,8 @@ bool SpecialPointDetector::Detect(size_t index, bool from_singular, Branch* bran
                            [](const Segment::Probe& p) { return p.sb_test; }, index, branch, &bracket_only));
   }
   for (const int k : turning_) {
-    if (a.tangent(k) * b.tangent(k) < 0) {
+    if (a.tangent(k) * b.tangent(k) < 0 &&
+        std::max(std::abs(a.tangent(k)), std::abs(b.tangent(k))) > kConstantComponent) {
       found.push_back(Locate(SpecialPointType::kTurningPoint, k,
                              [k](const Segment::Probe& p) { return p.tangent(k); }, index, branch, &bracket_only));
     }

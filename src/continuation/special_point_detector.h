@@ -61,6 +61,10 @@ class SpecialPointDetector {
   // A test function this small at the start of a branch from a bifurcation point, relative to its value
   // at the next sample, vanishes there: the zero is that point, the parent's.
   static constexpr double kStartNoise = 1e-3;
+  // A component whose unit tangent entries on both sides of a sign change are at most this is constant along the
+  // branch (the hopper's forward speed while it hops in place): its sign changes are rounding, no turning point.
+  // A real turning point between two accepted points has |τ_k| ~ h × curvature on at least one side.
+  static constexpr double kConstantComponent = 1e-8;
   // Evaluations of the minimization that looks for a pair of zeros at a local minimum of |g|.
   static constexpr int kPairSearchEvaluations = 24;
   // A minimum of |g| this small relative to the samples around it is refined (Brent, up to

@@ -356,6 +356,7 @@ ExploredFamilies ExploreFamilies(const HybridModel& model, const RunSetup& setup
     writer.SetParameterStarts(*out.parameter_starts);
   }
   if (formulation == Formulation::kStateBased) ConvertToTimeBased(exploration, layout, &diagram);
+  MarkExtrema(setup.extrema, &diagram);
   for (const Branch& b : diagram.branches) writer.EndBranch(b);
   exploration.ForgetBranchPointAnalyses();  // every point of the exploration has been analysed
   writer.SetExplorationStatus(diagram.status, diagram.message);

@@ -153,6 +153,11 @@ std::vector<StudyOptionSpec> Declare() {
                   "locate the points where an observable of the model reaches a value, e.g. speed=0.5, or several "
                   "values, speed=0.5,0.8 (repeatable; special points UZ)", true),
              &O::monitors),
+      Member(Spec("extrema", "--extremum", "extremum", K::kTexts, kResult, "OBSERVABLE",
+                  "locate where an observable of the model is largest or smallest along each family, e.g. speed "
+                  "(repeatable; special points EX, maxima and minima told apart; with " + M("curves") +
+                  " also continued in two parameters: the locus of the best orbits)", true),
+             &O::extrema),
       Member(Spec("bounds", "--bound", "bound", K::kIntervals, kResult, "NAME=LOWER:UPPER",
                   "replace the model's bound on an unknown, e.g. H=0:2.7 ('period' is the sum of the durations; an "
                   "empty end is unbounded) (repeatable)", true),

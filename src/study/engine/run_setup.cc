@@ -270,6 +270,28 @@ void ApplyObservables(const StudyOptions& args, const HybridModel& model, RunSet
     join(name);
     setup->monitors.push_back({name, value});
   }
+  // An extremum of an observable along a family is a turning point of its component once it joins the unknowns:
+  // located by the continuation like a fold (with the continued coordinate, which the components then name).
+  for (std::size_t i = 0; i < args.extrema.size(); ++i) {
+    const std::string& name = args.extrema[i];
+    if (model.FindObservable(name) < 0) {
+      std::string known;
+      for (const Observable& o : model.observables()) known += (known.empty() ? "" : ", ") + o.name;
+      Refuse("extrema", static_cast<int>(i), "'" + name + "': not an observable of model '" + model.name() + "' (" +
+                                                 (known.empty() ? "it declares none" : "observables: " + known) + ")");
+    }
+    if (std::find(setup->extrema.begin(), setup->extrema.end(), name) != setup->extrema.end()) {
+      Refuse("extrema", static_cast<int>(i), "'" + name + "': is given twice");
+    }
+    join(name);
+    setup->extrema.push_back(name);
+  }
+  if (!setup->extrema.empty()) {
+    const std::string continued = ShootingLayout(model, setup->free).continued_name();
+    std::vector<std::string>& turning = setup->exploration.continuation.turning_point_components;
+    turning = {continued};
+    turning.insert(turning.end(), setup->extrema.begin(), setup->extrema.end());
+  }
 }
 
 // --curves: the parameter and its bound (taken out of --bound, whose other names are the run's unknowns).

@@ -22,6 +22,9 @@ struct RunSetup {
   FreeParameters free;
   // --monitor: observables and the values at which their crossings are located (UZ points).
   std::vector<std::pair<std::string, double>> monitors;
+  // --extremum: observables joined to the unknowns whose turning points along the families are located
+  // (ContinuationOptions::turning_point_components, besides the continued coordinate) and named EX.
+  std::vector<std::string> extrema;
   // The options of the ordinary run in H that gives the starts of a run with free parameters (its
   // families' crossings of the fixed value): the scenario's, with --max-branches, --threads, --no-symmetry
   // and an H bound that contains the fixed value.

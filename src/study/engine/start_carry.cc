@@ -263,11 +263,12 @@ CarriedStart CarryStart(const HybridModel& model, const std::vector<NamedValue>&
     to_text += fmt::format("{}{:.6g}", to_text.empty() ? "" : ", ", to);
     if (!leg_how.empty()) how += "; " + leg_how;
   }
-  out.u = Relayout(base, u, given, {});
   if (given.num_observables() > 0) {
-    Vector without = u;
+    // The base layout is the given one without its observables, which come last: completed with their values.
     TimeBasedShooting map(model, integrator, route.free);
-    out.u = map.CompleteUnknowns(without);
+    out.u = map.CompleteUnknowns(u);
+  } else {
+    out.u = Relayout(base, u, given, {});
   }
   out.ok = true;
   if (from_text.empty()) {

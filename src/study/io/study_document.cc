@@ -108,12 +108,18 @@ StudySpecialPoint SpecialPointFromSummary(const nlohmann::json& entry, const std
   }
   p.word = JsonTexts(entry, "word", where);
   p.period_doubled_from = JsonInt(entry, "period_doubled_from", where, -1);
+  if (const std::string extremum = JsonText(entry, "extremum", where, ""); !extremum.empty()) {
+    if (extremum != "maximum" && extremum != "minimum") {
+      Malformed(where + ".extremum", "'" + extremum + "' is neither maximum nor minimum");
+    }
+    p.extremum = extremum == "maximum" ? 1 : -1;
+  }
   // The unknowns written by name (free parameters, observables among the unknowns): every other numeric field;
   // ResultFromSummary puts them in the order of the branch's unknowns.
   static const std::set<std::string> kFields = {"id", "type", "branch", "index", "H", "T", "status", "precision",
                                                 "precision_arclength", "precision_H", "residual", "component",
                                                 "duplicate_of", "message", "u", "word", "period_doubled_from",
-                                                "observables"};
+                                                "observables", "extremum"};
   for (const auto& [name, value] : entry.items()) {
     if (!kFields.count(name) && value.is_number()) p.named_unknowns.push_back({name, value.get<double>()});
   }

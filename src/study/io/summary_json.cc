@@ -88,6 +88,7 @@ nlohmann::json SpecialPointsJson(const std::vector<StudySpecialPoint>& points) {
     }
     if (!p.word.empty()) j["word"] = p.word;
     if (p.period_doubled_from >= 0) j["period_doubled_from"] = p.period_doubled_from;
+    if (p.extremum != 0) j["extremum"] = p.extremum > 0 ? "maximum" : "minimum";
     list.push_back(j);
   }
   return list;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -122,6 +123,16 @@ std::string RepeatedWordNote(const StudyResult& study) {
                      list);
 }
 
+// "largest speed 0.853": an EX point's observable, which extreme, and its value there.
+std::string ExtremumText(const StudySpecialPoint& sp) {
+  double value = std::numeric_limits<double>::quiet_NaN();
+  for (const NamedValue& v : sp.named_unknowns) {
+    if (v.name == sp.component) value = v.value;
+  }
+  const char* which = sp.extremum > 0 ? "largest" : sp.extremum < 0 ? "smallest" : "extremal";
+  return fmt::format("{} {} {:.10g}", which, sp.component, value);
+}
+
 }  // namespace
 
 std::string OneScreenAnswer(const StudyResult& study, double seconds) {
@@ -148,6 +159,16 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
     }
     out += RepeatedWordNote(study);
   }
+  // The extrema of the observables asked about (--extremum), on the families' physical stretches.
+  std::string extrema;
+  for (const StudySpecialPoint& sp : study.special_points) {
+    if (sp.type != SpecialPointType::kExtremum || sp.duplicate_of >= 0 || sp.branch < 0) continue;
+    const StudyBranch& b = study.branch(sp.branch);
+    if (b.family.empty() || !b.OnPhysicalStretch(sp.index)) continue;
+    extrema += fmt::format("  {}: {} at {} = {:.10g} ({})\n", b.family, ExtremumText(sp), b.continued,
+                           Coordinate(b, sp.u), sp.Label());
+  }
+  if (!extrema.empty()) out += "extrema along the families:\n" + extrema;
   // Which branches leave each special point: the families a point connects.
   std::map<int, std::vector<int>> children;
   for (const StudyBranch& b : study.branches) {
@@ -196,8 +217,9 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
     std::string located, leads;
     for (const StudySpecialPoint& sp : study.special_points) {
       if (sp.branch != b.id || sp.duplicate_of >= 0 || sp.code == "start" || !b.OnPhysicalStretch(sp.index)) continue;
-      located += fmt::format("    {:<6} {} = {:.10g}  T = {:.10g}  {}\n", sp.Label(), c, Coordinate(b, sp.u), sp.T,
-                             sp.status == "located" ? fmt::format("(to {:.1e})", sp.precision) : "(" + sp.status + ")");
+      located += fmt::format("    {:<6} {} = {:.10g}  T = {:.10g}  {}{}\n", sp.Label(), c, Coordinate(b, sp.u), sp.T,
+                             sp.status == "located" ? fmt::format("(to {:.1e})", sp.precision) : "(" + sp.status + ")",
+                             sp.type == SpecialPointType::kExtremum ? "  " + ExtremumText(sp) : std::string());
       const auto it = children.find(sp.id);
       if (it == children.end()) continue;
       std::vector<std::string> names;

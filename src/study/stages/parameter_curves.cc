@@ -247,6 +247,7 @@ class CurveTracer {
   // The type of the curve of a special point (StudyCurve::type).
   static std::string CurveType(const SpecialPoint& sp, bool fold) {
     if (fold) return ToString(CurveKind::kFold);
+    if (sp.type == SpecialPointType::kExtremum) return ToString(sp.type);
     if (sp.type == SpecialPointType::kSimpleBifurcation) return ToString(CurveKind::kBranchPoint);
     return ToString(sp.type);
   }
@@ -273,11 +274,14 @@ class CurveTracer {
   // phase's event is crossed tangentially (the zero of its crossing speed) continued in (a, p).
   void FromSpecialPoint(const SpecialPoint& sp, const BifurcationDiagram& diagram) {
     const bool fold = sp.type == SpecialPointType::kTurningPoint && sp.component == a_;
+    // An observable's extremum along the family: a fold of the family in that observable's coordinate.
+    const bool extremum = sp.type == SpecialPointType::kExtremum;
     const bool floquet = sp.type == SpecialPointType::kPeriodDoubling || sp.type == SpecialPointType::kNeimarkSacker;
     // A phase's end event grazed (FloquetTestFunctions' functions 2 .. 2 + m − 1; not an event's interior minimum).
     const bool grazing = sp.type == SpecialPointType::kGrazing && sp.component_index >= 2 &&
                          sp.component_index < 2 + model_.num_phases();
-    if (!(fold || floquet || grazing || sp.type == SpecialPointType::kSimpleBifurcation) || sp.duplicate_of >= 0 ||
+    if (!(fold || extremum || floquet || grazing || sp.type == SpecialPointType::kSimpleBifurcation) ||
+        sp.duplicate_of >= 0 ||
         sp.u.size() == 0 || ((floquet || grazing) && sp.status != LocationStatus::kLocated)) {
       return;
     }
@@ -306,7 +310,8 @@ class CurveTracer {
       return;
     }
     SpecialPointCurve curve;
-    const SpecialPoint on_base = OnBaseMap(sp, run_layout_.unknown_names(), base_.unknown_names(), p_, p0_);
+    SpecialPoint on_base = OnBaseMap(sp, run_layout_.unknown_names(), base_.unknown_names(), p_, p0_);
+    if (extremum) on_base.type = SpecialPointType::kTurningPoint;  // in its observable (on_base.component)
     try {
       if (floquet || grazing) {
         const CurveDefinition definition{CurveKind::kTestFunction, fix_row_, a_,

@@ -1,5 +1,6 @@
 #include "study/stages/special_points.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -9,6 +10,35 @@
 #include "hybridcont/special_point.h"
 
 namespace hybridcont::study {
+
+int ExtremumSign(const SpecialPoint& sp) {
+  const int k = sp.component_index;
+  if (sp.type != SpecialPointType::kExtremum || k < 0 || k >= sp.tangent_before.size() ||
+      k >= sp.tangent_after.size()) {
+    return 0;
+  }
+  const double before = sp.tangent_before(k), after = sp.tangent_after(k);
+  return before > 0 && after < 0 ? 1 : before < 0 && after > 0 ? -1 : 0;
+}
+
+void MarkExtrema(const std::vector<std::string>& extrema, BifurcationDiagram* d) {
+  if (extrema.empty()) return;
+  const auto mark = [&](SpecialPoint& sp) {
+    if (sp.type != SpecialPointType::kTurningPoint ||
+        std::find(extrema.begin(), extrema.end(), sp.component) == extrema.end()) {
+      return;
+    }
+    sp.type = SpecialPointType::kExtremum;
+    const int sign = ExtremumSign(sp);
+    const std::string what = sign > 0 ? "largest" : sign < 0 ? "smallest" : "an extremum (neither side's tangent tells which)";
+    sp.message = (sign != 0 ? sp.component + " is " + what : sp.component + ": " + what) + " along the family" +
+                 (sp.message.empty() ? "" : "; " + sp.message);
+  };
+  for (SpecialPoint& sp : d->special_points) mark(sp);
+  for (Branch& b : d->branches) {
+    for (SpecialPoint& sp : b.special_points) mark(sp);
+  }
+}
 
 std::vector<StudySpecialPoint> RecordSpecialPoints(const BifurcationDiagram& d, const ShootingLayout& layout,
                                                    const HybridModel* model, const IntegratorOptions& integrator) {
@@ -37,6 +67,7 @@ std::vector<StudySpecialPoint> RecordSpecialPoints(const BifurcationDiagram& d, 
     p.precision_H = sp.interval_width.size() && level ? sp.interval_width(layout.H_index()) : kNaN;
     p.residual = sp.residual_norm;
     p.component = sp.component;
+    p.extremum = ExtremumSign(sp);
     p.duplicate_of = sp.duplicate_of;
     p.message = sp.message;
     p.u = sp.u;

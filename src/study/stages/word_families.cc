@@ -152,8 +152,16 @@ std::string EndReason(OrbitClass c) {
 
 // The run's options on another word's layout: bounds and targets on unknowns it has, the period's bound (a sum
 // of every duration) on its own durations.
+// The run's turning-point components that are unknowns of `layout` (a word's families are traced in the model's
+// own layout: the observables the run joined for their extrema are none of its unknowns).
+ExplorationOptions WithTurningComponentsOf(ExplorationOptions o, const ShootingLayout& layout) {
+  std::erase_if(o.continuation.turning_point_components,
+                [&](const std::string& name) { return layout.UnknownIndex(name) < 0; });
+  return o;
+}
+
 ExplorationOptions WordOptions(const ExplorationOptions& run, const ShootingLayout& from, const ShootingLayout& to) {
-  ExplorationOptions o = run;
+  ExplorationOptions o = WithTurningComponentsOf(run, to);
   o.start_conditions.clear();
   const auto has = [&](const std::string& name) {
     const int index = to.UnknownIndex(name);
@@ -196,7 +204,8 @@ class WordExplorer {
   // The report section; the words and changes recorded and annotated into the summary.
   std::string Run(const BifurcationDiagram& diagram) {
     words_.push_back({model_.word(), nullptr, &model_, nullptr, diagram});
-    words_.back().exploration = std::make_unique<ModelExploration>(model_, setup_.scenario, integrator_, setup_.exploration);
+    words_.back().exploration = std::make_unique<ModelExploration>(
+        model_, setup_.scenario, integrator_, WithTurningComponentsOf(setup_.exploration, ShootingLayout(model_)));
     to_scan_.push_back({0, diagram});
     StartDeclaredWords();
     while (!to_scan_.empty()) {
