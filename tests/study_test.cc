@@ -352,7 +352,8 @@ TEST(Study, WordChangesAndParameterStartsAreTypedAndReadBackEqual) {
 TEST(StudyOptions, EveryDeclaredOptionIsSetFromItsTextAndReadBack) {
   const std::map<std::string, std::vector<std::string>> texts = {
       {"model", {"slip.toml"}},     {"parameters", {"k=30", "w2=5"}}, {"until", {"H=1.5"}},
-      {"monitors", {"apex=1,2"}},   {"bounds", {"H=0:", "k=:40"}},     {"rtol", {"1e-9"}},
+      {"monitors", {"apex=1,2"}},   {"extrema", {"speed", "apex"}},   {"bounds", {"H=0:", "k=:40"}},
+      {"rtol", {"1e-9"}},
       {"atol", {"2e-9"}},           {"max_branches", {"3"}},          {"formulation", {"state"}},
       {"free", {"k"}},              {"fix", {"H=1.25"}},              {"curves", {"w2"}},
       {"use_symmetries", {"true"}}, {"period_doubling", {"true"}},    {"follow_word_changes", {"true"}},
