@@ -1461,8 +1461,11 @@ def nice_length(s):
 
 
 def report_plane(res):
-    """The (p, H) plane of report.html's data (curves and the regions where families are physical and stable,
-    computed by the library: study_report.h), or {} without a report or a plane."""
+    """The regions of the curves' plane where families are physical and stable, computed by the library
+    (summary.json's "regions", regions.h; folders written before 0.12.0: report.html's data), as {"regions": [...]},
+    or {} without them."""
+    if isinstance(res.summary.get("regions"), list):
+        return {"regions": res.summary["regions"]}
     path = os.path.join(res.dir, "report.html")
     try:
         with open(path, encoding="utf-8") as f:

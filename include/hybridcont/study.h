@@ -189,6 +189,16 @@ struct StudyCurve {
   std::vector<Vector> points;        // in curve order, each in `columns` order
 };
 
+// A region of the plane of a study's curves (options.curves = p): where a family is physical or stable, between
+// the curves (or the bound) that end its range at the run's p, over the p both cover.
+struct StudyRegion {
+  std::string family;
+  std::string kind;   // "physical" or "stable"
+  int branch = -1;    // the branch whose range it extends
+  std::vector<std::pair<double, double>> polygon;  // (p, a) vertices in order, a the families' coordinate
+  bool operator==(const StudyRegion&) const = default;
+};
+
 // A change of an automaton's phase sequence the study considered (word_change.h): where a physical family of
 // a word reached a zero duration, touched a competing guard's surface or ended; the rule that builds the new
 // word, accepted or refused with the reason, and the branches it leads to (summary.json's "word_changes").
@@ -294,6 +304,9 @@ struct StudyResult {
   std::vector<StudyOrbit> orbits;    // key frames
   std::string curve_parameter;       // p of the curves (options.curves); empty without
   std::vector<StudyCurve> curves;    // id == index
+  // Where each family is physical and where stable in the plane of the curves: ParameterRegions (derived from
+  // branches and curves, like families).
+  std::vector<StudyRegion> regions;
   StudyWork work;
   // The whole saved document (summary.json, docs/results-format.md): beside the typed fields above, the
   // effective options and the model's presentation.

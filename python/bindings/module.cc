@@ -542,6 +542,28 @@ py::list CurveRows(const StudyResult& study) {
   return rows;
 }
 
+// One row per vertex of every region of the curves' plane (regions.h): region (its index), family, kind,
+// branch, then the parameter of the curves and the families' coordinate.
+py::list RegionRows(const StudyResult& study) {
+  py::list rows;
+  const std::string a = study.curves.empty() || study.curves.front().columns.empty() ? std::string("H")
+                                                                                     : study.curves.front().columns.front();
+  for (std::size_t k = 0; k < study.regions.size(); ++k) {
+    const StudyRegion& r = study.regions[k];
+    for (const auto& [p, level] : r.polygon) {
+      py::dict row;
+      row["region"] = static_cast<int>(k);
+      row["family"] = r.family;
+      row["kind"] = r.kind;
+      row["branch"] = r.branch;
+      row[py::str(study.curve_parameter)] = p;
+      row[py::str(a)] = level;
+      rows.append(row);
+    }
+  }
+  return rows;
+}
+
 // What Python's Study holds of a study: status, answer, its families' fold, labels and tables.
 // The study's points, column by column (study_table.h): numbers as numpy arrays, texts as lists.
 py::dict PointColumns(const StudyResult& study) {
@@ -566,6 +588,7 @@ py::dict StudyDict(const StudyResult& study) {
   out["branches"] = BranchRows(study);
   out["word_changes"] = WordChangeRows(study);
   out["curves"] = CurveRows(study);
+  out["regions"] = RegionRows(study);
   out["points"] = PointColumns(study);
   out["summary_json"] = study.summary_json;  // the saved document (effective options, presentation)
   out["model_source"] = py::dict(py::arg("kind") = ToString(study.model_source.kind), py::arg("name") = study.model_source.name,

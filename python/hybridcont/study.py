@@ -171,7 +171,8 @@ class Study:
         self._families = list(info["families"])
         # The typed study's tables (the library's record, as summary.json serializes it): rows of the special
         # points (labels by the library's one rule), branches and changes of word.
-        self._rows = {key: list(info[key]) for key in ("special_points", "branches", "word_changes", "curves")}
+        self._rows = {key: list(info[key]) for key in ("special_points", "branches", "word_changes", "curves",
+                                                       "regions")}
         self._points = dict(info["points"])  # the typed points, column by column (study_table.h)
         self._unknowns = list(info["unknowns"])
         self._model_source = dict(info["model_source"])
@@ -253,6 +254,13 @@ class Study:
         quantity), special_point (the one it continues, -1 for a boundary), status, then H, p and the curve's
         other unknowns."""
         return self._table("curves", lambda: pd.DataFrame(self._rows["curves"]))
+
+    @property
+    def regions(self):
+        """Where each family is physical and where stable in the plane of the curves (``curves=p``), one row per
+        vertex of each region's polygon: region (its index), family, kind ("physical" or "stable"), branch, then p
+        and the families' coordinate (H, or the free parameter)."""
+        return self._table("regions", lambda: pd.DataFrame(self._rows["regions"]))
 
     @property
     def orbits(self):

@@ -14,6 +14,7 @@
 #include "hybridcont/invariant.h"
 #include "study/io/study_document.h"
 #include "study/io/summary_json.h"
+#include "study/stages/regions.h"
 
 namespace hybridcont::study {
 
@@ -458,6 +459,7 @@ StudyResult ResultsWriter::Record() const {
     r.branches.push_back(b);
   }
   r.families = FoldFamilies(r.branches, r.special_points);
+  r.regions = ParameterRegions(r.branches, r.curves, r.curve_parameter, ParameterValue(r, r.curve_parameter));
   r.summary_json = Document().dump(1);
   return r;
 }

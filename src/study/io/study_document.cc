@@ -333,6 +333,7 @@ StudyResult ResultFromSummary(const nlohmann::json& summary, std::map<int, std::
                      [&](const NamedValue& a, const NamedValue& b) { return position(a) < position(b); });
   }
   r.families = FoldFamilies(r.branches, r.special_points);  // derived: summary.json's "families" is not read
+  // Derived too ("regions" is not read); the curves are read after the summary (study_folder.cc) and set them.
   r.summary_json = summary.dump(1);
   return r;
 }

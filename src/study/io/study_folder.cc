@@ -22,6 +22,8 @@
 #include "study/io/results_writer.h"
 #include "study/io/json_fields.h"
 #include "study/io/study_document.h"
+#include "study/io/summary_json.h"
+#include "study/stages/regions.h"
 
 namespace hybridcont {
 
@@ -329,6 +331,8 @@ StudyResult LoadStudy(const std::string& dir_text) {
     }
     StudyResult r = study::ResultFromSummary(summary, std::move(points));
     ReadCurves(summary, dir, &r);
+    r.regions = study::ParameterRegions(r.branches, r.curves, r.curve_parameter,
+                                        study::ParameterValue(r, r.curve_parameter));
     ReadOrbitSamples(summary, dir, &r);
     return r;
   } catch (const std::invalid_argument& e) {

@@ -1,12 +1,14 @@
 #include "study/io/summary_json.h"
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
 #include "hybridcont/orbit_observables.h"
 #include "study/engine/model_exploration.h"
 #include "study/stages/families.h"
+#include "study/stages/regions.h"
 
 namespace hybridcont::study {
 
@@ -241,6 +243,23 @@ nlohmann::json CurvesJson(const std::string& parameter, const std::vector<StudyC
   return list;
 }
 
+nlohmann::json RegionsJson(const std::vector<StudyRegion>& regions) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const StudyRegion& r : regions) {
+    nlohmann::json polygon = nlohmann::json::array();
+    for (const auto& [p, a] : r.polygon) polygon.push_back({p, a});
+    list.push_back({{"family", r.family}, {"kind", r.kind}, {"branch", r.branch}, {"polygon", std::move(polygon)}});
+  }
+  return list;
+}
+
+double ParameterValue(const StudyResult& result, const std::string& name) {
+  for (const NamedValue& v : result.parameters) {
+    if (v.name == name) return v.value;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
 std::string OrbitFileName(int k) { return "orbit-" + std::to_string(k) + ".csv"; }
 
 nlohmann::json OrbitsJson(const std::vector<StudyOrbit>& orbits, int listed) {
@@ -282,6 +301,7 @@ nlohmann::json SummaryJson(const StudyResult& record, const std::map<int, StudyB
     copy.continued = b.continued;
     copy.family = b.family;
     copy.ranges = b.ranges;
+    copy.origin = b.origin;
     ranged.push_back(std::move(copy));
   }
   document["branches"] = std::move(listed);
@@ -294,7 +314,12 @@ nlohmann::json SummaryJson(const StudyResult& record, const std::map<int, StudyB
     document["word_changes"] = WordChangesJson(record.word_changes);
   }
   if (record.parameter_starts) document["starts"] = ParameterStartsJson(*record.parameter_starts);
-  if (!record.curve_parameter.empty()) document["curves"] = CurvesJson(record.curve_parameter, record.curves);
+  if (!record.curve_parameter.empty()) {
+    document["curves"] = CurvesJson(record.curve_parameter, record.curves);
+    // Derived, as the families (LoadStudy computes them again): the regions of the curves' plane.
+    document["regions"] = RegionsJson(
+        ParameterRegions(ranged, record.curves, record.curve_parameter, ParameterValue(record, record.curve_parameter)));
+  }
   if (!record.report.empty()) document["report"] = record.report;
   if (!record.start_note.empty()) document["start_note"] = record.start_note;
   return document;

@@ -53,6 +53,10 @@ nlohmann::json ParameterStartsJson(const StudyParameterStarts& starts);
 nlohmann::json BranchJson(const StudyBranch& b, int rows, const StudyResult& study);
 // The study's two-parameter curves, summary.json's "curves" (parameter_curves.h).
 nlohmann::json CurvesJson(const std::string& parameter, const std::vector<StudyCurve>& curves);
+// "regions": [{"family", "kind" ("physical" | "stable"), "branch", "polygon": [[p, a], ...]}] (regions.h).
+nlohmann::json RegionsJson(const std::vector<StudyRegion>& regions);
+// The value of the model parameter `name` in result.parameters; NaN where it has none.
+double ParameterValue(const StudyResult& result, const std::string& name);
 // The file of the k-th key frame of a results folder: "orbit-<k>.csv".
 std::string OrbitFileName(int k);
 // The first `listed` key frames, summary.json's "orbits": [{"file", "branch", "index", "H", "T", "label",

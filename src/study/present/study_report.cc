@@ -154,37 +154,22 @@ json SpecialPointJson(const StudySpecialPoint& sp, const StudyResult& study) {
 
 // The (p, a) plane of a study with curves (options.curves = p; a the coordinate its families are continued
 // in, H̄ or a free parameter): each curve as (p, a) pairs, and the regions where a family is physical and
-// where stable, wherever both ends of its range are edges
-// known over p: a curve through the end (the curve of that special point, or of one at the same orbit) or
-// the bound of H̄ the branch reached. A range with an end of neither kind (a singular start, a point not
-// located) has no region: its edge over p is not known.
+// where stable (StudyResult::regions, regions.h).
 json PlaneJson(const StudyResult& study) {
   if (study.curves.empty() || study.curve_parameter.empty()) return nullptr;
   double p0 = NAN;
   for (const NamedValue& v : study.parameters) {
     if (v.name == study.curve_parameter) p0 = v.value;
   }
-  struct Edge {
-    std::vector<std::pair<double, double>> points;  // (p, H), sorted by p
-  };
-  std::vector<Edge> curve_edges;
-  json curves = json::array();
-  double p_min = HUGE_VAL, p_max = -HUGE_VAL;
   const std::string a = study.curves.front().columns.empty() ? std::string("H") : study.curves.front().columns.front();
+  json curves = json::array();
   for (const StudyCurve& c : study.curves) {
     const auto h = std::find(c.columns.begin(), c.columns.end(), a) - c.columns.begin();
     const auto q = std::find(c.columns.begin(), c.columns.end(), study.curve_parameter) - c.columns.begin();
-    Edge e;
     json points = json::array();
     if (h < static_cast<long>(c.columns.size()) && q < static_cast<long>(c.columns.size())) {
-      for (const Vector& u : c.points) {
-        e.points.emplace_back(u(q), u(h));
-        points.push_back({Number(u(q)), Number(u(h))});
-        p_min = std::min(p_min, u(q)), p_max = std::max(p_max, u(q));
-      }
+      for (const Vector& u : c.points) points.push_back({Number(u(q)), Number(u(h))});
     }
-    std::sort(e.points.begin(), e.points.end());
-    curve_edges.push_back(std::move(e));
     std::string label = c.name;
     std::string family;
     if (c.special_point >= 0 && c.special_point < static_cast<int>(study.special_points.size())) {
@@ -194,51 +179,11 @@ json PlaneJson(const StudyResult& study) {
     }
     curves.push_back({{"id", c.id}, {"type", c.type}, {"label", label}, {"family", family}, {"points", std::move(points)}});
   }
-  // The edge a range's end lies on: the curve of its special point, else a curve through (p0, value).
-  const auto edge_of = [&](const RangeEnd& end) -> const Edge* {
-    for (std::size_t k = 0; k < study.curves.size(); ++k) {
-      if (end.special_point >= 0 && study.curves[k].special_point == end.special_point) return &curve_edges[k];
-    }
-    for (const Edge& e : curve_edges) {
-      for (const auto& [p, H] : e.points) {
-        if (std::abs(p - p0) <= 1e-9 * (1 + std::abs(p0)) && std::abs(H - end.value) <= 1e-6 * (1 + std::abs(end.value))) {
-          return &e;
-        }
-      }
-    }
-    return nullptr;
-  };
-  const auto bound = [&](const RangeEnd& end) { return end.how.find("bound-reached") != std::string::npos; };
   json regions = json::array();
-  for (const StudyBranch& b : study.branches) {
-    if (b.family.empty() || b.continued != a || !b.origin.empty()) continue;
-    for (const auto& [kind, ranges] : {std::pair<std::string, const std::vector<Range>*>{"physical", &b.ranges.physical},
-                                       {"stable", &b.ranges.stable}}) {
-      for (const Range& r : *ranges) {
-        const Edge* from = edge_of(r.from);
-        const Edge* to = edge_of(r.to);
-        if ((!from && !bound(r.from)) || (!to && !bound(r.to)) || (!from && !to)) continue;
-        // Over the p both edges cover (a bound covers every p of the other edge).
-        const Edge& lower = from ? *from : *to;
-        double lo = lower.points.front().first, hi = lower.points.back().first;
-        if (from && to) lo = std::max(lo, to->points.front().first), hi = std::min(hi, to->points.back().first);
-        if (!(lo < hi)) continue;
-        json polygon = json::array();
-        const auto along = [&](const RangeEnd& end, const Edge* e, bool reversed) {
-          std::vector<std::pair<double, double>> pts;
-          if (e) {
-            for (const auto& pt : e->points) if (pt.first >= lo && pt.first <= hi) pts.push_back(pt);
-          } else {
-            pts = {{lo, end.value}, {hi, end.value}};
-          }
-          if (reversed) std::reverse(pts.begin(), pts.end());
-          for (const auto& [p, H] : pts) polygon.push_back({Number(p), Number(H)});
-        };
-        along(r.from, from, false);
-        along(r.to, to, true);
-        regions.push_back({{"family", b.family}, {"kind", kind}, {"branch", b.id}, {"polygon", std::move(polygon)}});
-      }
-    }
+  for (const StudyRegion& r : study.regions) {
+    json polygon = json::array();
+    for (const auto& [p, level] : r.polygon) polygon.push_back({Number(p), Number(level)});
+    regions.push_back({{"family", r.family}, {"kind", r.kind}, {"branch", r.branch}, {"polygon", std::move(polygon)}});
   }
   return {{"parameter", study.curve_parameter}, {"coordinate", a}, {"value", Number(p0)}, {"curves", std::move(curves)},
           {"regions", std::move(regions)}};
