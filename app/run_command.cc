@@ -77,13 +77,14 @@ StudyOptions StudyOptionsOf(const RunArguments& args) {
 
 // Progress on `out`. On a terminal one line, rewritten in place: the branch, its family, the point and the
 // continued coordinate, the points so far and the time (the number of branches is what the run discovers, so
-// no fraction of the whole is known in advance); each stage's first words on a line of their own. In a pipe,
-// or with --verbose, a line per branch and per accepted point.
+// no fraction of the whole is known in advance); each stage's first words on a line of their own. With
+// --verbose a line per branch and per accepted point. In a pipe (a log, `| less`, a notebook's `!hybridcont`)
+// none without --verbose: the answer is what a reader of the pipe wants.
 StudyHooks PrintingHooks(const RunArguments& args, bool terminal, std::ostream& out, std::ostream& err) {
   StudyHooks hooks;
   hooks.on_note = [&err](const std::string& line) { err << "note: " << line << "\n"; };
   hooks.option_words = FlagOf;
-  if (args.quiet) return hooks;
+  if (args.quiet || (!terminal && !args.verbose)) return hooks;
   auto current = std::make_shared<int>(-1);
   if (terminal && !args.verbose) {
     struct Status {

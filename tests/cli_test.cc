@@ -386,6 +386,20 @@ std::string ReadFile(const fs::path& file) {
 // --threads changes nothing but the wall time. The progress lines, the report and every CSV
 // file are those of --threads 1, byte for byte (the report's wall-time line and the folder aside), in both
 // formulations.
+// In a pipe (a log, `| less`, a notebook's `!hybridcont`) standard output holds the answer alone; a line per
+// point only with --verbose.
+TEST(Cli, InAPipeStandardOutputIsTheAnswerUnlessVerbose) {
+  const fs::path dir = TempDir("pipe_answer");
+  const CliResult plain = RunTool({"run", "slip", "--out", dir.string(), "--no-plots"});
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  EXPECT_EQ(plain.out.find("branch 0\n"), std::string::npos) << plain.out;
+  EXPECT_EQ(plain.out.rfind("\nslip: 5 branches with physical orbits of 23", 0), 0u) << plain.out;
+  const CliResult verbose = RunTool({"run", "slip", "--out", dir.string(), "--no-plots", "--verbose"});
+  ASSERT_EQ(verbose.code, 0) << verbose.err;
+  EXPECT_NE(verbose.out.find("branch 0\n"), std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST(Cli, RunOnTwoThreadsWritesWhatTheSerialRunWrites) {
   for (const auto& [model, formulation] : {std::pair{"bouncing-rod", "time"}, std::pair{"bouncing-ball", "state"}}) {
     SCOPED_TRACE(std::string(model) + " " + formulation);
@@ -394,7 +408,7 @@ TEST(Cli, RunOnTwoThreadsWritesWhatTheSerialRunWrites) {
     for (const int threads : {1, 2}) {
       dirs[threads - 1] = TempDir(std::string("threads_") + model + "_" + std::to_string(threads));
       const CliResult r = RunTool({"run", model, "--formulation", formulation, "--threads", std::to_string(threads),
-                                   "--out", dirs[threads - 1].string(), "--no-plots"});
+                                   "--out", dirs[threads - 1].string(), "--no-plots", "--verbose"});
       ASSERT_EQ(r.code, 0) << r.err;
       std::stringstream lines(r.out);
       for (std::string line; std::getline(lines, line);) {
@@ -402,7 +416,7 @@ TEST(Cli, RunOnTwoThreadsWritesWhatTheSerialRunWrites) {
       }
     }
     EXPECT_EQ(out[0], out[1]);
-    EXPECT_NE(out[0].find("branch 1\n"), std::string::npos) << out[0];  // progress lines are there
+    EXPECT_NE(out[0].find("branch 1\n"), std::string::npos) << out[0];  // progress lines are there (--verbose)
     int files = 0;
     for (const auto& entry : fs::directory_iterator(dirs[0])) {
       if (entry.path().extension() != ".csv") continue;

@@ -336,6 +336,12 @@ def test_one_version():
     rc, out, _ = cli("--version")
     assert hc.__version__ in out
     assert hc.run("bouncing-ball", progress=False).summary["version"] == hc.__version__
+    # The citation names the same version, and the changelog has its entry.
+    source = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+    with open(os.path.join(source, "CITATION.cff")) as f:
+        assert 'version: "%s"' % hc.__version__ in f.read()
+    with open(os.path.join(source, "CHANGELOG.md")) as f:
+        assert "## %s (" % hc.__version__ in f.read()
 
 
 def test_ctrl_c_during_a_model_compile_ends_the_command_at_once(tmp_path):
