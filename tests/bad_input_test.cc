@@ -690,6 +690,26 @@ INSTANTIATE_TEST_SUITE_P(Table, BadInput, ::testing::ValuesIn(Cases()),
                            return name;
                          });
 
+// `text` with its control bytes and the bytes that are no UTF-8 (a hostile argument's) as \xNN: the document
+// stays valid UTF-8 and shows which bytes the row sent.
+std::string Printable(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size();) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    const int length = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xe ? 3 : (c >> 3) == 0x1e ? 4 : 0;
+    bool valid = length > 0 && i + length <= text.size();
+    for (int k = 1; valid && k < length; ++k) valid = (static_cast<unsigned char>(text[i + k]) >> 6) == 0x2;
+    if (valid && !(length == 1 && (c < 0x20 || c == 0x7f))) {
+      out.append(text, i, length);
+      i += length;
+    } else {
+      out += fmt::format("\\x{:02x}", c);
+      ++i;
+    }
+  }
+  return out;
+}
+
 // The table, written as docs/bad-input.md shows it (run with --gtest_also_run_disabled_tests and
 // HYBRIDCONT_BAD_INPUT_MD=path to regenerate the document).
 TEST(BadInputTable, DISABLED_WriteMarkdown) {
@@ -736,8 +756,8 @@ TEST(BadInputTable, DISABLED_WriteMarkdown) {
         args += (args.empty() ? "" : " ") + (a.empty() || a.find(' ') != std::string::npos ? "'" + a + "'" : a);
       }
       std::string message = Replace(c.message, "|", "\\|");
-      md << "- **" << c.name << "** `" << (c.tool == Tool::kScript ? "hybridcont_plot.py" : "hybridcont") << " " << args
-         << "` → exit " << c.exit_code << (message.empty() ? "" : ": `" + message + "`") << "\n";
+      md << "- **" << c.name << "** `" << (c.tool == Tool::kScript ? "hybridcont_plot.py" : "hybridcont") << " "
+         << Printable(args) << "` → exit " << c.exit_code << (message.empty() ? "" : ": `" + message + "`") << "\n";
     }
   }
   // What a row of one command cannot show: a state made by an earlier command, a process killed. Each has its test.

@@ -54,15 +54,18 @@ def _options(model_name, out, **options):
 
 
 def _options_help():
-    """The options of ``run`` as the library declares them, one paragraph each (its docstring)."""
+    """The options of ``run`` as the library declares them (its docstring): an RST definition list, one entry each."""
+    import re
     import textwrap
     lines = []
     for spec in native.study_options():
         if spec["keyword"] in ("model", "out"):
             continue
         default = "" if spec["default"] in (None, False, "", [], {}) else " (default %r)" % (spec["default"],)
-        lines.append(textwrap.fill("%s%s: %s" % (spec["keyword"], default, spec["help"]), width=100,
-                                   initial_indent="      ", subsequent_indent="          "))
+        # A keyword's trailing underscore (from_, as_) would be a reference in RST.
+        text = re.sub(r"(?<=\w)_(?=\W|$)", r"\\_", spec["help"] + default)
+        lines.append("    ``%s``" % spec["keyword"])
+        lines.append(textwrap.fill(text, width=100, initial_indent="        ", subsequent_indent="        "))
     return "\n".join(lines)
 
 
@@ -79,13 +82,18 @@ def run(model, out=None, progress=True, report=True, **options):
     """Runs a study of ``model`` (a name, a model file's path, or a Model) and returns its Study.
 
     Keyword arguments are the options of ``hybridcont run`` (the library declares them; values as
-    set={"k": 60}, until={"H": 1.8}, bound={"H": (0, None)}, monitor={"speed": [0.5, 0.8]}, fix={"H": 1.5},
-    from_=a Study or a folder, families_of=a Study or a folder; threads default to every core):
+    ``set={"k": 60}``, ``until={"H": 1.8}``, ``bound={"H": (0, None)}``, ``monitor={"speed": [0.5, 0.8]}``,
+    ``fix={"H": 1.5}``, ``from_=`` a Study or a folder, ``families_of=`` a Study or a folder; threads default to
+    every core):
+
 {options}
-      out="results/slip"              the results folder (default: a temporary one)
-    progress: True shows a bar (tqdm where installed, else lines), False nothing, or a callable
-    f(stage, branches, points, message) called as the study goes.
-    report: write report.html into the folder (2 MB: a sweep's grid points do without).
+    ``out``
+        the results folder, e.g. ``"results/slip"`` (default: a temporary one)
+    ``progress``
+        True shows a bar (tqdm where installed, else lines), False nothing, or a callable
+        ``f(stage, branches, points, message)`` called as the study goes.
+    ``report``
+        write report.html into the folder (2 MB: a sweep's grid points do without).
 
     Bad input raises ValueError with the library's message; a numerical failure is the study's status.
     Ctrl-C ends the study after its current step: status "cancelled", the work so far kept (and warned)."""
@@ -347,6 +355,59 @@ class Study:
         return Study(path, model=self.model)
 
     # ---- pictures ----------------------------------------------------------------------------------------
+    def diagram(self, x=None, y="T", ax=None):
+        """The bifurcation diagram as a matplotlib figure (returned; nothing is written): column ``y`` over column
+        ``x`` (default: the coordinate the families are continued in) of every branch, its physical stretches in
+        its family's colour (thick where stable), the rest thin and grey, and the located special points of the
+        physical stretches labelled at their markers. ``ax``: draw into these axes instead of a new figure."""
+        import matplotlib.pyplot as plt
+        points = self.points
+        if x is None:
+            x = self._rows["branches"][0]["continued"] if self._rows["branches"] else "H"
+        for column in (x, y):
+            if column not in points.columns:
+                raise ValueError("diagram: no column '%s' (the points have %s)" % (column, ", ".join(points.columns)))
+        if ax is None:
+            fig, ax = plt.subplots(figsize=(7.0, 4.4))
+        else:
+            fig = ax.figure
+        families = sorted({f for f in points["family"] if isinstance(f, str) and f})
+        colours = dict(zip(families, plt.rcParams["axes.prop_cycle"].by_key()["color"] * 4))
+        labelled = set()
+        for _, branch in points.groupby("branch"):
+            ax.plot(branch[x], branch[y], color="0.75", lw=0.8, zorder=1)
+            physical = branch["physical"].astype(bool)
+            stable = physical & (branch["stable"].astype(str).str.lower().isin(["1", "true", "1.0"]))
+            for mask, width in ((physical, 1.6), (stable, 3.0)):
+                part = branch[x].where(mask), branch[y].where(mask)
+                family = next((f for f in branch["family"] if isinstance(f, str) and f), None)
+                label = family if width < 2 and family and family not in labelled else None
+                if label:
+                    labelled.add(family)
+                ax.plot(*part, color=colours.get(family, "0.3"), lw=width, zorder=2, label=label)
+        # Located special points on physical stretches; points that coincide share one marker and one label.
+        physical_at = {(b, i) for b, i, ph in zip(points["branch"], points["index"], points["physical"]) if ph}
+        marks = {}
+        for _, sp in self.special_points.iterrows():
+            if sp["status"] != "located" or sp["type"] == "start" or x not in sp or y not in sp:
+                continue
+            xv, yv = sp.get(x), sp.get(y)
+            on_physical = (sp["branch"], sp["index"]) in physical_at or (sp["branch"], sp["index"] + 1) in physical_at
+            if not (on_physical and np.isfinite(xv) and np.isfinite(yv)):
+                continue
+            key = (round(float(xv), 6), round(float(yv), 6))
+            marks.setdefault(key, (xv, yv, []))[2].append(sp["label"])
+        for xv, yv, labels in marks.values():
+            ax.plot([xv], [yv], "o", ms=4, mfc="white", mec="black", zorder=3)
+            ax.annotate(" = ".join(labels), (xv, yv), textcoords="offset points", xytext=(4, 4), fontsize=7)
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+        ax.grid(True, color="0.92", lw=0.6)
+        if labelled:
+            ax.legend(fontsize=8, frameon=False)
+        ax.set_title("%s: %s over %s (thick: stable)" % (self.model_name, y, x), fontsize=10)
+        return fig
+
     def plot(self, x=None, y=None, svg=False, pdf=False, all=False):
         """The figures of ``hybridcont plot`` written into the folder (or, with x and y, the diagram of column
         y over column x); returns their paths."""
