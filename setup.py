@@ -1,7 +1,8 @@
 """Builds the Python package with CMake (pyproject.toml declares it; `pip install .` runs this).
 
-The extension module and the package's data are what CMake lays out in <build>/python/hybridcont (target
-hybridcont_python_package, CMakeLists.txt); this copies that folder into the wheel. The build folder is
+The extension module, the command-line tool (data/bin/hybridcont, run by the `hybridcont` command) and the
+package's data are what CMake lays out in <build>/python/hybridcont (target hybridcont_python_package,
+CMakeLists.txt); this copies that folder into the wheel. The build folder is
 setuptools' temporary one, or HYBRIDCONT_CMAKE_BUILD_DIR (an existing build tree: only what changed is
 rebuilt). CMake builds for the interpreter running pip (Python_EXECUTABLE). HYBRIDCONT_PREBUILT_PACKAGE (a
 package folder a build laid out) installs that folder as it is, without CMake: the tests' way of checking
@@ -39,7 +40,7 @@ class CMakeBuild(build_ext):
         if not os.path.exists(os.path.join(build, "CMakeCache.txt")):
             generator = ["-G", "Ninja"] if shutil.which("ninja") else []
             subprocess.run(["cmake", "-S", ROOT, "-B", build, *generator, "-DCMAKE_BUILD_TYPE=Release",
-                            "-DBUILD_TESTING=OFF", "-DHYBRIDCONT_BUILD_BENCH=OFF", "-DHYBRIDCONT_BUILD_CLI=OFF",
+                            "-DBUILD_TESTING=OFF", "-DHYBRIDCONT_BUILD_BENCH=OFF",
                             "-DPython_EXECUTABLE=" + sys.executable], check=True)
         else:  # an existing build tree: for this interpreter (a reconfigure that changes nothing is quick)
             subprocess.run(["cmake", build, "-DPython_EXECUTABLE=" + sys.executable], check=True,

@@ -34,6 +34,15 @@ DataLocation Locate() {
   const fs::path executable = fs::read_symlink("/proc/self/exe", ec);  // symlinks already resolved
   if (ec || executable.empty()) return {};
   const fs::path exe_dir = executable.parent_path();
+  // The executable a Python package carries (a wheel: hybridcont/data/bin/hybridcont) reads the package's data.
+  if (exe_dir.filename() == "bin" && exe_dir.parent_path().filename() == "data" &&
+      exe_dir.parent_path().parent_path().filename() == "hybridcont") {
+    const fs::path data = exe_dir.parent_path();
+    const fs::path report = data / "report";
+    return {data / "hybridcont_plot.py", data / "models",
+            {report / "template.html", report / "viewer.js", report / "viewer.css", report / "plotly-basic.min.js"},
+            data.parent_path().parent_path()};
+  }
   // equivalent() is false (with ec set) once the build directory is gone: the executable is then not in it.
   if (fs::equivalent(exe_dir, fs::path(HYBRIDCONT_BUILD_BIN_DIR), ec)) {
     const fs::path source = HYBRIDCONT_SOURCE_TREE;

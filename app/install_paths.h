@@ -12,6 +12,10 @@
 //    ${CMAKE_INSTALL_DATADIR}/hybridcont fixed at configure time (usually ../share/hybridcont). Relative, so
 //    it holds for a prefix chosen at install time (`cmake --install build --prefix P`) and for an
 //    installation moved as a whole.
+//  - the executable of a Python package (a wheel's hybridcont/data/bin/hybridcont, run by the package's
+//    `hybridcont` command) reads the package's data: hybridcont/data/{hybridcont_plot.py, models, report}, and
+//    the package itself from the folder holding hybridcont/ (model files compile against
+//    hybridcont/data/include, model_compiler.cc: <exe dir>/../include).
 // So an installed executable never reads the source tree it was built from, even while that still exists.
 // `hybridcont --paths` prints both paths.
 #ifndef HYBRIDCONT_APP_INSTALL_PATHS_H_

@@ -22,3 +22,10 @@ file(COPY ${SOURCE}/report/template.html ${SOURCE}/report/viewer.js ${SOURCE}/re
 if(PLOTLY_JS AND EXISTS ${PLOTLY_JS})
   file(COPY ${PLOTLY_JS} DESTINATION ${DEST}/data/report)
 endif()
+# The command-line tool and the headers model files compile against (a wheel carries both: its `hybridcont` command
+# runs data/bin/hybridcont, which reads this folder's data; app/install_paths.h), where the build made the tool.
+if(CLI AND EXISTS ${CLI})
+  file(COPY ${CLI} DESTINATION ${DEST}/data/bin FILE_PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE GROUP_READ
+       GROUP_EXECUTE WORLD_READ WORLD_EXECUTE)
+  file(COPY ${SOURCE}/include/hybridcont DESTINATION ${DEST}/data/include)
+endif()
