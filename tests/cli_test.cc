@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <regex>
 #include <sstream>
 #include <utility>
 
@@ -241,8 +242,10 @@ bounds = { gamma = [0.0, 0.3], period = [0, 200] }
 )toml";
   const CliResult r = RunTool({"run", (dir / "wheel.toml").string(), "--out", (dir / "out").string(), "--no-plots"});
   EXPECT_EQ(r.code, 1) << r.err;
-  EXPECT_NE(r.out.find("no start point: start 1: event-driven simulation did not settle"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("the event stays above 0, where a phase goes on: is its sign the intended one?"),
+  // The answer wraps its lines at 100 characters: read as one text.
+  const std::string out = std::regex_replace(r.out, std::regex("\n +"), " ");
+  EXPECT_NE(out.find("no start point: start 1: event-driven simulation did not settle"), std::string::npos) << r.out;
+  EXPECT_NE(out.find("the event stays above 0, where a phase goes on: is its sign the intended one?"),
             std::string::npos) << r.out;
   fs::remove_all(dir);
 }
@@ -394,6 +397,8 @@ TEST(Cli, InAPipeStandardOutputIsTheAnswerUnlessVerbose) {
   ASSERT_EQ(plain.code, 0) << plain.err;
   EXPECT_EQ(plain.out.find("branch 0\n"), std::string::npos) << plain.out;
   EXPECT_EQ(plain.out.rfind("\nslip: 5 branches with physical orbits of 23", 0), 0u) << plain.out;
+  std::stringstream lines(plain.out);
+  for (std::string line; std::getline(lines, line);) EXPECT_LE(line.size(), 100u) << line;  // a terminal's width
   const CliResult verbose = RunTool({"run", "slip", "--out", dir.string(), "--no-plots", "--verbose"});
   ASSERT_EQ(verbose.code, 0) << verbose.err;
   EXPECT_NE(verbose.out.find("branch 0\n"), std::string::npos);

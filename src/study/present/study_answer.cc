@@ -123,6 +123,30 @@ std::string RepeatedWordNote(const StudyResult& study) {
                      list);
 }
 
+// The answer's lines at most kAnswerWidth characters (a terminal's, a log's, a notebook cell's): a longer line is
+// broken at its last space before the width, its continuation indented two more than the line.
+constexpr std::size_t kAnswerWidth = 100;
+
+std::string WrapLines(const std::string& text) {
+  std::string out;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = std::min(text.find('\n', start), text.size());
+    std::string line = text.substr(start, end - start);
+    const std::string indent(line.find_first_not_of(' ') == std::string::npos ? 0 : line.find_first_not_of(' ') + 2,
+                             ' ');
+    while (line.size() > kAnswerWidth) {
+      const std::size_t cut = line.rfind(' ', kAnswerWidth);
+      if (cut == std::string::npos || cut <= indent.size()) break;  // one word longer than the width: left whole
+      out += line.substr(0, cut) + "\n";
+      line = indent + line.substr(cut + 1);
+    }
+    out += line + (end < text.size() ? "\n" : "");
+    start = end + 1;
+  }
+  return out;
+}
+
 // "largest speed 0.853": an EX point's observable, which extreme, and its value there.
 std::string ExtremumText(const StudySpecialPoint& sp) {
   double value = std::numeric_limits<double>::quiet_NaN();
@@ -265,10 +289,10 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
   if (study.status != ExplorationStatus::kCompleted) {
     out += fmt::format("\nThe run did not complete ({}): {}\n", ToString(study.status), study.message);
   }
-  out += "Every branch, special point and switch: --verbose, or \"report\" in summary.json; restart from a label "
-         "with --from DIR --at LABEL.\n";
+  out += "Every branch, special point and switch: --verbose, or \"report\" in summary.json;\n"
+         "restart from a label with --from DIR --at LABEL.\n";
   out += fmt::format("wall time {:.3f} s\n", seconds);
-  return out;
+  return WrapLines(out);
 }
 
 }  // namespace hybridcont
