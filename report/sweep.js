@@ -23,7 +23,7 @@
   function markerSize() {
     const el = document.getElementById('map');
     const nx = data.grid[names[0]].length, ny = names.length > 1 ? data.grid[names[1]].length : 1;
-    return Math.max(4, Math.min((el.clientWidth - 160) / nx, (el.clientHeight - 90) / ny) * 0.92);
+    return Math.max(4, Math.min((el.clientWidth - 160) / nx, (el.clientHeight - 120) / ny));  // cells that touch
   }
   // "physical 1.2 .. 1.4, 1.6 .. 1.9": every disjoint interval of the table's "a..b;c..d".
   function ranges(kind, text) {
@@ -57,7 +57,9 @@
                             showscale: true, colorbar: {title: {text: colour.replace('_', ' ')}}}});
     }
     Plotly.react('map', traces, {
-      margin: {l: 60, r: 10, t: 10, b: 50}, hovermode: 'closest', legend: {font: {size: 11}},
+      // The legend in a row above the plot, left of the toolbar (top right): never under it.
+      margin: {l: 60, r: 10, t: 40, b: 50}, hovermode: 'closest',
+      legend: {font: {size: 11}, orientation: 'h', x: 0, xanchor: 'left', y: 1.02, yanchor: 'bottom'},
       showlegend: colour === 'class',  // the classes present, even when only one is
       xaxis: {title: {text: names[0]}, zeroline: false},
       yaxis: names.length > 1 ? {title: {text: names[1]}, zeroline: false} : {visible: false},

@@ -174,15 +174,20 @@
     canvas.dataset.frames = frames.length;
   }
 
-  // The selected point: its values, class, stability and multipliers.
-  function select(branchId, index) {
+  // The selected point: its values, class, stability and multipliers. `note`: what the point stands for when it
+  // is not the one asked for (a special point lies between two computed points: the one before it is shown).
+  function select(branchId, index, note) {
     const b = branchById.get(branchId);
     if (!b) return;
     document.getElementById('hint').hidden = true;
     const rows = [['branch', b.id + (b.family ? ' · ' + b.family : '')], ['point', index],
                   ['class', b.classification[index]], ['stability', b.stability[index] || '—']];
+    if (note) rows.unshift(['shown', note]);
     if (b.word && b.word.length) rows.splice(1, 0, ['word', b.word.join(' > ')]);
-    for (const name of Object.keys(b.columns)) rows.push([name, fmt(b.columns[name][index])]);
+    // A value below the integration's resolution (|v| < 1e-12, e.g. a state that is zero by symmetry and comes
+    // out as 1e-110) is shown as 0.
+    const shown = (v) => (typeof v === 'number' && Math.abs(v) < 1e-12 ? '0' : fmt(v));
+    for (const name of Object.keys(b.columns)) rows.push([name, shown(b.columns[name][index])]);
     const table = document.createElement('table');
     for (const [k, v] of rows) {
       const tr = table.insertRow();
@@ -208,8 +213,10 @@
     }
     const lim = Math.max(1.3, ...(mu || []).map((m) => Math.hypot(m[0], m[1]) * 1.1));
     Plotly.react('multipliers', traces, {
-      title: {text: mu ? 'Floquet multipliers' : 'no multipliers (not physical)', font: {size: 12}},
-      showlegend: false, margin: {l: 30, r: 10, t: 30, b: 30},
+      // The title left, below the top margin that holds the toolbar (which sits at the top right).
+      title: {text: mu ? 'Floquet multipliers' : 'no multipliers (not physical)', font: {size: 12}, x: 0.02,
+              xanchor: 'left', y: 0.97, yanchor: 'top'},
+      showlegend: false, margin: {l: 30, r: 10, t: 48, b: 30},
       xaxis: {range: [-lim, lim], zeroline: true}, yaxis: {range: [-lim, lim], scaleanchor: 'x', zeroline: true},
     }, {displaylogo: false, responsive: true});
   }
@@ -228,7 +235,7 @@
       tr.addEventListener('click', () => {
         for (const other of table.querySelectorAll('tr.selected')) other.classList.remove('selected');
         tr.classList.add('selected');
-        select(row.branch, row.index);
+        select(row.branch, row.index, row.note);
       });
     }
   }
@@ -249,8 +256,11 @@
   fillTable('special-points', ['label', 'branch', 'family', 'coordinate', 'T', 'status', 'precision'],
             specialPoints.map((sp) => {
               const b = branchById.get(sp.branch);
+              const index = Math.min(sp.index, b.physical.length - 1);
               return {
-                branch: sp.branch, index: Math.min(sp.index, b.physical.length - 1),
+                branch: sp.branch, index,
+                note: 'point ' + index + ', the computed point before ' + sp.label + ' (which lies between points ' +
+                      sp.index + ' and ' + (sp.index + 1) + ')',
                 cells: [sp.label, sp.branch, b.family || '—', b.continued + ' = ' + fmt(sp.coordinate), fmt(sp.T),
                         sp.status, typeof sp.precision === 'number' ? sp.precision.toExponential(1) : '—'],
               };

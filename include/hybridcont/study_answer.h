@@ -19,6 +19,10 @@ namespace hybridcont {
 // `seconds`: the wall time of the computation, its last line.
 std::string OneScreenAnswer(const StudyResult& study, double seconds);
 
+// How a range's end is known, as the answer and the report say it: a special point's label ("PD4", with ", not
+// located" where it was only bracketed), else the end's own words ("end of the branch, bound-reached").
+std::string RangeEndText(const RangeEnd& end, const std::vector<StudySpecialPoint>& special_points);
+
 }  // namespace hybridcont
 
 #endif  // HYBRIDCONT_STUDY_ANSWER_H_

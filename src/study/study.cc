@@ -337,7 +337,10 @@ ExploredFamilies ExploreFamilies(const HybridModel& model, const RunSetup& setup
     }
   } else if (setup.free.empty()) {
     out.starts_report = exploration.start_report();
-    if (!out.starts_report.empty()) say("start", out.starts_report);  // how far Newton moved a guess
+    if (!out.starts_report.empty()) {  // how far Newton moved a guess: said now, and in the answer
+      say("start", out.starts_report);
+      writer.AppendStartNote(out.starts_report);
+    }
     diagram = exploration.Run(on_point);
   } else if (model.num_first_integrals() == 0) {  // the family in the parameter from the model's start
     const OrbitStarts starts = FindOrbitStarts(model, setup, layout);

@@ -4,6 +4,7 @@ Environment: PYTHONPATH holds the built package (build/python), HYBRIDCONT_BIN t
 """
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -107,7 +108,7 @@ def test_the_options_are_the_librarys_declaration_in_pythons_words(capsys):
     specs = native.study_options()
     for spec in specs:  # run's docstring is the declaration
         if spec["keyword"] not in ("model", "out"):
-            assert "\n      %s" % spec["keyword"] in hc.run.__doc__, spec["keyword"]
+            assert "\n    ``%s``" % spec["keyword"] in hc.run.__doc__, spec["keyword"]
     with pytest.raises(TypeError, match="unexpected keyword argument 'untill'"):
         hc.run("slip", untill={"H": 1}, progress=False)
     with pytest.raises(ValueError, match=r"^fix 'H=1.5': needs free PARAMETER"):
@@ -253,8 +254,8 @@ def test_every_family_of_a_restart_is_in_the_answer_the_tables_and_the_folder(tm
     stable = families[families.kind == "stable"].iloc[0]
     assert physical["from"] == pytest.approx(1.282699643, abs=1e-7) and physical["to"] == pytest.approx(1.427197748, abs=1e-8)
     assert stable["to"] == pytest.approx(1.282809324, abs=1e-8)
-    assert "  %s: physical H %.10g .. %.10g; stable H %.10g .. %.10g" % (
-        name, physical["from"], physical["to"], stable["from"], stable["to"]) in str(doubled)
+    assert "%s: physical H %.10g .. %.10g; stable H %.10g .. %.10g" % (
+        name, physical["from"], physical["to"], stable["from"], stable["to"]) in re.sub(r"\n +", " ", str(doubled))
     assert doubled.summary["families"][0]["physical"][0]["from"] == physical["from"]
     rows = family_rows(doubled, "0", {"k": 40.0})
     assert [r["exists"] for r in rows if r["family"] == "hopping in place"] == [False]  # the model's, not here

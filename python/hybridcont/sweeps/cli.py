@@ -126,4 +126,19 @@ def main(argv=None):
         return 1
     points = table["point"].nunique() if len(table) else 0
     print("%d grid points, %d rows: %s" % (points, len(table), os.path.join(os.path.abspath(out), "table.csv")))
+    print(found_line(table, points))
     return 0
+
+
+def found_line(table, points):
+    """What the sweep found, per family: at how many grid points it has physical orbits and at how many stable
+    ones ("found: hopping in place physical at 16 of 16 grid points, stable at 12; ..."); "found: no family" where
+    no grid point holds one."""
+    if not len(table) or "family" not in table.columns:
+        return "found: no family"
+    said = []
+    for family, rows in table[table.exists.astype(bool)].groupby("family", sort=False):
+        physical = rows[rows.physical.astype(bool)]["point"].nunique()
+        stable = rows[rows.stable.astype(bool)]["point"].nunique()
+        said.append("%s physical at %d of %d grid points, stable at %d" % (family, physical, points, stable))
+    return "found: " + ("; ".join(said) if said else "no family")

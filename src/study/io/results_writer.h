@@ -31,6 +31,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -144,6 +145,18 @@ class ResultsWriter {
                        const std::string& label, const Matrix& monodromy = Matrix());
   void SetReport(const std::string& report);
   void SetStartNote(const std::string& note) { record_.start_note = note; }
+  // More of it (how far Newton moved a start that was a guess): each line not said yet, in order.
+  void AppendStartNote(const std::string& text) {
+    std::size_t start = 0;
+    while (start < text.size()) {
+      const std::size_t end = std::min(text.find('\n', start), text.size());
+      const std::string line = text.substr(start, end - start);
+      if (!line.empty() && record_.start_note.find(line) == std::string::npos) {
+        record_.start_note += (record_.start_note.empty() ? "" : "\n") + line;
+      }
+      start = end + 1;
+    }
+  }
   // Rewrites summary.json atomically; false (and write_error() set) when it could not be written.
   bool WriteSummary();
   // The final summary: "status": "complete", or "cancelled" for a study stopped on request. False when it

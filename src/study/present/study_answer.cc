@@ -25,12 +25,7 @@ double Coordinate(const StudyBranch& b, const Vector& u) {
 
 // "1.2828 .. 1.6144  (PD4 .. BP6)" for a range: the values and how each end is known.
 std::string RangeText(const Range& r, const std::vector<StudySpecialPoint>& special) {
-  const auto end = [&](const RangeEnd& e) {
-    if (e.special_point >= 0 && e.special_point < static_cast<int>(special.size())) {
-      return special[e.special_point].Label() + (e.located ? "" : ", not located");
-    }
-    return e.how;
-  };
+  const auto end = [&](const RangeEnd& e) { return RangeEndText(e, special); };
   const double lo = std::min(r.from.value, r.to.value), hi = std::max(r.from.value, r.to.value);
   const bool forward = r.from.value <= r.to.value;
   return fmt::format("{:.10g} .. {:.10g}   ({} .. {})", lo, hi, end(forward ? r.from : r.to), end(forward ? r.to : r.from));
@@ -147,6 +142,31 @@ std::string WrapLines(const std::string& text) {
   return out;
 }
 
+// Whether two located points of branch b are one point: the coordinate and the period agree within the larger of
+// their precisions (and 1e-9 relative). EX points keep their own lines (they say their observable's value).
+bool Coincide(const StudyBranch& b, const StudySpecialPoint& p, const StudySpecialPoint& q) {
+  if (p.type == SpecialPointType::kExtremum || q.type == SpecialPointType::kExtremum || p.status != "located" ||
+      q.status != "located") {
+    return false;
+  }
+  const double x = Coordinate(b, p.u), y = Coordinate(b, q.u);
+  const double tolerance = std::max({p.precision, q.precision, 1e-9 * (1 + std::abs(x))});
+  return std::abs(x - y) <= tolerance && std::abs(p.T - q.T) <= std::max(tolerance, 1e-9 * (1 + std::abs(p.T)));
+}
+
+// What a special point's code says, in a few words (the README's table, special-point codes).
+std::string CodeMeaning(const std::string& code) {
+  static const std::map<std::string, std::string> kMeaning = {
+      {"SB", "families cross"},        {"TP", "a fold"},
+      {"BP", "a multiplier at +1"},    {"PD", "a multiplier at -1"},
+      {"NS", "a pair on the circle"},  {"KC", "two pairs collide"},
+      {"GR", "an event grazed"},       {"CB", "a constraint at 0"},
+      {"ZD", "a phase vanishes"},      {"UZ", "a monitored value"},
+      {"EX", "an extremum"}};
+  const auto it = kMeaning.find(code);
+  return it == kMeaning.end() ? code : it->second;
+}
+
 // "largest speed 0.853": an EX point's observable, which extreme, and its value there.
 std::string ExtremumText(const StudySpecialPoint& sp) {
   double value = std::numeric_limits<double>::quiet_NaN();
@@ -159,6 +179,13 @@ std::string ExtremumText(const StudySpecialPoint& sp) {
 
 }  // namespace
 
+std::string RangeEndText(const RangeEnd& e, const std::vector<StudySpecialPoint>& special) {
+  if (e.special_point >= 0 && e.special_point < static_cast<int>(special.size())) {
+    return special[e.special_point].Label() + (e.located ? "" : ", not located");
+  }
+  return e.how;
+}
+
 std::string OneScreenAnswer(const StudyResult& study, double seconds) {
   std::string out;
   int points = 0, physical_branches = 0;
@@ -168,6 +195,12 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
   }
   out += fmt::format("\n{}: {} branch{} with physical orbits of {} ({} points)\n", study.model, physical_branches,
                      physical_branches == 1 ? "" : "es", study.branches.size(), points);
+  // The parameter values it was computed at: the answer holds for these.
+  if (!study.parameters.empty()) {
+    std::string values;
+    for (const NamedValue& p : study.parameters) values += fmt::format("{}{} = {:.6g}", values.empty() ? "" : ", ", p.name, p.value);
+    out += "at " + values + "\n";
+  }
   if (!study.start_note.empty()) out += study.start_note + "\n";
   // The families over all their branches (FoldFamilies): what a sweep's table and Python's families say.
   if (!study.families.empty()) {
@@ -239,11 +272,35 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
     if (image_of_family) continue;
     // Its located special points on physical stretches, and where other families leave them.
     std::string located, leads;
+    std::vector<const StudySpecialPoint*> listed;
     for (const StudySpecialPoint& sp : study.special_points) {
       if (sp.branch != b.id || sp.duplicate_of >= 0 || sp.code == "start" || !b.OnPhysicalStretch(sp.index)) continue;
-      located += fmt::format("    {:<6} {} = {:.10g}  T = {:.10g}  {}{}\n", sp.Label(), c, Coordinate(b, sp.u), sp.T,
-                             sp.status == "located" ? fmt::format("(to {:.1e})", sp.precision) : "(" + sp.status + ")",
-                             sp.type == SpecialPointType::kExtremum ? "  " + ExtremumText(sp) : std::string());
+      listed.push_back(&sp);
+    }
+    // Points that coincide (within their precision: an SB point of a physical family is always a BP point too)
+    // are one line, their labels joined, with what each says.
+    for (std::size_t i = 0; i < listed.size();) {
+      std::size_t j = i + 1;
+      while (j < listed.size() && Coincide(b, *listed[i], *listed[j])) ++j;
+      const StudySpecialPoint& sp = *listed[i];
+      std::string labels, meanings;
+      double precision = 0;
+      bool all_located = true;
+      for (std::size_t k = i; k < j; ++k) {
+        labels += (k > i ? " = " : "") + listed[k]->Label();
+        meanings += (k > i ? ", " : "") + CodeMeaning(listed[k]->code);
+        precision = std::max(precision, listed[k]->precision);
+        all_located = all_located && listed[k]->status == "located";
+      }
+      if (j - i > 1) labels += " ";  // "SB1 = BP2 = PD3  H = ..."
+      located += fmt::format("    {:<6} {} = {:.10g}  T = {:.10g}  {}{}\n", labels, c, Coordinate(b, sp.u), sp.T,
+                             all_located ? fmt::format("(to {:.1e})", precision) : "(" + sp.status + ")",
+                             j - i > 1 ? ": " + meanings
+                             : sp.type == SpecialPointType::kExtremum ? "  " + ExtremumText(sp) : std::string());
+      i = j;
+    }
+    for (const StudySpecialPoint* listed_point : listed) {
+      const StudySpecialPoint& sp = *listed_point;
       const auto it = children.find(sp.id);
       if (it == children.end()) continue;
       std::vector<std::string> names;

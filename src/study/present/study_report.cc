@@ -20,6 +20,7 @@
 #include "hybridcont/classification.h"
 #include "hybridcont/orbit_trace.h"
 #include "hybridcont/setup_evaluation.h"
+#include "hybridcont/study_answer.h"
 
 namespace hybridcont {
 
@@ -30,11 +31,14 @@ using nlohmann::json;
 // A number as JSON: NaN and infinities (undefined values) as null.
 json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
-json RangesJson(const std::vector<Range>& ranges) {
+// Each end said as the answer says it (RangeEndText: "PD4", not the engine's "PD #4, located to ...", whose
+// precision is the arclength's, not the table's).
+json RangesJson(const std::vector<Range>& ranges, const std::vector<StudySpecialPoint>& special_points) {
   json out = json::array();
   for (const Range& r : ranges) {
-    out.push_back({{"from", Number(r.from.value)}, {"to", Number(r.to.value)}, {"how_from", r.from.how},
-                   {"how_to", r.to.how}, {"first_point", r.first_point}, {"last_point", r.last_point}});
+    out.push_back({{"from", Number(r.from.value)}, {"to", Number(r.to.value)},
+                   {"how_from", RangeEndText(r.from, special_points)}, {"how_to", RangeEndText(r.to, special_points)},
+                   {"first_point", r.first_point}, {"last_point", r.last_point}});
   }
   return out;
 }
@@ -81,7 +85,7 @@ json AnimationJson(const StudyBranch& b, const HybridModel& model, const OrbitPr
   return frames;
 }
 
-json BranchJson(const StudyBranch& b) {
+json BranchJson(const StudyBranch& b, const std::vector<StudySpecialPoint>& special_points) {
   json columns = json::object();
   for (std::size_t k = 0; k < b.unknown_names.size(); ++k) {
     json values = json::array();
@@ -132,7 +136,8 @@ json BranchJson(const StudyBranch& b) {
           {"classification", std::move(classification)},
           {"stability", std::move(stability)},
           {"multipliers", std::move(multipliers)},
-          {"ranges", {{"physical", RangesJson(b.ranges.physical)}, {"stable", RangesJson(b.ranges.stable)}}}};
+          {"ranges", {{"physical", RangesJson(b.ranges.physical, special_points)},
+                      {"stable", RangesJson(b.ranges.stable, special_points)}}}};
 }
 
 json SpecialPointJson(const StudySpecialPoint& sp, const StudyResult& study) {
@@ -242,7 +247,7 @@ std::string StudyReportData(const StudyResult& study, const HybridModel* model) 
     }
   }
   for (const StudyBranch& b : study.branches) {
-    json branch = BranchJson(b);
+    json branch = BranchJson(b, study.special_points);
     // The study's own model, its families in H̄ (the orbit's unknowns alone) or in a parameter (its last
     // unknown): a period-doubled family or another word runs on another model.
     const bool continued_last = !b.unknown_names.empty() && b.unknown_names.back() == b.continued;
