@@ -131,8 +131,8 @@ def main(argv=None):
 
 
 def found_line(table, points):
-    """What the sweep found, per family: at how many grid points it has physical orbits and at how many stable
-    ones ("found: hopping in place physical at 16 of 16 grid points, stable at 12; ..."); "found: no family" where
+    """What the sweep found, a line per family: at how many grid points it has physical orbits and at how many
+    stable ones ("  hopping in place: physical at 16 of 16 grid points, stable at 12"); "found: no family" where
     no grid point holds one."""
     if not len(table) or "family" not in table.columns:
         return "found: no family"
@@ -140,5 +140,5 @@ def found_line(table, points):
     for family, rows in table[table.exists.astype(bool)].groupby("family", sort=False):
         physical = rows[rows.physical.astype(bool)]["point"].nunique()
         stable = rows[rows.stable.astype(bool)]["point"].nunique()
-        said.append("%s physical at %d of %d grid points, stable at %d" % (family, physical, points, stable))
-    return "found: " + ("; ".join(said) if said else "no family")
+        said.append("  %s: physical at %d of %d grid points, stable at %d" % (family, physical, points, stable))
+    return "found:\n" + "\n".join(said) if said else "found: no family"
