@@ -67,13 +67,24 @@
       traces.push({
         type: 'scatter', mode: 'lines+markers', x: xs, y: ys, text: text, customdata: custom,
         hovertemplate: '%{text}<extra></extra>', connectgaps: false,
-        name: (b.family || 'branch ' + b.id) + ' · ' + kind.name,
-        legendgroup: b.family || 'none', showlegend: false,
+        name: kind.name === 'not physical' ? 'not physical' : (b.family || 'branch ' + b.id),
+        meta: kind.name,  // which stretches: 'not physical', 'physical' or 'stable'
+        // One legend entry per family (its first physical stretch drawn), the family's stretches grouped under it.
+        legendgroup: kind.name === 'not physical' ? 'not physical' : (b.family || 'none'),
+        showlegend: legendShown(kind.name === 'not physical' ? 'not physical' : (b.family || 'branch ' + b.id)),
         line: {color: kind.name === 'not physical' ? NONPHYSICAL : colourOf(b.family), width: kind.width, dash: kind.dash},
         marker: {size: 3, color: kind.name === 'not physical' ? NONPHYSICAL : colourOf(b.family)},
       });
     }
     return traces;
+  }
+
+  // Whether a legend entry of this name is still to be shown in the drawing being made (draw() resets it).
+  let legendNames = new Set();
+  function legendShown(name) {
+    if (legendNames.has(name)) return false;
+    legendNames.add(name);
+    return true;
   }
 
   function describePoint(b, i) {
@@ -84,12 +95,20 @@
   }
 
   function specialTrace(x, y, showNonphysical) {
-    const xs = [], ys = [], text = [], custom = [], symbols = [], colours = [];
+    const xs = [], ys = [], text = [], custom = [], symbols = [], colours = [], labels = [];
+    const at = new Map();  // a drawn position -> its index: points that coincide share one label
     for (const sp of specialPoints) {
       const b = branchById.get(sp.branch);
       if (!b || !(x in sp.columns) || !(y in sp.columns)) continue;
       const physical = b.physical[Math.min(sp.index, b.physical.length - 1)] || b.physical[Math.min(sp.index + 1, b.physical.length - 1)];
       if (!physical && !showNonphysical) continue;
+      const key = Number(sp.columns[x]).toPrecision(8) + ',' + Number(sp.columns[y]).toPrecision(8);
+      if (physical && at.has(key)) {
+        labels[at.get(key)] += ' = ' + sp.label;
+      } else if (physical) {
+        at.set(key, labels.length);
+      }
+      labels.push(physical && at.get(key) === labels.length ? sp.label : '');
       xs.push(sp.columns[x]);
       ys.push(sp.columns[y]);
       text.push(sp.label + ' on branch ' + sp.branch + (b.family ? ' (' + b.family + ')' : '') + '<br>' +
@@ -100,17 +119,23 @@
       symbols.push(SYMBOLS[sp.code] || 'x');
       colours.push(physical ? '#222' : NONPHYSICAL);
     }
-    return {type: 'scatter', mode: 'markers', x: xs, y: ys, hovertext: text, hovertemplate: '%{hovertext}<extra></extra>', customdata: custom, showlegend: false,
+    // Each physical point labelled at its marker (up and right of it).
+    return {type: 'scatter', mode: 'markers+text', x: xs, y: ys, text: labels, textposition: 'top right',
+            textfont: {size: 10, color: '#222'}, hovertext: text, hovertemplate: '%{hovertext}<extra></extra>',
+            customdata: custom, showlegend: false,
             marker: {symbol: symbols, size: 9, color: colours, line: {width: 1, color: '#222'}}};
   }
 
   function draw() {
     const x = xSelect.value, y = ySelect.value, showNonphysical = document.getElementById('show-nonphysical').checked;
     const traces = [];
+    legendNames = new Set();
     for (const b of study.branches) traces.push(...branchTraces(b, x, y, showNonphysical));
     traces.push(specialTrace(x, y, showNonphysical));
     const layout = {
-      margin: {l: 60, r: 10, t: 10, b: 50}, hovermode: 'closest', dragmode: 'zoom',
+      // The families' legend in a row above the plot, left of the toolbar.
+      margin: {l: 60, r: 10, t: 40, b: 50}, hovermode: 'closest', dragmode: 'zoom',
+      legend: {orientation: 'h', x: 0, xanchor: 'left', y: 1.02, yanchor: 'bottom', font: {size: 11}},
       xaxis: {title: {text: x}, zeroline: false}, yaxis: {title: {text: y}, zeroline: false},
     };
     Plotly.react('diagram', traces, layout, {responsive: true, displaylogo: false, scrollZoom: true});

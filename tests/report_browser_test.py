@@ -42,7 +42,7 @@ def test_report_opens_offline_and_a_click_shows_the_orbit(slip_report):
         # A point of hopping in place (branch 2) where it is stable, at its pixel on the screen.
         where = browser.evaluate("""(() => {
             const gd = document.getElementById('diagram');
-            const trace = gd.data.findIndex(t => t.name === 'hopping in place · stable');
+            const trace = gd.data.findIndex(t => t.name === 'hopping in place' && t.meta === 'stable');
             const t = gd.data[trace];
             const i = t.x.findIndex((v, k) => v !== null && t.x[k + 3] !== null && k > 2);
             const xa = gd._fullLayout.xaxis, ya = gd._fullLayout.yaxis;
