@@ -171,7 +171,8 @@ def _names(items, what):
 
 class ModelBuilder:
     """A model written in Python: parameters, phases (vector fields, or mechanics from T and V or M(q)),
-    symmetries, starts, run settings, families, quantities and drawing, each as its model-file entry
+    symmetries, starts, run settings, families, quantities, observables, constraints and drawing, each as its
+    model-file entry
     (docs/model-files.md), with SymPy expressions where the file has expression strings.
 
     ``text()`` is the model file this builder writes; ``build()`` the Model the library makes of it (its
@@ -329,6 +330,37 @@ class ModelBuilder:
         if description:
             entry["description"] = description
         self._doc.setdefault("quantities", {})[name] = entry
+
+    def observable(self, name, description=None, value=None, integral=None, mean=None, minimum=None, maximum=None,
+                   final=None):
+        """What a study measures of an orbit (``[observables]``): exactly one of ``value`` (an expression of the
+        unknowns, ``T`` and the parameters), or ``integral``, ``mean``, ``minimum``, ``maximum`` or ``final``
+        ({phase: expression}, the phase's states, parameters and definitions). Usable as the model file's are:
+        ``until``, ``fix`` with ``free``, ``monitor``, ``extremum``, ``bound``. Returns its name."""
+        kinds = {"value": value, "integral": integral, "mean": mean, "minimum": minimum, "maximum": maximum,
+                 "final": final}
+        given = [k for k, v in kinds.items() if v is not None]
+        if len(given) != 1:
+            raise ValueError("observable %r: give exactly one of %s (given: %s)"
+                             % (name, ", ".join(kinds), ", ".join(given) or "none"))
+        kind = given[0]
+        entry = {kind: self._t(value) if kind == "value" else self._table(kinds[kind])}
+        if description:
+            entry["description"] = description
+        self._doc.setdefault("observables", {})[_names([name], "observable")[0]] = entry
+        return name
+
+    def constraint(self, name, phases=None, final=None, description=None):
+        """Admissibility (``[constraints]``): ``phases`` {phase: expression} that stays >= 0 throughout each named
+        phase of a physical orbit, or ``final`` {phase: expression} >= 0 at the end of the one phase it names.
+        Orbits that violate it are classified ``constraint-violated``; its boundary is located (``CB``)."""
+        if (phases is None) == (final is None):
+            raise ValueError("constraint %r: give phases={phase: expression} or final={phase: expression}" % name)
+        entry = {"final": self._table(final)} if final is not None else self._table(phases)
+        if description:
+            entry["description"] = description
+        self._doc.setdefault("constraints", {})[_names([name], "constraint")[0]] = entry
+        return name
 
     def drawing(self, phases, mass_radius=None, ground=None):
         """How the mechanism is drawn: {phase: {"points": {name: (x, y)}, "lines": [[...]], "masses": [...]}}."""

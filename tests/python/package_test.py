@@ -173,6 +173,23 @@ def test_a_sympy_model_equals_its_model_file_twin():
     assert np.allclose(a.H, b.H, atol=1e-9) and np.allclose(a["T"], b["T"], atol=1e-9)
 
 
+def test_model_builder_declares_observables_and_constraints():
+    """As a model file's [observables] and [constraints]: the ball's apex (its largest height in flight) is
+    H / (m g) exactly, so the monitored crossing apex = 0.5 is located at H = 0.5."""
+    b = bouncing_ball_in_python()
+    y = sp.Symbol("y")
+    assert b.observable("apex", maximum={"flight": y}, description="highest point in flight") == "apex"
+    b.constraint("above_floor", phases={"flight": y + 1}, description="never below the floor")
+    with pytest.raises(ValueError, match="give exactly one of"):
+        b.observable("both", value="x1_dy", mean={"flight": y})
+    with pytest.raises(ValueError, match="give phases"):
+        b.constraint("none")
+    study = hc.run(b.build(), progress=False, monitor={"apex": [0.5]})
+    uz = study.special_points[(study.special_points.type == "UZ") & (study.special_points.status == "located")]
+    assert len(uz) >= 1 and np.allclose(uz.H, 0.5, atol=1e-9), uz[["label", "H"]]
+    assert "above_floor" in study.points.columns and (study.points[study.points.physical == 1]["above_floor"] > 0).all()
+
+
 def test_progress_reaches_python_and_the_gil_is_released_while_computing():
     calls = []
     ticks = []

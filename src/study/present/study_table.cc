@@ -11,11 +11,19 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Columns filled row by row: a number column is created (NaN for the rows before) when first met.
+// Columns filled row by row: a number column is created (NaN for the rows before) when first met. A column
+// given twice in one row keeps the first value: an observable among the unknowns (--monitor, --extremum) is
+// both an unknown and an observable of the point, equal on the orbit.
 class ColumnBuilder {
  public:
-  void Text(const std::string& name, const std::string& value) { At(name, true).texts.push_back(value); }
-  void Number(const std::string& name, double value) { At(name, false).numbers.push_back(value); }
+  void Text(const std::string& name, const std::string& value) {
+    StudyColumn& c = At(name, true);
+    if (static_cast<int>(c.texts.size()) <= rows_) c.texts.push_back(value);
+  }
+  void Number(const std::string& name, double value) {
+    StudyColumn& c = At(name, false);
+    if (static_cast<int>(c.numbers.size()) <= rows_) c.numbers.push_back(value);
+  }
   // Ends a row: every column the row did not reach gets NaN (or "").
   void EndRow() {
     ++rows_;
