@@ -207,8 +207,8 @@
     document.getElementById('hint').hidden = true;
     const rows = [['branch', b.id + (b.family ? ' · ' + b.family : '')], ['point', index],
                   ['class', b.classification[index]], ['stability', b.stability[index] || '—']];
-    if (note) rows.unshift(['shown', note]);
     if (b.word && b.word.length) rows.splice(1, 0, ['word', b.word.join(' > ')]);
+    if (note) rows.unshift(['shown', note]);
     // A value below the integration's resolution (|v| < 1e-12, e.g. a state that is zero by symmetry and comes
     // out as 1e-110) is shown as 0.
     const shown = (v) => (typeof v === 'number' && Math.abs(v) < 1e-12 ? '0' : fmt(v));
@@ -282,10 +282,12 @@
             specialPoints.map((sp) => {
               const b = branchById.get(sp.branch);
               const index = Math.min(sp.index, b.physical.length - 1);
+              // A start is a computed point; another special point lies between two, of which this is the first.
+              const between = sp.code !== 'start' && sp.index + 1 < b.physical.length;
               return {
                 branch: sp.branch, index,
-                note: 'point ' + index + ', the computed point before ' + sp.label + ' (which lies between points ' +
-                      sp.index + ' and ' + (sp.index + 1) + ')',
+                note: between ? 'point ' + index + ', the computed point before ' + sp.label +
+                                ' (which lies between points ' + sp.index + ' and ' + (sp.index + 1) + ')' : undefined,
                 cells: [sp.label, sp.branch, b.family || '—', b.continued + ' = ' + fmt(sp.coordinate), fmt(sp.T),
                         sp.status, typeof sp.precision === 'number' ? sp.precision.toExponential(1) : '—'],
               };

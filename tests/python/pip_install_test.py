@@ -50,7 +50,9 @@ def test_a_wheel_installs_offline_and_its_package_and_command_work(tmp_path):
                           env=env, cwd=str(tmp_path))
     assert proc.returncode == 0 and "slip: 5 branches with physical orbits" in proc.stdout, proc.stderr
     assert os.path.exists(tmp_path / "slip" / "report.html")
-    models = os.path.join(str(venv), "lib", "python3.11", "site-packages", "hybridcont", "data", "models")
+    where = subprocess.run([python, "-c", "import hybridcont, os; print(os.path.dirname(hybridcont.__file__))"],
+                           capture_output=True, text=True, env=env, cwd=str(tmp_path), check=True).stdout.strip()
+    models = os.path.join(where, "data", "models")
     proc = subprocess.run([command, "run", os.path.join(models, "forced-impact-oscillator.toml"), "--out", "oscillator",
                            "--quiet"], capture_output=True, text=True, env=env, cwd=str(tmp_path))
     assert proc.returncode == 0, proc.stderr

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -195,11 +196,20 @@ std::string OneScreenAnswer(const StudyResult& study, double seconds) {
   }
   out += fmt::format("\n{}: {} branch{} with physical orbits of {} ({} points)\n", study.model, physical_branches,
                      physical_branches == 1 ? "" : "es", study.branches.size(), points);
-  // The parameter values it was computed at: the answer holds for these.
+  // The parameter values it was computed at: the answer holds for these. A parameter the families are continued
+  // in (--free, a model without first integral) varies along them: named as such, not given a value.
   if (!study.parameters.empty()) {
-    std::string values;
-    for (const NamedValue& p : study.parameters) values += fmt::format("{}{} = {:.6g}", values.empty() ? "" : ", ", p.name, p.value);
-    out += "at " + values + "\n";
+    std::set<std::string> continued;
+    for (const StudyBranch& b : study.branches) continued.insert(b.continued);
+    std::string values, varying;
+    for (const NamedValue& p : study.parameters) {
+      if (continued.count(p.name)) {
+        varying += (varying.empty() ? "" : ", ") + p.name;
+      } else {
+        values += fmt::format("{}{} = {:.6g}", values.empty() ? "" : ", ", p.name, p.value);
+      }
+    }
+    out += "at " + values + (varying.empty() ? "" : " (" + varying + " varies along the families)") + "\n";
   }
   if (!study.start_note.empty()) out += study.start_note + "\n";
   // The families over all their branches (FoldFamilies): what a sweep's table and Python's families say.

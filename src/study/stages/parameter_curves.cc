@@ -73,6 +73,7 @@ FreeParameters BaseParameters(const FreeParameters& run, const std::string& p, d
 Vector ToBaseUnknowns(const Vector& v, const std::vector<std::string>& from, const std::vector<std::string>& to,
                       const std::string& p, double p0_value) {
   if (v.size() == 0) return v;
+  HYBRIDCONT_DEMAND(v.size() == static_cast<Eigen::Index>(from.size()));  // v is laid out by `from`
   Vector w(static_cast<Eigen::Index>(to.size()));
   for (std::size_t j = 0; j < to.size(); ++j) {
     const auto at = std::find(from.begin(), from.end(), to[j]);
@@ -243,6 +244,19 @@ class CurveTracer {
 
   // How close to a traced curve's polyline a start counts as on it: the chords' sag at the curves' steps.
   double OnCurveTolerance() const { return 1e-3 * (1 + std::abs(p0_)); }
+  // The same, in (a, p) each relative to its size (1 + |a|, 1 + |p0|).
+  static constexpr double kOnCurveTolerance = 1e-3;
+
+  // Whether a branch point next to `sp` (the one before it or after it on its branch) is a physical orbit.
+  bool PhysicalNextTo(const SpecialPoint& sp, const BifurcationDiagram& diagram) const {
+    const auto branch = std::find_if(diagram.branches.begin(), diagram.branches.end(),
+                                     [&](const Branch& b) { return b.id == sp.branch_id; });
+    if (branch == diagram.branches.end()) return false;
+    for (const int i : {sp.index, sp.index + 1}) {
+      if (i >= 0 && i < static_cast<int>(branch->points.size()) && PhysicalAt(branch->points[i].u)) return true;
+    }
+    return false;
+  }
 
   // The type of the curve of a special point (StudyCurve::type).
   static std::string CurveType(const SpecialPoint& sp, bool fold) {
@@ -285,12 +299,23 @@ class CurveTracer {
         sp.u.size() == 0 || ((floquet || grazing) && sp.status != LocationStatus::kLocated)) {
       return;
     }
-    if (!PhysicalAt(sp.u) && !grazing) return;  // a grazing orbit is on the physical family's boundary
-    // A point on a curve of its type traced already (a mirror image's, the other end of one grazing curve).
-    const Eigen::Vector2d at(sp.u(run_layout_.continued_index()), p0_);
+    // A grazing orbit is on the physical family's boundary: one of the branch points around it is physical.
+    if (grazing ? !PhysicalNextTo(sp, diagram) : !PhysicalAt(sp.u)) return;
+    // A point on a curve of its kind traced already (a mirror image's, the other end of one grazing curve): the
+    // same type and component (an EX point's observable, a GR point's event), within the curves' sampling in
+    // (a, p), each axis relative to its size.
+    const Eigen::Vector2d scale(1 + std::abs(sp.u(run_layout_.continued_index())), 1 + std::abs(p0_));
+    const Eigen::Vector2d at = Eigen::Vector2d(sp.u(run_layout_.continued_index()), p0_).cwiseQuotient(scale);
     for (const StudyCurve& c : *curves_) {
-      const auto& traced = special_point_curves_[c.id];
-      if (c.special_point >= 0 && c.type == CurveType(sp, fold) && OnCurve({traced}, at, OnCurveTolerance())) {
+      const auto source = std::find_if(diagram.special_points.begin(), diagram.special_points.end(),
+                                       [&](const SpecialPoint& q) { return q.id == c.special_point; });
+      if (c.special_point < 0 || source == diagram.special_points.end() || c.type != CurveType(sp, fold) ||
+          source->component != sp.component || source->component_index != sp.component_index) {
+        continue;
+      }
+      std::vector<Eigen::Vector2d> traced = special_point_curves_[c.id];
+      for (Eigen::Vector2d& q : traced) q = q.cwiseQuotient(scale);
+      if (OnCurve({traced}, at, kOnCurveTolerance)) {
         *report_ += fmt::format("  from special point {} ({}): on curve {} (of special point {}, the same type)\n",
                                 sp.id, Code(sp.type), c.id, c.special_point);
         return;

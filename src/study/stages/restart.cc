@@ -144,6 +144,12 @@ void PlanAtSpecialPoint(const RestartSpec& spec, const StudyOptions& options, co
   if (plan->kind == Kind::kCurve && options.curves.empty()) {
     Refuse(spec, "a curve of the point needs its second parameter (curves)");
   }
+  // A saved point is in the model's own layout; a run with free parameters or observables among its unknowns
+  // continues its curves in another one (its --free parameter at a fixed value, its observables joined).
+  if (plan->kind == Kind::kCurve && (!options.free.empty() || !options.extrema.empty() || !options.monitors.empty())) {
+    Refuse(spec, "a saved point's curve is continued in (H, " + options.curves +
+                     ") only: not with free, monitors or extrema (run those studies whole: their curves come with them)");
+  }
   if (plan->kind == Kind::kCurve && sp->type != SpecialPointType::kTurningPoint &&
       sp->type != SpecialPointType::kSimpleBifurcation) {
     Refuse(spec, "curves continue turning points and SB points, not " + sp->code + " points");
