@@ -147,8 +147,9 @@ void PlanAtSpecialPoint(const RestartSpec& spec, const StudyOptions& options, co
   // A saved point is in the model's own layout; a run with free parameters or observables among its unknowns
   // continues its curves in another one (its --free parameter at a fixed value, its observables joined).
   if (plan->kind == Kind::kCurve && (!options.free.empty() || !options.extrema.empty() || !options.monitors.empty())) {
-    Refuse(spec, "a saved point's curve is continued in (H, " + options.curves +
-                     ") only: not with free, monitors or extrema (run those studies whole: their curves come with them)");
+    Refuse(spec, "a saved point's curve is continued in (H, " + options.curves + ") only: not with " +
+                     MentionOption("free") + ", " + MentionOption("monitors") + " or " + MentionOption("extrema") +
+                     " (run those studies whole: their curves come with them)");
   }
   if (plan->kind == Kind::kCurve && sp->type != SpecialPointType::kTurningPoint &&
       sp->type != SpecialPointType::kSimpleBifurcation) {
