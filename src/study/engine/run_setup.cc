@@ -340,6 +340,14 @@ RunSetup MakeRunSetup(const StudyOptions& given, const HybridModel& model) {
   ApplyExplorationLimits(args, &setup.exploration);
   ApplyFreeParameter(args, model, &setup);
   ApplyObservables(args, model, &setup);
+  // The period-doubled model (the phase sequence traversed twice) carries no observables: its families cannot be
+  // followed with one among the unknowns.
+  if (args.period_doubling && !setup.free.observables.empty()) {
+    Refuse("period_doubling", -1, ": not with an observable among the unknowns ('" + setup.free.observables.front() +
+                                      "', from " + MentionOption("monitors") + ", " + MentionOption("extrema") + ", " +
+                                      MentionOption("until") + " or " + MentionOption("bounds") +
+                                      "): the doubled model does not carry the model's observables");
+  }
   // Family names read the points of this run's layout: with its free parameters at their values in u.
   setup.scenario.describe = [presentation = OrbitPresentation(model, setup.free)](const Vector& u) {
     return presentation.Family(u);

@@ -90,6 +90,7 @@ std::string ExplorePeriodDoubledFamilies(const HybridModel& model, const HybridM
       AnalyzePoint(at_point, setup.integrator, floquet_map, replay, &record, known ? &*known : nullptr);
       writer.AddPoint(id, record);
     });
+    MarkExtrema(setup.extrema, &d);  // the observables' turning points are EX points here too
     const FloquetResult at_pd = ComputeFloquet(parent_map, u_pd);
     report += fmt::format("  from PD #{} at {} = {:.12f} (parent period {:.12f}, multipliers {}):\n", pd_id,
                           parent.continued_name(), u_pd(parent.continued_index()), parent.Period(u_pd),
