@@ -21,6 +21,8 @@
 #include "hybridcont/orbit_trace.h"
 #include "hybridcont/setup_evaluation.h"
 #include "hybridcont/study_answer.h"
+#include "study/io/summary_json.h"
+#include "study/stages/regions.h"
 
 namespace hybridcont {
 
@@ -162,11 +164,8 @@ json SpecialPointJson(const StudySpecialPoint& sp, const StudyResult& study) {
 // where stable (StudyResult::regions, regions.h).
 json PlaneJson(const StudyResult& study) {
   if (study.curves.empty() || study.curve_parameter.empty()) return nullptr;
-  double p0 = NAN;
-  for (const NamedValue& v : study.parameters) {
-    if (v.name == study.curve_parameter) p0 = v.value;
-  }
-  const std::string a = study.curves.front().columns.empty() ? std::string("H") : study.curves.front().columns.front();
+  const double p0 = study::ParameterValue(study, study.curve_parameter);
+  const std::string a = study::CurvesCoordinate(study.curves);
   json curves = json::array();
   for (const StudyCurve& c : study.curves) {
     const auto h = std::find(c.columns.begin(), c.columns.end(), a) - c.columns.begin();

@@ -135,7 +135,8 @@ struct Boundary {
 // gradient independent of dr's rows) — the defining system of a boundary, as a fold's is r = 0 with a
 // turning-point condition. Traced both ways from the corrected start, `orbit` in the run's unknowns (`run`).
 std::vector<Vector> TraceBoundary(const HybridModel& model, const RunSetup& setup, const Boundary& boundary,
-                                  const Vector& orbit, const std::vector<std::string>& run, double p0,
+                                  const Vector& orbit, const std::vector<std::string>& run, const std::string& a,
+                                  double p0,
                                   const ContinuationOptions& options, std::vector<std::string>* names,
                                   std::string* why) {
   const std::string& p = setup.curve_parameter;
@@ -157,7 +158,7 @@ std::vector<Vector> TraceBoundary(const HybridModel& model, const RunSetup& setu
     ContinuationOptions c = options;
     c.direction = direction;
     c.detect_bifurcations = false;
-    c.turning_point_components = {ShootingLayout(model, setup.free).continued_name()};
+    c.turning_point_components = {a};
     const Branch half = TraceBranch(&map, start, c);
     if (half.points.empty()) {
       *why = half.message;
@@ -193,7 +194,7 @@ class CurveTracer {
   CurveTracer(const HybridModel& model, const RunSetup& setup, const std::filesystem::path& dir, std::string* report,
               std::vector<StudyCurve>* curves)
       : model_(model), setup_(setup), p_(setup.curve_parameter), p0_(model.parameter(p_)),
-        run_layout_(model, setup.free), a_(run_layout_.continued_name()),
+        run_layout_(model, setup.free), at_point_(model.Clone()), a_(run_layout_.continued_name()),
         base_(model, setup.integrator, BaseParameters(setup.free, p_, p0_)),
         fix_row_(base_.layout().fixed_row(base_.layout().num_fixed() - 1)), dir_(dir), report_(report),
         curves_(curves) {
@@ -232,6 +233,7 @@ class CurveTracer {
   const std::string p_;
   const double p0_;
   const ShootingLayout run_layout_;  // the layout of the diagram's points
+  HybridModel at_point_;             // the model at a point's free parameters (PhysicalAt)
   const std::string a_;              // the coordinate the run's families are continued in
   TimeBasedShooting base_;
   const int fix_row_;                // the base map's row that holds p at p0
@@ -248,7 +250,7 @@ class CurveTracer {
   static constexpr double kOnCurveTolerance = 1e-3;
 
   // Whether a branch point next to `sp` (the one before it or after it on its branch) is a physical orbit.
-  bool PhysicalNextTo(const SpecialPoint& sp, const BifurcationDiagram& diagram) const {
+  bool PhysicalNextTo(const SpecialPoint& sp, const BifurcationDiagram& diagram) {
     const auto branch = std::find_if(diagram.branches.begin(), diagram.branches.end(),
                                      [&](const Branch& b) { return b.id == sp.branch_id; });
     if (branch == diagram.branches.end()) return false;
@@ -267,10 +269,9 @@ class CurveTracer {
   }
 
   // Whether the run's point u is a physical orbit of the model at u's free parameters.
-  bool PhysicalAt(const Vector& u) const {
-    HybridModel at = model_.Clone();
-    SetFreeParameters(run_layout_, u, &at);
-    return IsPhysical(at, OrbitPart(run_layout_, u), setup_.integrator);
+  bool PhysicalAt(const Vector& u) {
+    SetFreeParameters(run_layout_, u, &at_point_);
+    return IsPhysical(at_point_, OrbitPart(run_layout_, u), setup_.integrator);
   }
 
   // Writes the curve's file (curve_<id>.csv) and records `c` with its id and points; returns its id.
@@ -383,8 +384,8 @@ class CurveTracer {
     std::string why;
     std::vector<Vector> points;
     try {
-      points = TraceBoundary(model_, setup_, boundary, orbit, run_layout_.unknown_names(), p0_, options_.continuation,
-                             &names, &why);
+      points = TraceBoundary(model_, setup_, boundary, orbit, run_layout_.unknown_names(), a_, p0_,
+                             options_.continuation, &names, &why);
     } catch (const std::invalid_argument& e) {
       why = e.what();
     }

@@ -24,9 +24,6 @@ Edge EdgeThrough(const std::vector<std::pair<double, double>>& curve, std::pair<
   Edge edge;
   if (curve.size() < 2) return edge;
   const double sp = 1 + std::abs(at.first), sa = 1 + std::abs(at.second);
-  const auto distance = [&](const std::pair<double, double>& q) {
-    return std::hypot((q.first - at.first) / sp, (q.second - at.second) / sa);
-  };
   std::size_t nearest = 0;
   double best = HUGE_VAL;
   for (std::size_t i = 0; i + 1 < curve.size(); ++i) {
@@ -52,13 +49,16 @@ Edge EdgeThrough(const std::vector<std::pair<double, double>>& curve, std::pair<
 
 }  // namespace
 
+std::string CurvesCoordinate(const std::vector<StudyCurve>& curves) {
+  return curves.empty() || curves.front().columns.empty() ? std::string("H") : curves.front().columns.front();
+}
+
 std::vector<StudyRegion> ParameterRegions(const std::vector<StudyBranch>& branches,
                                           const std::vector<StudyCurve>& curves, const std::string& parameter,
                                           double value) {
   std::vector<StudyRegion> regions;
   if (curves.empty() || parameter.empty()) return regions;
-  // The families' coordinate: the first column of every curve (parameter_curves.h).
-  const std::string a = curves.front().columns.empty() ? std::string("H") : curves.front().columns.front();
+  const std::string a = CurvesCoordinate(curves);
   std::vector<std::vector<std::pair<double, double>>> drawn;  // each curve's (p, a), in curve order
   for (const StudyCurve& c : curves) {
     const auto h = std::find(c.columns.begin(), c.columns.end(), a) - c.columns.begin();

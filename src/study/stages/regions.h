@@ -19,6 +19,10 @@
 
 namespace hybridcont::study {
 
+// The families' coordinate a the curves are drawn in besides their parameter: every curve's first column
+// (parameter_curves.h); "H" without columns.
+std::string CurvesCoordinate(const std::vector<StudyCurve>& curves);
+
 // The regions of the families of `branches` (their ranges, continued coordinate and origin are read) between
 // `curves` in (parameter, a), `value` the run's parameter value; empty without curves.
 std::vector<StudyRegion> ParameterRegions(const std::vector<StudyBranch>& branches,
